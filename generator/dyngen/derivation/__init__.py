@@ -1,0 +1,1 @@
+"""Derivation: symbolic Newton-Euler, built as straight-line code while it recurses."""

@@ -1,0 +1,138 @@
+"""Every quantity dyngen emits, as straight-line programs over named inputs.
+
+A `Model` is the math of one emitted C function: its inputs (name, symbols, meaning),
+its pruned assignments and its flat outputs. Regressors come full (all 10N standard
+parameters); reduction picks their base columns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ..description import Robot
+from ..parameters import PER_LINK, dynamic_symbols, standard_from_dynamic_link, standard_symbols
+from .newton_euler import Chain, joint_symbols, link_wrench
+from .program import Program
+
+
+@dataclass
+class Input:
+    name: str  # the C argument
+    symbols: list  # entry k of the argument is symbols[k]
+    doc: str
+
+
+@dataclass
+class Model:
+    name: str
+    inputs: list[Input]
+    outputs: list  # flat, row-major
+    shape: tuple
+    doc: str
+    program: Program = field(repr=False)
+    trig: dict = field(default_factory=dict)  # trig symbol -> (joint, "sin" | "cos")
+
+    @property
+    def assignments(self):
+        return self.program.pruned(self.outputs)
+
+
+class Derivation:
+    """Builds the models of one robot; each model has its own program."""
+
+    def __init__(self, robot: Robot):
+        self.robot = robot
+        self.n = robot.dof
+        self.s = standard_symbols(self.n)
+        self.p = dynamic_symbols(self.n)
+
+    # ---- inputs -------------------------------------------------------------------------
+
+    def _joint_inputs(self, sym, *which):
+        docs = {"q": "joint positions [rad or m]", "qd": "joint velocities", "qdd": "joint accelerations"}
+        return [Input(w, getattr(sym, w), docs[w]) for w in which]
+
+    def _gravity_inputs(self):
+        g = list(self.robot.gravity_symbols)
+        return [Input("gravity", g, "gravity symbols " + ", ".join(map(str, g)))] if g else []
+
+    def _params_input(self):
+        return Input("s", self.s, "standard parameters, 10 per link (docs/conventions.md)")
+
+    def _start(self):
+        program = Program()
+        sym = joint_symbols(self.robot)
+        return program, sym, Chain(self.robot, program, sym)
+
+    # ---- inverse dynamics and its conveniences ------------------------------------------
+
+    def rnea(self) -> Model:
+        program, sym, chain = self._start()
+        motions = chain.forward(sym.qd, sym.qdd, self.robot.gravity)
+        tau = self._tau(program, chain, motions)
+        return Model("rnea", self._joint_inputs(sym, "q", "qd", "qdd") + [self._params_input()] + self._gravity_inputs(),
+                     tau, (self.n,), "inverse dynamics tau = M(q) qdd + c(q, qd) + g(q) (Newton-Euler)",
+                     program, sym.trig)
+
+    def gravity(self) -> Model:
+        program, sym, chain = self._start()
+        zero = [0] * self.n
+        g = self._tau(program, chain, chain.forward(zero, zero, self.robot.gravity))
+        return Model("gravity", self._joint_inputs(sym, "q") + [self._params_input()] + self._gravity_inputs(),
+                     g, (self.n,), "gravity vector g(q)", program, sym.trig)
+
+    def mass_matrix(self) -> Model:
+        program, sym, chain = self._start()
+        M = sp.zeros(self.n, self.n)
+        for k in range(self.n):
+            unit = [int(j == k) for j in range(self.n)]
+            column = self._tau(program, chain, chain.forward([0] * self.n, unit, [0, 0, 0]))
+            for j in range(k + 1):
+                M[j, k] = M[k, j] = column[j]
+        return Model("mass_matrix", self._joint_inputs(sym, "q") + [self._params_input()], list(M),
+                     (self.n, self.n), "inertia matrix M(q), row-major", program, sym.trig)
+
+    def _tau(self, program, chain, motions):
+        wrenches = []
+        for i, motion in enumerate(motions):
+            program.section = f"link {i + 1}: link wrench"
+            wrenches.append(link_wrench(program, motion, self.s[PER_LINK * i: PER_LINK * (i + 1)]))
+        return chain.backward(wrenches)
+
+    # ---- regressors (all 10N columns) ---------------------------------------------------
+
+    def regressor(self, kind: str) -> Model:
+        """kind: 'gravity' (N x 10N), 'inertia' (N(N+1)/2 x 10N, stacked upper M), 'full' (N x 10N)."""
+        program, sym, chain = self._start()
+        zero = [0] * self.n
+        if kind == "full":
+            rows = chain.regressor_columns(chain.forward(sym.qd, sym.qdd, self.robot.gravity))
+            inputs = self._joint_inputs(sym, "q", "qd", "qdd") + self._gravity_inputs()
+        elif kind == "gravity":
+            rows = chain.regressor_columns(chain.forward(zero, zero, self.robot.gravity))
+            inputs = self._joint_inputs(sym, "q") + self._gravity_inputs()
+        elif kind == "inertia":
+            columns = []
+            for k in range(self.n):
+                unit = [int(j == k) for j in range(self.n)]
+                columns.append(chain.regressor_columns(chain.forward(zero, unit, [0, 0, 0])))
+            rows = [columns[k][j] for j in range(self.n) for k in range(j, self.n)]  # M[j][k], j <= k
+            inputs = self._joint_inputs(sym, "q")
+        else:
+            raise ValueError(kind)
+        shape = (len(rows), PER_LINK * self.n)
+        return Model(f"regressor_{kind}", inputs, [x for row in rows for x in row], shape,
+                     f"{kind} regressor over all standard parameters", program, sym.trig)
+
+    # ---- parameters ---------------------------------------------------------------------
+
+    def standard_from_dynamic(self) -> Model:
+        program = Program()
+        out = []
+        for i in range(self.n):
+            program.section = f"link {i + 1}"
+            out += program.let_vector(standard_from_dynamic_link(self.p[PER_LINK * i: PER_LINK * (i + 1)]))
+        return Model("standard_from_dynamic", [Input("p", self.p, "dynamic parameters, 10 per link")], out,
+                     (PER_LINK * self.n,), "standard parameters s from dynamic parameters p", program)

@@ -1,0 +1,86 @@
+"""The Robot value: everything one YAML file says about an arm.
+
+Kinematic constants are exact SymPy numbers (0.4 -> 2/5, "pi/2" -> pi/2) so that the
+derivation drops the zero terms of cos(pi/2) exactly. Inertial data are floats.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import sympy as sp
+
+from ..parameters import DYNAMIC_NAMES_PER_LINK
+
+
+@dataclass(frozen=True)
+class Limits:
+    lower: Optional[float] = None
+    upper: Optional[float] = None
+    velocity: Optional[float] = None
+    effort: Optional[float] = None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One DH row. For a revolute joint q adds to theta, for a prismatic one to d."""
+
+    type: str  # "revolute" | "prismatic"
+    a: sp.Expr
+    alpha: sp.Expr
+    d: sp.Expr
+    theta: sp.Expr
+    limits: Optional[Limits] = None
+
+    @property
+    def revolute(self) -> bool:
+        return self.type == "revolute"
+
+
+@dataclass(frozen=True)
+class LinkValues:
+    """The 10 dynamic parameters of one link (or their bounds), in the canonical order."""
+
+    m: float
+    c: tuple[float, float, float]
+    I: tuple[float, float, float, float, float, float]  # xx, xy, xz, yy, yz, zz
+
+    def as_tuple(self) -> tuple[float, ...]:
+        return (self.m, *self.c, *self.I)
+
+    @staticmethod
+    def from_tuple(values) -> "LinkValues":
+        v = tuple(float(x) for x in values)
+        assert len(v) == len(DYNAMIC_NAMES_PER_LINK)
+        return LinkValues(v[0], v[1:4], v[4:10])
+
+
+@dataclass(frozen=True)
+class IdentifiedCoefficient:
+    coefficient: str  # an expression in dynamic or standard parameter names
+    value: float
+
+
+@dataclass(frozen=True)
+class Robot:
+    name: str
+    source: str  # the file it came from, for error messages
+    convention: str  # "standard" | "modified"
+    joints: tuple[Joint, ...]
+    gravity: tuple[sp.Expr, sp.Expr, sp.Expr]
+    nominal: Optional[tuple[LinkValues, ...]] = None
+    lower: Optional[tuple[LinkValues, ...]] = None
+    upper: Optional[tuple[LinkValues, ...]] = None
+    total_mass: Optional[tuple[float, float]] = None
+    identified: dict = field(default_factory=dict)  # kind -> tuple[IdentifiedCoefficient]
+
+    @property
+    def dof(self) -> int:
+        return len(self.joints)
+
+    @property
+    def gravity_symbols(self) -> tuple[sp.Symbol, ...]:
+        """Symbols in the gravity vector, sorted by name: extra inputs of the generated code."""
+        free = set().union(*(sp.sympify(g).free_symbols for g in self.gravity))
+        return tuple(sorted(free, key=lambda s: s.name))

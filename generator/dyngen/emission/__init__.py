@@ -1,0 +1,1 @@
+"""Emission: straight-line programs printed as C99 through the jinja2 templates."""

@@ -1,0 +1,90 @@
+"""The two parametrisations of a link, their names and the one canonical order.
+
+dynamic p (the paper's eqs. 2-5): m, c_x, c_y, c_z, I_xx, I_xy, I_xz, I_yy, I_yz, I_zz
+    c in link frame i, I about the centre of mass with axes parallel to frame i.
+standard s (linear in the dynamics, Khalil-Dombre): m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ
+    (mx, my, mz) = m c, and XX..ZZ the inertia about the origin of frame i.
+Both are stacked link by link, link 1 first; see docs/conventions.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+DYNAMIC_NAMES_PER_LINK = ("m", "cx", "cy", "cz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz")
+STANDARD_NAMES_PER_LINK = ("m", "mx", "my", "mz", "XX", "XY", "XZ", "YY", "YZ", "ZZ")
+PER_LINK = len(DYNAMIC_NAMES_PER_LINK)
+
+# Index of the symmetric 3x3 entries (row, col) in the 6-vector xx, xy, xz, yy, yz, zz.
+_INERTIA_INDEX = {(0, 0): 0, (0, 1): 1, (0, 2): 2, (1, 1): 3, (1, 2): 4, (2, 2): 5}
+
+
+def dynamic_name(link: int, k: int) -> str:
+    """m3, c3x, I3xx: the letter, the link number (from 1), then the axes."""
+    base = DYNAMIC_NAMES_PER_LINK[k]
+    return f"{base[0]}{link}{base[1:]}"
+
+
+def standard_name(link: int, k: int) -> str:
+    """m3, mx3, XX3."""
+    return f"{STANDARD_NAMES_PER_LINK[k]}{link}"
+
+
+def dynamic_symbols(n_links: int) -> list[sp.Symbol]:
+    return [sp.Symbol(dynamic_name(i + 1, k), real=True) for i in range(n_links) for k in range(PER_LINK)]
+
+
+def standard_symbols(n_links: int) -> list[sp.Symbol]:
+    return [sp.Symbol(standard_name(i + 1, k), real=True) for i in range(n_links) for k in range(PER_LINK)]
+
+
+def inertia_matrix(six) -> sp.Matrix:
+    """3x3 symmetric matrix from (xx, xy, xz, yy, yz, zz)."""
+    return sp.Matrix(3, 3, lambda r, c: six[_INERTIA_INDEX[(min(r, c), max(r, c))]])
+
+
+def standard_from_dynamic_link(p10):
+    """Symbolic or numeric: one link's standard parameters from its dynamic ones."""
+    m, cx, cy, cz, ixx, ixy, ixz, iyy, iyz, izz = p10
+    return [
+        m, m * cx, m * cy, m * cz,
+        ixx + m * (cy * cy + cz * cz), ixy - m * cx * cy, ixz - m * cx * cz,
+        iyy + m * (cx * cx + cz * cz), iyz - m * cy * cz,
+        izz + m * (cx * cx + cy * cy),
+    ]
+
+
+def dynamic_from_standard_link(s10):
+    """Inverse of standard_from_dynamic_link (needs m != 0)."""
+    m, mx, my, mz, xx, xy, xz, yy, yz, zz = s10
+    cx, cy, cz = mx / m, my / m, mz / m
+    return [
+        m, cx, cy, cz,
+        xx - m * (cy * cy + cz * cz), xy + m * cx * cy, xz + m * cx * cz,
+        yy - m * (cx * cx + cz * cz), yz + m * cy * cz,
+        zz - m * (cx * cx + cy * cy),
+    ]
+
+
+def standard_from_dynamic(p: np.ndarray) -> np.ndarray:
+    """Numeric, all links: (10N,) dynamic -> (10N,) standard."""
+    p = np.asarray(p, dtype=float).reshape(-1, PER_LINK)
+    return np.array([standard_from_dynamic_link(row) for row in p], dtype=float).ravel()
+
+
+def dynamic_from_standard(s: np.ndarray) -> np.ndarray:
+    s = np.asarray(s, dtype=float).reshape(-1, PER_LINK)
+    return np.array([dynamic_from_standard_link(row) for row in s], dtype=float).ravel()
+
+
+def standard_in_dynamic_symbols(n_links: int) -> dict[sp.Symbol, sp.Expr]:
+    """Each standard symbol as an expression of the dynamic symbols (mx3 -> c3x*m3)."""
+    p = dynamic_symbols(n_links)
+    s = standard_symbols(n_links)
+    out = {}
+    for i in range(n_links):
+        exprs = standard_from_dynamic_link(p[PER_LINK * i: PER_LINK * (i + 1)])
+        for k in range(PER_LINK):
+            out[s[PER_LINK * i + k]] = sp.expand(exprs[k])
+    return out

@@ -1,0 +1,1 @@
+"""Reduction: from the 10N standard parameters to a minimal set of base coefficients."""

@@ -1,0 +1,102 @@
+"""Exact evaluation of straight-line code over the prime field GF(P).
+
+The regressors are polynomials in sin/cos of the joint angles (and in q for prismatic
+joints, qd, qdd and gravity symbols) with rational coefficients. At the rational points
+(cos, sin) = ((1 - t^2)/(1 + t^2), 2t/(1 + t^2)) of the unit circle they take rational
+values; evaluated modulo a large prime they give, with probability ~1 - 1e-30, the exact
+rank over the rationals. No floating point tolerance is involved.
+"""
+
+from __future__ import annotations
+
+import random
+
+import sympy as sp
+
+P = (1 << 127) - 1  # a Mersenne prime
+
+
+def inverse(x: int) -> int:
+    return pow(x % P, P - 2, P)
+
+
+def to_field(value) -> int:
+    r = sp.Rational(value)
+    return (int(r.p) * inverse(int(r.q))) % P
+
+
+def circle_point(rng: random.Random) -> tuple[int, int]:
+    """(cos, sin) of a random rational angle, in GF(P)."""
+    t = rng.randrange(1, P)
+    den = inverse(1 + t * t)
+    return ((1 - t * t) * den) % P, (2 * t * den) % P
+
+
+def evaluate(expr, env: dict, cache: dict) -> int:
+    """expr in GF(P); env maps symbols to field values; cache memoises numbers."""
+    if expr.is_Symbol:
+        return env[expr]
+    if expr.is_Number:
+        if expr not in cache:
+            cache[expr] = to_field(expr)
+        return cache[expr]
+    if expr.is_Add:
+        total = 0
+        for arg in expr.args:
+            total += evaluate(arg, env, cache)
+        return total % P
+    if expr.is_Mul:
+        product = 1
+        for arg in expr.args:
+            product = (product * evaluate(arg, env, cache)) % P
+        return product
+    if expr.is_Pow and expr.exp.is_Integer:
+        base = evaluate(expr.base, env, cache)
+        e = int(expr.exp)
+        return pow(base, e, P) if e >= 0 else pow(inverse(base), -e, P)
+    raise ValueError(f"cannot evaluate {expr} exactly")
+
+
+def run(assignments, outputs, env: dict) -> list[int]:
+    """Evaluate a pruned program and its outputs at one point."""
+    env = dict(env)
+    cache: dict = {}
+    for a in assignments:
+        env[a.symbol] = evaluate(a.expr, env, cache)
+    return [evaluate(sp.sympify(o), env, cache) for o in outputs]
+
+
+def rational(x: int) -> sp.Rational:
+    """Rational reconstruction: the a/b with |a|, b < sqrt(P/2) and a = b x mod P."""
+    bound = 1 << 63
+    r0, r1, s0, s1 = P, x % P, 0, 1
+    while r1 >= bound:
+        quotient = r0 // r1
+        r0, r1 = r1, r0 - quotient * r1
+        s0, s1 = s1, s0 - quotient * s1
+    if s1 == 0 or abs(s1) >= bound:
+        raise ValueError("no small rational")
+    return sp.Rational(r1, s1)
+
+
+def rref(rows: list[list[int]], n_cols: int):
+    """Reduced row echelon form over GF(P): (pivot columns, reduced rows)."""
+    rows = [list(r) for r in rows]
+    pivots = []
+    top = 0
+    for col in range(n_cols):
+        hit = next((r for r in range(top, len(rows)) if rows[r][col] % P), None)
+        if hit is None:
+            continue
+        rows[top], rows[hit] = rows[hit], rows[top]
+        inv = inverse(rows[top][col])
+        rows[top] = [(v * inv) % P for v in rows[top]]
+        for r in range(len(rows)):
+            if r != top and rows[r][col]:
+                k = rows[r][col]
+                rows[r] = [(v - k * w) % P for v, w in zip(rows[r], rows[top])]
+        pivots.append(col)
+        top += 1
+        if top == len(rows):
+            break
+    return pivots, rows[: len(pivots)]

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs everything dyngen needs on a fresh Debian/Ubuntu machine:
+# system packages (C compiler, NLopt, Eigen) and the Python package with its
+# test dependencies. Safe to run twice.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need_apt=()
+command -v cc >/dev/null 2>&1 || need_apt+=(gcc)
+command -v c++ >/dev/null 2>&1 || need_apt+=(g++)
+command -v cmake >/dev/null 2>&1 || need_apt+=(cmake)
+[ -f /usr/include/nlopt.h ] || need_apt+=(libnlopt-dev)
+[ -d /usr/include/eigen3 ] || need_apt+=(libeigen3-dev)
+command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
+
+if [ ${#need_apt[@]} -gt 0 ]; then
+  echo "setup: installing system packages: ${need_apt[*]}"
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
+fi
+
+PY=${PYTHON:-python3}
+echo "setup: installing the dyngen Python package (editable, with test extras)"
+$PY -m pip install -q --disable-pip-version-check -e ".[test]"

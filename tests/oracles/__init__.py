@@ -1,0 +1,1 @@
+"""Independent oracles for dyngen's tests (no imports from the dyngen package)."""
