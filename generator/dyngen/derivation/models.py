@@ -136,3 +136,22 @@ class Derivation:
             out += program.let_vector(standard_from_dynamic_link(self.p[PER_LINK * i: PER_LINK * (i + 1)]))
         return Model("standard_from_dynamic", [Input("p", self.p, "dynamic parameters, 10 per link")], out,
                      (PER_LINK * self.n,), "standard parameters s from dynamic parameters p", program)
+
+
+def coefficient_model(derivation: Derivation, base, kind: str) -> Model:
+    """pi(p): the base coefficients of one regressor from the dynamic parameters."""
+    program = Program()
+    s_exprs = []
+    for i in range(derivation.n):
+        program.section = f"link {i + 1}: standard parameters"
+        s_exprs += program.let_vector(standard_from_dynamic_link(derivation.p[PER_LINK * i: PER_LINK * (i + 1)]))
+    program.section = "coefficients"
+    outputs = [program.let(sp.Add(*(k * s for k, s in zip(row, s_exprs) if k != 0))) for row in base.K]
+    return Model(f"pi_{kind}", [Input("p", derivation.p, "dynamic parameters, 10 per link")], outputs,
+                 (len(outputs),), f"{kind} base coefficients", program)
+
+
+def base_regressor_outputs(model: Model, base) -> list:
+    """The pivot columns of a full regressor model, row-major."""
+    rows, cols = model.shape
+    return [model.outputs[r * cols + c] for r in range(rows) for c in base.pivots]

@@ -1,0 +1,129 @@
+"""C99 text of one straight-line program: per-link sections, no heap, only <math.h>.
+
+Inputs are flat arrays (q[0] is joint 1), constants go through the robot's cast macro
+(<P>_K(0.39)) so that a float build computes in float, and x**2 is written x*x.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+
+from .opcount import OpCount, count_all
+
+
+@dataclass
+class CFunction:
+    name: str
+    doc: str
+    inputs: list  # (argument name, length, meaning)
+    output: tuple  # (argument name, shape, meaning)
+    body: list[str]
+    ops: OpCount
+    used: set  # input arguments the body reads (the others are cast to void)
+
+
+class Printer(C99CodePrinter):
+    def __init__(self, prefix: str, names: dict):
+        super().__init__({"strict": False})
+        self.macro = prefix.upper()
+        self.names = names  # symbol -> C text (array entries)
+
+    def _print_Symbol(self, expr):
+        return self.names.get(expr, expr.name)
+
+    def _print_Rational(self, expr):
+        return f"{self.macro}_K({_decimal(expr)})"
+
+    def _print_Integer(self, expr):
+        return str(int(expr))
+
+    def _print_Float(self, expr):
+        return f"{self.macro}_K({float(expr)!r})"
+
+    def _print_Mul(self, expr):
+        coeff, rest = expr.as_coeff_Mul()
+        if coeff.is_Rational and not coeff.is_Integer:
+            sign = "-" if coeff < 0 else ""
+            return f"{sign}{self._print_Rational(abs(coeff))}*{self.parenthesize(rest, 50)}"
+        return super()._print_Mul(expr)
+
+    def _print_Pow(self, expr):
+        if expr.exp.is_Integer and 1 < expr.exp <= 4:
+            base = self.parenthesize(expr.base, 100)
+            return "*".join([base] * int(expr.exp))
+        if expr.exp == -1:
+            return f"{self.macro}_K(1)/{self.parenthesize(expr.base, 100)}"
+        return super()._print_Pow(expr)
+
+    def _print_sin(self, expr):
+        return f"{self.macro}_SIN({self._print(expr.args[0])})"
+
+    def _print_cos(self, expr):
+        return f"{self.macro}_COS({self._print(expr.args[0])})"
+
+
+def _decimal(r: sp.Rational) -> str:
+    """39/100 -> 0.39 when the decimal terminates; otherwise a quotient the compiler folds."""
+    p, q = int(r.p), int(r.q)
+    twos = fives = 0
+    while q % 2 == 0:
+        q //= 2; twos += 1
+    while q % 5 == 0:
+        q //= 5; fives += 1
+    if q == 1:
+        digits = max(twos, fives)
+        text = f"{abs(p) * 10**digits // int(r.q):d}"
+        text = text.rjust(digits + 1, "0")
+        text = (text[:-digits] + "." + text[-digits:]).rstrip("0").rstrip(".") if digits else text + ".0"
+        return ("-" if p < 0 else "") + text
+    return f"{p}.0/{int(r.q)}.0"
+
+
+def input_names(model) -> dict:
+    return {sym: f"{inp.name}[{k}]" for inp in model.inputs for k, sym in enumerate(inp.symbols)}
+
+
+def render_function(prefix: str, joints, name: str, model, outputs, output, doc: str) -> CFunction:
+    """outputs: flat expressions written to output[0] (argument name, shape, meaning)."""
+    pruned = model.program.pruned(outputs)
+    names = input_names(model)
+    names.update({a.symbol: f"x{k}" for k, a in enumerate(pruned)})  # dense numbering: stable diffs
+    printer = Printer(prefix, names)
+    real = f"{prefix}_real"
+    macro = prefix.upper()
+    body = []
+    trig_used = sorted({s for a in pruned for s in a.expr.free_symbols if s in model.trig} |
+                       {s for o in outputs for s in sp.sympify(o).free_symbols if s in model.trig},
+                       key=lambda s: (model.trig[s][0], model.trig[s][1]))
+    if trig_used:
+        body.append("/* joint angles */")
+    for s in trig_used:
+        joint, fn = model.trig[s]
+        angle = f"q[{joint}]"
+        if joints[joint].theta != 0:
+            angle = f"q[{joint}] + {macro}_K({float(joints[joint].theta)!r})"
+        body.append(f"const {real} {s.name} = {macro}_{fn.upper()}({angle});")
+    section = None
+    for a in pruned:
+        if a.section != section:
+            section = a.section
+            body.append(f"/* {section} */")
+        body.append(f"const {real} {names[a.symbol]} = {printer.doprint(a.expr)};")
+    body.append(f"/* {output[0]} */")
+    flat = [sp.sympify(o) for o in outputs]
+    zeros = sum(1 for o in flat if o == 0)
+    if zeros > 8:
+        body.append(f"for (int k = 0; k < {len(flat)}; ++k) {output[0]}[k] = 0;")
+    for k, o in enumerate(flat):
+        if o != 0 or zeros <= 8:
+            body.append(f"{output[0]}[{k}] = {printer.doprint(o)};")
+    ops = count_all([a.expr for a in pruned] + flat) + OpCount(trig=len(trig_used))
+    ins = [(inp.name, len(inp.symbols), inp.doc) for inp in model.inputs]
+    free = set().union(*(a.expr.free_symbols for a in pruned), *(o.free_symbols for o in flat))
+    used = {inp.name for inp in model.inputs if free & set(inp.symbols)}
+    if trig_used:
+        used.add("q")
+    return CFunction(f"{prefix}_{name}", doc, ins, output, body, ops, used)

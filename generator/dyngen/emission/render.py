@@ -1,0 +1,133 @@
+"""Render one robot's folder: header, C sources, CMake file, manifest, coefficient list."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import jinja2
+
+from .. import __version__
+from ..derivation.models import base_regressor_outputs, coefficient_model
+from ..parameters import PER_LINK, dynamic_name, standard_name
+from ..reduction.identifiability import classify
+from .c_code import render_function
+from .coefficients import dynamic_names_text, grouped_text
+
+TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
+KIND_LABELS = {"gravity": "gravity vector g(q) = Y_g(q) pi_gravity",
+               "inertia": "stacked inertia matrix m~(q) = Y_m(q) pi_inertia",
+               "full": "inverse dynamics tau = Y(q, qd, qdd) pi_full"}
+
+
+@dataclass
+class Emitted:
+    files: dict  # file name -> text
+    functions: list  # CFunction
+    manifest: dict
+
+
+def environment() -> jinja2.Environment:
+    return jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)), trim_blocks=True,
+                              lstrip_blocks=True, keep_trailing_newline=True, undefined=jinja2.StrictUndefined)
+
+
+def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emitted:
+    """regressors: kind -> full regressor Model; bases: kind -> BaseSet; models: rnea, gravity, mass_matrix."""
+    P, n = robot.name, robot.dof
+    joints = robot.joints
+    n_stacked = n * (n + 1) // 2
+    std_names = [standard_name(i + 1, k) for i in range(n) for k in range(PER_LINK)]
+    dyn_text = dynamic_names_text(n)
+
+    def fn(name, model, outputs, out, doc):
+        return render_function(P, joints, name, model, outputs, out, doc)
+
+    parameters = [fn("standard_from_dynamic", (m := derivation.standard_from_dynamic()), m.outputs,
+                     ("s", (PER_LINK * n,), "standard parameters"), "Standard parameters s from dynamic parameters p.")]
+    regressor_fns = []
+    kinds = []
+    out_rows = {"gravity": n, "inertia": n_stacked, "full": n}
+    for kind in ("gravity", "inertia", "full"):
+        base, reg = bases[kind], regressors[kind]
+        cm = coefficient_model(derivation, base, kind)
+        parameters.append(fn(f"pi_{kind}", cm, cm.outputs, ("pi", (base.rank,), f"pi_{kind}"),
+                             f"Base coefficients pi_{kind}(p) of the {KIND_LABELS[kind]}."))
+        name = {"gravity": "regressor_gravity", "inertia": "regressor_inertia", "full": "regressor"}[kind]
+        regressor_fns.append(fn(name, reg, base_regressor_outputs(reg, base),
+                                ("Y", (out_rows[kind], base.rank), "row-major"),
+                                f"Base regressor of the {KIND_LABELS[kind]}."))
+        standard, dynamic = classify(base, n)
+        coefficients = []
+        for k, row in enumerate(base.K):
+            coefficients.append({"index": k, "standard": grouped_text(row, std_names),
+                                 "dynamic": grouped_text(row, [dyn_text[s] for s in std_names])})
+        kinds.append({"name": kind, "rank": base.rank, "label": KIND_LABELS[kind], "coefficients": coefficients,
+                      "pivots": [std_names[j] for j in base.pivots], "standard": standard, "dynamic": dynamic})
+    dynamics = [
+        fn("rnea", models["rnea"], models["rnea"].outputs, ("tau", (n,), "joint torques/forces"),
+           "Inverse dynamics tau = M(q) qdd + c(q, qd) + g(q), recursive Newton-Euler."),
+        fn("gravity", models["gravity"], models["gravity"].outputs, ("g", (n,), "gravity torques"),
+           "Gravity vector g(q)."),
+        fn("mass_matrix", models["mass_matrix"], models["mass_matrix"].outputs, ("M", (n, n), "row-major, symmetric"),
+           "Inertia matrix M(q)."),
+    ]
+    functions = parameters + regressor_fns + dynamics
+    env = environment()
+    gravity_symbols = [s.name for s in robot.gravity_symbols]
+    common = dict(robot=robot, P=P, M=P.upper(), version=__version__, source=robot.source, kinds=kinds,
+                  n_stacked=n_stacked, gravity_symbols=gravity_symbols,
+                  joint_types="".join("R" if j.revolute else "P" for j in joints),
+                  gravity_text=", ".join(_gravity_text(g) for g in robot.gravity))
+    sources = {f"{P}_parameters.c": ("parameters and base coefficients", parameters),
+               f"{P}_regressors.c": ("base regressors", regressor_fns),
+               f"{P}_dynamics.c": ("inverse dynamics, gravity and inertia matrix", dynamics)}
+    files = {f"{P}.h": env.get_template("header.h.j2").render(functions=functions, **common)}
+    for filename, (summary, fns) in sources.items():
+        files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
+                                                                  functions=fns, **common)
+    files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=sorted(sources), **common)
+    files["coefficients.md"] = env.get_template("coefficients.md.j2").render(**common)
+    manifest = _manifest(robot, functions, kinds, std_names, n_stacked)
+    files["manifest.json"] = json.dumps(manifest, indent=1) + "\n"
+    return Emitted(files, functions, manifest)
+
+
+def _gravity_text(g) -> str:
+    return str(float(g)) if g.is_number else str(g)
+
+
+def _manifest(robot, functions, kinds, std_names, n_stacked) -> dict:
+    n = robot.dof
+    return {
+        "generator": f"dyngen {__version__}",
+        "robot": robot.name,
+        "source": robot.source,
+        "dof": n,
+        "convention": robot.convention,
+        "joint_types": [j.type for j in robot.joints],
+        "gravity": [_gravity_text(g) for g in robot.gravity],
+        "gravity_symbols": [s.name for s in robot.gravity_symbols],
+        "parameters": {
+            "dynamic": [dynamic_name(i + 1, k) for i in range(n) for k in range(PER_LINK)],
+            "standard": std_names,
+        },
+        "stacked_inertia_order": [f"M{j + 1}{k + 1}" for j in range(n) for k in range(j, n)],
+        "functions": [{
+            "name": f.name, "doc": f.doc,
+            "inputs": [{"name": a, "length": length, "meaning": m} for a, length, m in f.inputs],
+            "output": {"name": f.output[0], "shape": list(f.output[1]), "meaning": f.output[2]},
+            "ops": {"mul": f.ops.mul, "add": f.ops.add, "div": f.ops.div, "sin_cos": f.ops.trig},
+        } for f in functions],
+        "coefficients": {k["name"]: {
+            "rank": k["rank"],
+            "base_columns": k["pivots"],
+            "expressions": [{"standard": c["standard"], "dynamic": c["dynamic"]} for c in k["coefficients"]],
+            "identifiable_alone": list(k["standard"].alone),
+            "grouped": list(k["standard"].grouped),
+            "absent": list(k["standard"].absent),
+            "dynamic_alone": list(k["dynamic"].alone),
+            "dynamic_absent": list(k["dynamic"].absent),
+        } for k in kinds},
+    }

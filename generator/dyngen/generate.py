@@ -1,0 +1,46 @@
+"""The generate step: YAML -> derivation -> reduction -> emitted folder."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from .atomic import write_folder
+from .derivation.models import Derivation
+from .description import Robot, load_robot
+from .emission.render import Emitted, emit
+from .progress import Progress
+from .reduction.base import BaseSet, reduce_model
+
+KINDS = ("gravity", "inertia", "full")
+
+
+@dataclass
+class Generated:
+    robot: Robot
+    bases: dict  # kind -> BaseSet
+    emitted: Emitted
+    folder: Path
+
+
+def build(robot: Robot, progress: Progress | None = None) -> tuple[dict, Emitted]:
+    """Derive, reduce and render in memory (nothing written)."""
+    progress = progress or Progress(quiet=True)
+    derivation = Derivation(robot)
+    with progress.step("derive regressors (symbolic Newton-Euler)"):
+        regressors = {kind: derivation.regressor(kind) for kind in KINDS}
+        models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix()}
+    with progress.step("reduce to base coefficients (exact rank)"):
+        bases: dict[str, BaseSet] = {kind: reduce_model(regressors[kind]) for kind in KINDS}
+    with progress.step("emit C"):
+        emitted = emit(robot, derivation, regressors, bases, models)
+    return bases, emitted
+
+
+def generate(path, out_root="generated", progress: Progress | None = None) -> Generated:
+    progress = progress or Progress(quiet=True)
+    robot = load_robot(path)
+    bases, emitted = build(robot, progress)
+    folder = Path(out_root) / robot.name
+    write_folder(folder, emitted.files)
+    return Generated(robot, bases, emitted, folder)

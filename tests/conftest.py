@@ -1,0 +1,56 @@
+"""Shared fixtures: every example arm generated, compiled and paired with its oracles."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from cbuild import Compiled, compile_folder  # noqa: E402
+from oracles.arm import Arm, nominal_parameters  # noqa: E402
+
+from dyngen.atomic import write_folder  # noqa: E402
+from dyngen.description import load_robot  # noqa: E402
+from dyngen.generate import build  # noqa: E402
+
+EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
+ARM_NAMES = [p.stem for p in EXAMPLES]
+
+
+@dataclass
+class Built:
+    name: str
+    yaml: Path
+    robot: object
+    bases: dict
+    emitted: object
+    c: Compiled
+    arm: Arm  # the oracles' own reading of the same file
+    nominal: np.ndarray  # dynamic parameters, from the oracles' reading
+
+
+def build_arm(yaml_path: Path, out: Path) -> Built:
+    robot = load_robot(yaml_path)
+    bases, emitted = build(robot)
+    folder = out / "generated" / robot.name
+    write_folder(folder, emitted.files)
+    compiled = compile_folder(folder, out / "build")
+    return Built(robot.name, yaml_path, robot, bases, emitted, compiled, Arm.from_yaml(yaml_path),
+                 nominal_parameters(yaml_path))
+
+
+@pytest.fixture(scope="session", params=ARM_NAMES)
+def built(request, tmp_path_factory) -> Built:
+    path = ROOT / "examples" / f"{request.param}.yaml"
+    return build_arm(path, tmp_path_factory.mktemp(request.param))
+
+
+@pytest.fixture(scope="session")
+def lwr(tmp_path_factory) -> Built:
+    return build_arm(ROOT / "examples" / "lwr.yaml", tmp_path_factory.mktemp("lwr_only"))
