@@ -35,13 +35,14 @@ class Built:
     nominal: np.ndarray  # dynamic parameters, from the oracles' reading
 
 
-def build_arm(yaml_path: Path, out: Path) -> Built:
+def build_arm(yaml_path: Path, out: Path, gravity_values: dict | None = None) -> Built:
+    """gravity_values: numbers for symbolic gravity entries, for the oracles' Arm."""
     robot = load_robot(yaml_path)
     bases, emitted = build(robot)
     folder = out / "generated" / robot.name
     write_folder(folder, emitted.files)
     compiled = compile_folder(folder, out / "build")
-    return Built(robot.name, yaml_path, robot, bases, emitted, compiled, Arm.from_yaml(yaml_path),
+    return Built(robot.name, yaml_path, robot, bases, emitted, compiled, Arm.from_yaml(yaml_path, gravity_values),
                  nominal_parameters(yaml_path))
 
 
