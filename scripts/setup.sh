@@ -22,4 +22,10 @@ fi
 
 PY=${PYTHON:-python3}
 echo "setup: installing the dyngen Python package (editable, with test extras)"
-$PY -m pip install -q --disable-pip-version-check -e ".[test]"
+if ! $PY -m pip install -q --disable-pip-version-check -e ".[test]" 2>/tmp/dyngen-pip.err; then
+  if grep -q externally-managed /tmp/dyngen-pip.err; then  # Debian's system Python (PEP 668)
+    $PY -m pip install -q --disable-pip-version-check --break-system-packages -e ".[test]"
+  else
+    cat /tmp/dyngen-pip.err >&2; exit 1
+  fi
+fi

@@ -34,13 +34,15 @@ def _generate_parser(prog: str) -> argparse.ArgumentParser:
 
 
 def cmd_generate(argv, prog="dyngen generate") -> int:
+    from .description import load_robot
     from .generate import generate
 
     args = _generate_parser(prog).parse_args(argv)
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
+    robot = load_robot(args.robot)  # validate before announcing anything
     progress.say(f"dyngen {__version__}: generating {args.robot}")
-    result = generate(args.robot, args.output, progress)
+    result = generate(robot, args.output, progress)
     if not args.quiet:
         _summary(result, time.perf_counter() - start)
     return 0

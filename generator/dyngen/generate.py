@@ -37,9 +37,11 @@ def build(robot: Robot, progress: Progress | None = None) -> tuple[dict, Emitted
     return bases, emitted
 
 
-def generate(path, out_root="generated", progress: Progress | None = None) -> Generated:
+def generate(robot: Robot | str | Path, out_root="generated", progress: Progress | None = None) -> Generated:
+    """Generate into out_root/<robot name>/; nothing is written unless everything succeeded."""
     progress = progress or Progress(quiet=True)
-    robot = load_robot(path)
+    if not isinstance(robot, Robot):
+        robot = load_robot(robot)
     bases, emitted = build(robot, progress)
     folder = Path(out_root) / robot.name
     write_folder(folder, emitted.files)
