@@ -103,3 +103,17 @@ def test_base_regressor_has_full_column_rank(built, kind):
     sv = np.linalg.svd(Y, compute_uv=False)
     assert Y.shape[1] == built.bases[kind].rank
     assert sv[-1] > 1e-8 * sv[0]
+
+
+def test_coefficient_jacobians_match_central_differences(built):
+    p = random_parameters(built.robot.dof, seed=8)
+    for kind in ("gravity", "inertia", "full"):
+        J = built.c(f"pi_{kind}_jacobian", p)
+        numeric = np.zeros_like(J)
+        for j in range(p.size):
+            h = 1e-6 * max(1.0, abs(p[j]))
+            up, down = p.copy(), p.copy()
+            up[j] += h
+            down[j] -= h
+            numeric[:, j] = (built.c(f"pi_{kind}", up) - built.c(f"pi_{kind}", down)) / (2 * h)
+        assert rel_err(J, numeric) < 1e-8, kind

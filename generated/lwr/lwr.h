@@ -21,8 +21,11 @@
  * Operation counts (multiplications, additions, divisions, sin/cos):
  *   lwr_standard_from_dynamic    126 mul, 63 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity               25 mul, 13 add, 0 div, 0 sin/cos
+ *   lwr_pi_gravity_jacobian      0 mul, 2 add, 0 div, 0 sin/cos
  *   lwr_pi_inertia               133 mul, 102 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia_jacobian      123 mul, 35 add, 0 div, 0 sin/cos
  *   lwr_pi_full                  138 mul, 106 add, 0 div, 0 sin/cos
+ *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
  *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 12 sin/cos
  *   lwr_regressor_inertia        2022 mul, 906 add, 0 div, 12 sin/cos
  *   lwr_regressor                696 mul, 420 add, 0 div, 12 sin/cos
@@ -75,6 +78,13 @@ void lwr_standard_from_dynamic(const lwr_real *p, lwr_real *s);
  */
 void lwr_pi_gravity(const lwr_real *p, lwr_real *pi);
 
+/* Jacobian d pi_gravity / d p (for gradient-based extraction).
+ *   p        [70]  dynamic parameters, 10 per link
+ *   J        [12 x 70]  row-major (written)
+ * 0 mul, 2 add, 0 div, 0 sin/cos
+ */
+void lwr_pi_gravity_jacobian(const lwr_real *p, lwr_real *J);
+
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [39]  pi_inertia (written)
@@ -82,12 +92,26 @@ void lwr_pi_gravity(const lwr_real *p, lwr_real *pi);
  */
 void lwr_pi_inertia(const lwr_real *p, lwr_real *pi);
 
+/* Jacobian d pi_inertia / d p (for gradient-based extraction).
+ *   p        [70]  dynamic parameters, 10 per link
+ *   J        [39 x 70]  row-major (written)
+ * 123 mul, 35 add, 0 div, 0 sin/cos
+ */
+void lwr_pi_inertia_jacobian(const lwr_real *p, lwr_real *J);
+
 /* Base coefficients pi_full(p) of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [43]  pi_full (written)
  * 138 mul, 106 add, 0 div, 0 sin/cos
  */
 void lwr_pi_full(const lwr_real *p, lwr_real *pi);
+
+/* Jacobian d pi_full / d p (for gradient-based extraction).
+ *   p        [70]  dynamic parameters, 10 per link
+ *   J        [43 x 70]  row-major (written)
+ * 118 mul, 33 add, 0 div, 0 sin/cos
+ */
+void lwr_pi_full_jacobian(const lwr_real *p, lwr_real *J);
 
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   q        [7]  joint positions [rad or m]

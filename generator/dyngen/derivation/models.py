@@ -155,3 +155,22 @@ def base_regressor_outputs(model: Model, base) -> list:
     """The pivot columns of a full regressor model, row-major."""
     rows, cols = model.shape
     return [model.outputs[r * cols + c] for r in range(rows) for c in base.pivots]
+
+
+def coefficient_jacobian_model(derivation: Derivation, base, kind: str) -> Model:
+    """d pi / d p (rank x 10N, row-major): pi = K s(p), and s depends on its own link's p only."""
+    program = Program()
+    n_params = PER_LINK * derivation.n
+    J = [[sp.Integer(0)] * n_params for _ in base.K]
+    for i in range(derivation.n):
+        program.section = f"link {i + 1}"
+        p_link = derivation.p[PER_LINK * i: PER_LINK * (i + 1)]
+        s_link = standard_from_dynamic_link(p_link)
+        ds = [[program.let(sp.diff(s_link[j], p_link[l])) for l in range(PER_LINK)] for j in range(PER_LINK)]
+        for r, row in enumerate(base.K):
+            for l in range(PER_LINK):
+                J[r][PER_LINK * i + l] = program.let(
+                    sp.Add(*(row[PER_LINK * i + j] * ds[j][l] for j in range(PER_LINK) if row[PER_LINK * i + j] != 0)))
+    outputs = [x for row in J for x in row]
+    return Model(f"pi_{kind}_jacobian", [Input("p", derivation.p, "dynamic parameters, 10 per link")], outputs,
+                 (len(base.K), n_params), f"Jacobian of pi_{kind} with respect to p", program)

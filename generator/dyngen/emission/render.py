@@ -9,7 +9,7 @@ from pathlib import Path
 import jinja2
 
 from .. import __version__
-from ..derivation.models import base_regressor_outputs, coefficient_model
+from ..derivation.models import base_regressor_outputs, coefficient_jacobian_model, coefficient_model
 from ..parameters import PER_LINK, dynamic_name, standard_name
 from ..reduction.identifiability import classify
 from .c_code import render_function
@@ -54,6 +54,9 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
         cm = coefficient_model(derivation, base, kind)
         parameters.append(fn(f"pi_{kind}", cm, cm.outputs, ("pi", (base.rank,), f"pi_{kind}"),
                              f"Base coefficients pi_{kind}(p) of the {KIND_LABELS[kind]}."))
+        jm = coefficient_jacobian_model(derivation, base, kind)
+        parameters.append(fn(f"pi_{kind}_jacobian", jm, jm.outputs, ("J", (base.rank, PER_LINK * n), "row-major"),
+                             f"Jacobian d pi_{kind} / d p (for gradient-based extraction)."))
         name = {"gravity": "regressor_gravity", "inertia": "regressor_inertia", "full": "regressor"}[kind]
         regressor_fns.append(fn(name, reg, base_regressor_outputs(reg, base),
                                 ("Y", (out_rows[kind], base.rank), "row-major"),
@@ -87,6 +90,7 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     for filename, (summary, fns) in sources.items():
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
+    files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(**common)
     files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=sorted(sources), **common)
     files["coefficients.md"] = env.get_template("coefficients.md.j2").render(**common)
     manifest = _manifest(robot, functions, kinds, std_names, n_stacked)

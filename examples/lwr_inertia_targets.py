@@ -1,0 +1,46 @@
+"""Write identified.inertia of examples/lwr.yaml: pi_inertia of the paper's own final solution.
+
+The paper does not print its identified inertia coefficients pi_hat_m; following the paper's
+own numbers, they are rebuilt from its final solution (examples/lwr_paper_solution.yaml:
+Tables II and IV, eq. 20 don't-care values, eq. 15 identities) through dyngen's pi_inertia(p).
+Run: python examples/lwr_inertia_targets.py  (rewrites the block between the markers).
+"""
+
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from dyngen.description import load_robot
+from dyngen.emission.coefficients import grouped_text
+from dyngen.generate import build
+from dyngen.parameters import PER_LINK, standard_from_dynamic, standard_name
+
+HERE = Path(__file__).resolve().parent
+BEGIN, END = "  # BEGIN inertia targets (examples/lwr_inertia_targets.py)\n", "  # END inertia targets\n"
+
+
+def paper_solution() -> np.ndarray:
+    links = yaml.safe_load((HERE / "lwr_paper_solution.yaml").read_text())["solution"]
+    return np.array([v for link in links for v in (link["m"], *link["c"], *link["I"])], dtype=float)
+
+
+def main():
+    robot = load_robot(HERE / "lwr.yaml")
+    bases, _ = build(robot)
+    base = bases["inertia"]
+    s = standard_from_dynamic(paper_solution())
+    names = [standard_name(i + 1, k) for i in range(robot.dof) for k in range(PER_LINK)]
+    lines = [BEGIN, "  # The paper does not print pi_hat_m: these are pi_inertia(p) of the paper's own final solution\n  # (examples/lwr_paper_solution.yaml: Tables II, IV, eq. 20, eq. 15), by examples/lwr_inertia_targets.py.\n  inertia:\n"]
+    for row in base.K:
+        value = float(sum(float(k) * x for k, x in zip(row, s)))
+        lines.append(f'    - {{coefficient: "{grouped_text(row, names)}", value: {value!r}}}\n')
+    lines.append(END)
+    text = (HERE / "lwr.yaml").read_text()
+    if BEGIN in text:
+        text = text[:text.index(BEGIN)] + text[text.index(END) + len(END):]
+    (HERE / "lwr.yaml").write_text(text.rstrip("\n") + "\n" + "".join(lines))
+
+
+if __name__ == "__main__":
+    main()

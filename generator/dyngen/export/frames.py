@@ -1,0 +1,200 @@
+"""What URDF and MJCF share: joint placements from the DH table, inertials in joint frames,
+checks that a simulator can load the parameters, and number formatting.
+
+Simulators turn a joint about (or slide along) the z axis of its own frame, and a child
+link's frame is that joint frame. Each DH transform is split as
+T(i-1, i)(q) = pre_i * J(q) * post_i with J a pure Rz(q) or Tz(q):
+
+  standard  revolute : pre = Rz(theta0)                    post = Tz(d) Tx(a) Rx(alpha)
+  standard  prismatic: pre = Rz(theta) Tz(d0)              post = Tx(a) Rx(alpha)
+  modified  revolute : pre = Rx(alpha) Tx(a) Rz(theta0)    post = Tz(d)
+  modified  prismatic: pre = Rx(alpha) Tx(a) Rz(theta) Tz(d0)   post = I
+
+so the simulator's joint frame J_i sits at post_{i-1} * pre_i in J_{i-1} (post_0 = I, J_0 =
+frame 0), DH frame i is J_i * post_i, and the simulator's q is the DH q (offsets are in pre).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+# Relative tolerance of the physical-consistency check (eigenvalues of the CoM inertia).
+CONSISTENCY_TOL = 1e-12
+
+
+def _rx(alpha) -> sp.Matrix:
+    c, s = sp.cos(alpha), sp.sin(alpha)
+    return sp.Matrix([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
+
+
+def _rz(theta) -> sp.Matrix:
+    c, s = sp.cos(theta), sp.sin(theta)
+    return sp.Matrix([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+
+
+def _tx(a) -> sp.Matrix:
+    T = sp.eye(4)
+    T[0, 3] = a
+    return T
+
+
+def _tz(d) -> sp.Matrix:
+    T = sp.eye(4)
+    T[2, 3] = d
+    return T
+
+
+def split_joint(convention: str, joint) -> tuple[sp.Matrix, sp.Matrix]:
+    """(pre, post), exact, with T(i-1, i)(q) = pre * J(q) * post (see module docstring)."""
+    a, alpha, d, theta = joint.a, joint.alpha, joint.d, joint.theta
+    if convention == "standard":
+        if joint.revolute:
+            return _rz(theta), _tz(d) * _tx(a) * _rx(alpha)
+        return _rz(theta) * _tz(d), _tx(a) * _rx(alpha)
+    if convention == "modified":
+        if joint.revolute:
+            return _rx(alpha) * _tx(a) * _rz(theta), _tz(d)
+        return _rx(alpha) * _tx(a) * _rz(theta) * _tz(d), sp.eye(4)
+    raise ValueError(f"unknown DH convention {convention!r}")
+
+
+def _to_float(T: sp.Matrix) -> np.ndarray:
+    # Products are formed exactly first, so cos(pi/2) etc. give exact zeros in the files.
+    return np.array([[float(x) for x in T.row(r)] for r in range(T.rows)], dtype=float)
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Joint i: where its frame J_i sits in J_{i-1}, and where DH frame i sits in J_i."""
+
+    origin: np.ndarray  # 4x4, J_i in J_{i-1} at q = 0
+    post: np.ndarray  # 4x4, DH frame i in J_i
+
+
+def placements(robot) -> list[Placement]:
+    out = []
+    prev_post = sp.eye(4)
+    for joint in robot.joints:
+        pre, post = split_joint(robot.convention, joint)
+        out.append(Placement(_to_float(prev_post * pre), _to_float(post)))
+        prev_post = post
+    return out
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """A link's inertial data in its joint frame J_i: CoM position and inertia about the CoM
+    with J_i's axes (rotated there so files need no inertial orientation)."""
+
+    mass: float
+    com: np.ndarray  # (3,)
+    inertia: np.ndarray  # 3x3, matrix entries (products are the off-diagonal entries)
+
+
+def link_matrix(pi) -> np.ndarray:
+    _, _, _, _, xx, xy, xz, yy, yz, zz = pi
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+
+
+def check_consistent(p: np.ndarray) -> None:
+    """Raise ValueError naming the first link whose parameters no rigid body has: simulators
+    refuse them (MuJoCo) or silently misbehave. m > 0, CoM inertia positive definite and
+    A + B >= C on its principal moments, to a relative tolerance CONSISTENCY_TOL."""
+    for i, pi in enumerate(p, start=1):
+        m = pi[0]
+        if not m > 0:
+            raise ValueError(f"link {i}: mass {float(m)!r} is not positive; simulators cannot load it")
+        e = [float(x) for x in np.linalg.eigvalsh(link_matrix(pi))]
+        tol = CONSISTENCY_TOL * max(abs(e[2]), np.finfo(float).tiny)
+        if not e[0] > tol:
+            raise ValueError(f"link {i}: inertia about the CoM is not positive definite (principal moments "
+                             f"{e[0]!r}, {e[1]!r}, {e[2]!r}); simulators cannot load it")
+        if e[0] + e[1] < e[2] - tol:
+            raise ValueError(f"link {i}: inertia about the CoM violates the triangle inequality A + B >= C "
+                             f"(principal moments {e[0]!r}, {e[1]!r}, {e[2]!r}); no rigid body has it, "
+                             f"simulators cannot load it")
+
+
+def link_parameters(robot, p) -> np.ndarray:
+    """p (10N,) checked for shape, finiteness and physical consistency -> (N, 10)."""
+    p = np.asarray(p, dtype=float)
+    n = robot.dof
+    if p.shape != (10 * n,):
+        raise ValueError(f"{robot.name}: expected {10 * n} dynamic parameters (10 per link), got shape {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError(f"{robot.name}: dynamic parameters must be finite")
+    P = p.reshape(n, 10)
+    check_consistent(P)
+    return P
+
+
+def inertials(P: np.ndarray, places: list[Placement]) -> list[Inertial]:
+    out = []
+    for pi, place in zip(P, places):
+        R, t = place.post[:3, :3], place.post[:3, 3]
+        I = R @ link_matrix(pi) @ R.T
+        out.append(Inertial(float(pi[0]), t + R @ pi[1:4], 0.5 * (I + I.T)))
+    return out
+
+
+def numeric_gravity(robot) -> np.ndarray:
+    """The gravity vector as floats; ValueError if it has symbols (a file needs numbers)."""
+    free = robot.gravity_symbols
+    if free:
+        names = ", ".join(s.name for s in free)
+        raise ValueError(f"{robot.source}: gravity {list(map(str, robot.gravity))} contains symbols ({names}); "
+                         f"a simulator file needs numbers: give gravity as numbers in the YAML to export")
+    return np.array([float(g) for g in robot.gravity])
+
+
+# --- numbers and rotations ---------------------------------------------------------------
+
+def fmt(x) -> str:
+    """Shortest text that reads back as the same double (repr); -0.0 written as 0.0."""
+    v = float(x) + 0.0
+    if not math.isfinite(v):
+        raise ValueError(f"non-finite number {v!r} in export")
+    return repr(v)
+
+
+def vec(xs) -> str:
+    return " ".join(fmt(x) for x in xs)
+
+
+def rpy(R: np.ndarray) -> tuple[float, float, float]:
+    """URDF roll-pitch-yaw (fixed axes X, Y, Z): R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    R = np.asarray(R, dtype=float)
+    cp = math.hypot(R[0, 0], R[1, 0])
+    pitch = math.atan2(-R[2, 0], cp)
+    if cp > 1e-9:
+        return math.atan2(R[2, 1], R[2, 2]), pitch, math.atan2(R[1, 0], R[0, 0])
+    # Gimbal lock (pitch = +-pi/2): only roll -+ yaw is defined; put it all into yaw.
+    # With roll = 0: R[0,1] = -sin(yaw), R[1,1] = cos(yaw) for either sign of pitch.
+    return 0.0, pitch, math.atan2(-R[0, 1], R[1, 1])
+
+
+def quaternion(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd: largest pivot first)."""
+    R = np.asarray(R, dtype=float)
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    k = int(np.argmax([tr, R[0, 0], R[1, 1], R[2, 2]]))
+    if k == 0:
+        s = 2.0 * math.sqrt(1.0 + tr)
+        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
+    elif k == 1:
+        s = 2.0 * math.sqrt(1.0 + R[0, 0] - R[1, 1] - R[2, 2])
+        q = [(R[2, 1] - R[1, 2]) / s, 0.25 * s, (R[0, 1] + R[1, 0]) / s, (R[0, 2] + R[2, 0]) / s]
+    elif k == 2:
+        s = 2.0 * math.sqrt(1.0 - R[0, 0] + R[1, 1] - R[2, 2])
+        q = [(R[0, 2] - R[2, 0]) / s, (R[0, 1] + R[1, 0]) / s, 0.25 * s, (R[1, 2] + R[2, 1]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 - R[0, 0] - R[1, 1] + R[2, 2])
+        q = [(R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, 0.25 * s]
+    q = np.array(q)
+    if q[0] < 0:  # one of the two signs, for stable output
+        q = -q
+    return q / np.linalg.norm(q)

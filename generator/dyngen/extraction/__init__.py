@@ -1,0 +1,1 @@
+"""Extraction: physically consistent link parameters from identified coefficients."""

@@ -1,0 +1,146 @@
+"""Build the emitted NLopt driver (<robot>_extract.cpp) and run it on a problem file."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .problem import Options, Problem, Stage
+
+
+class DriverError(RuntimeError):
+    pass
+
+
+def eigen_include() -> str:
+    for candidate in ("/usr/include/eigen3", "/usr/local/include/eigen3"):
+        if Path(candidate, "Eigen", "Dense").exists():
+            return candidate
+    try:
+        flags = subprocess.run(["pkg-config", "--cflags", "eigen3"], capture_output=True, text=True, check=True)
+        return flags.stdout.strip().removeprefix("-I")
+    except (OSError, subprocess.CalledProcessError):
+        raise DriverError("Eigen 3 not found: run scripts/setup.sh (apt package libeigen3-dev)") from None
+
+
+def build(folder: Path, cache_dir: Path | None = None) -> Path:
+    """Compile the driver once per source content; returns the executable."""
+    folder = Path(folder)
+    name = folder.name
+    sources = [folder / f"{name}_extract.cpp", folder / f"{name}_parameters.c", folder / f"{name}.h"]
+    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:16]
+    cache_dir = Path(cache_dir or Path(tempfile.gettempdir()) / "dyngen-drivers")
+    exe = cache_dir / f"{name}_extract-{digest}"
+    if exe.exists():
+        return exe
+    cache_dir.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
+    try:
+        obj = work / "parameters.o"
+        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(sources[1]), "-o", str(obj)])
+        tmp_exe = work / exe.name
+        _run(["c++", "-O2", "-std=c++17", "-I", str(folder), "-I", eigen_include(), str(sources[0]), str(obj),
+              "-o", str(tmp_exe), "-lnlopt", "-lpthread"])
+        os.replace(tmp_exe, exe)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return exe
+
+
+def _run(cmd):
+    try:
+        subprocess.run(cmd, check=True, capture_output=True, text=True)
+    except FileNotFoundError:
+        raise DriverError(f"{cmd[0]} not found: run scripts/setup.sh") from None
+    except subprocess.CalledProcessError as err:
+        raise DriverError(f"building the extractor failed:\n{err.stderr[-2000:]}") from None
+
+
+def problem_text(problem: Problem, stage: Stage, options: Options) -> str:
+    def vec(x):
+        return " ".join(repr(float(v)) for v in x)
+
+    lines = ["dyngen-extraction 1", f"parameters {problem.lower.size}",
+             f"lower {vec(problem.lower)}", f"upper {vec(problem.upper)}", f"value {vec(stage.value)}",
+             f"reference {vec(problem.reference)}", f"weight {vec(problem.weight)}",
+             "free " + " ".join(str(int(f)) for f in stage.free)]
+    lo, hi = problem.total_mass if problem.total_mass else (0.0, 0.0)
+    lines.append(f"total_mass {int(problem.total_mass is not None)} {lo!r} {hi!r}")
+    lines.append(f"margin {options.margin!r}")
+    lines.append(f"blocks {len(stage.blocks)}")
+    for block in stage.blocks:
+        lines.append(f"{block.kind} {block.W.shape[0]}")
+        lines.extend(vec(row) for row in block.W)
+        lines.append(vec(block.v))
+    lines.append(f"equalities {len(problem.equalities)}")
+    for terms in problem.equalities:
+        lines.append(str(len(terms)) + " " + " ".join(
+            f"{c!r} {len(idx)} " + " ".join(map(str, idx)) for c, idx in terms))
+    lines += [f"restarts {options.restarts}", f"seed {options.seed}", f"threads {options.threads}",
+              f"global_algorithm {options.global_algorithm}", f"global_maxeval {options.global_maxeval}",
+              f"local_maxeval {options.local_maxeval}", f"tolerance {options.tolerance!r}", "end"]
+    return "\n".join(lines) + "\n"
+
+
+@dataclass
+class StageResult:
+    name: str
+    status: str  # "ok" | "infeasible"
+    restarts: int
+    consistent: int
+    restart_costs: np.ndarray
+    restart_violations: np.ndarray
+    p: np.ndarray | None = None
+    fit_cost: float = np.nan
+    cost: float = np.nan
+    violation: float = np.nan
+    residuals: dict | None = None  # kind -> W pi(p) - v
+    lambda_min: np.ndarray | None = None
+
+
+def run(exe: Path, problem: Problem, stage: Stage, options: Options, on_progress=None) -> StageResult:
+    with tempfile.TemporaryDirectory(prefix="dyngen-extract-") as tmp:
+        problem_file, result_file = Path(tmp, "problem.txt"), Path(tmp, "result.txt")
+        problem_file.write_text(problem_text(problem, stage, options))
+        proc = subprocess.Popen([str(exe), str(problem_file), str(result_file)], stderr=subprocess.PIPE, text=True)
+        errors = []
+        for line in proc.stderr:
+            if line.startswith("progress ") and on_progress:
+                done, total = map(int, line.split()[1:3])
+                on_progress(done, total)
+            elif not line.startswith("progress "):
+                errors.append(line)
+        if proc.wait() != 0:
+            raise DriverError("extractor failed: " + "".join(errors))
+        return parse(stage.name, result_file.read_text())
+
+
+def parse(name: str, text: str) -> StageResult:
+    fields, residuals = {}, {}
+    for line in text.splitlines():
+        words = line.split()
+        if not words:
+            continue
+        if words[0] == "residual":
+            residuals[words[1]] = np.array([float(w) for w in words[2:]])
+        else:
+            fields[words[0]] = words[1:]
+    result = StageResult(name, fields["status"][0], int(fields["restarts"][0]), int(fields["restarts"][2]),
+                         np.array([float(w) for w in fields["restart_costs"]]),
+                         np.array([float(w) for w in fields["restart_violations"]]))
+    if "parameters" in fields:
+        result.p = np.array([float(w) for w in fields["parameters"]])
+    if result.status == "ok":
+        result.fit_cost = float(fields["fit_cost"][0])
+        result.cost = float(fields["cost"][0])
+        result.violation = float(fields["violation"][0])
+        result.residuals = residuals
+        result.lambda_min = np.array([float(w) for w in fields["lambda_min"]])
+    return result
