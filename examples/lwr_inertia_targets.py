@@ -37,9 +37,8 @@ def main():
         lines.append(f'    - {{coefficient: "{grouped_text(row, names)}", value: {value!r}}}\n')
     lines.append(END)
     text = (HERE / "lwr.yaml").read_text()
-    if BEGIN in text:
-        text = text[:text.index(BEGIN)] + text[text.index(END) + len(END):]
-    (HERE / "lwr.yaml").write_text(text.rstrip("\n") + "\n" + "".join(lines))
+    start, end = text.index(BEGIN), text.index(END) + len(END)  # replaced in place
+    (HERE / "lwr.yaml").write_text(text[:start] + "".join(lines) + text[end:])
 
 
 if __name__ == "__main__":

@@ -8,13 +8,18 @@ import time
 
 from . import __version__
 from .errors import InputError
+from .extraction.driver import DriverError
+from .extraction.problem import Infeasible
 from .progress import Progress
 
 MAIN_HELP = """\
 dyngen: robot dynamic models as exact, standalone C from a DH table.
 
-  dyngen ROBOT.yaml [-o DIR]          the main job: generate (see below)
-  dyngen generate ROBOT.yaml [-o DIR] derive, reduce to base coefficients, emit C into DIR/<name>/
+  dyngen ROBOT.yaml [options]          the main job: generate, then (when the YAML has identified
+                                       coefficients and bounds) extract and export
+  dyngen generate ROBOT.yaml [-o DIR]  derive, reduce to base coefficients, emit C into DIR/<name>/
+  dyngen extract ROBOT.yaml [options]  physically consistent link parameters from the identified
+                                       coefficients, written to OUT/<name>/
 
 Run `dyngen COMMAND --help` for a command's options. The YAML schema and the parameter
 conventions are in docs/conventions.md; examples/ has the KUKA LWR IV+ and other arms.
@@ -33,11 +38,119 @@ def _generate_parser(prog: str) -> argparse.ArgumentParser:
     return parser
 
 
+def _extract_options(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("extraction (defaults: the YAML's `extraction:` block, then these)")
+    group.add_argument("--out", default="out", metavar="DIR",
+                       help="parent folder of the extraction results OUT/<name>/ (default: out)")
+    group.add_argument("--procedure", choices=("joint", "two-stage"),
+                       help="one stage over all coefficients (default), or the paper's two stages: "
+                            "gravity (eq. 16), then inertia with the gravity parameters fixed (eq. 19)")
+    group.add_argument("--restarts", type=int, metavar="K", help="random starts, eq. 17 (default 16)")
+    group.add_argument("--seed", type=int, help="seed of the random starts (default 1: reproducible)")
+    group.add_argument("--threads", type=int, default=0, help="threads for the restarts (default: all cores)")
+    group.add_argument("--global", dest="global_algorithm", choices=("isres", "none"), default="isres",
+                       help="global NLopt stage before the local SLSQP refinement (default isres)")
+    group.add_argument("--global-maxeval", type=int, default=1500, metavar="N", help="budget of the global stage")
+    group.add_argument("--local-maxeval", type=int, default=1000, metavar="N", help="budget of the local stage")
+    group.add_argument("--margin", type=float,
+                       help="consistency margin: smallest eigenvalue of tr(I)/2 E - I [kg m^2] (default 1e-7)")
+    group.add_argument("--identity", action="append", default=None, metavar="EQ",
+                       help='an identity imposed on the parameters, e.g. "I7xz = c7x*c7z*m7" (eq. 15); repeatable')
+    group.add_argument("--compare", metavar="FILE",
+                       help="a solution (YAML list of links under `solution:`) to compare with, e.g. the paper's")
+
+
+def _options_from(args, robot):
+    from .extraction.problem import Options
+
+    settings = dict(robot.extraction)
+    options = Options(threads=args.threads, global_algorithm=args.global_algorithm,
+                      global_maxeval=args.global_maxeval, local_maxeval=args.local_maxeval)
+    for key in ("procedure", "restarts", "seed", "margin"):
+        value = getattr(args, key)
+        if value is None:
+            value = settings.get(key)
+        if value is not None:
+            setattr(options, key, value)
+    identities = args.identity if args.identity is not None else settings.get("identities", ())
+    options.identities = tuple(identities)
+    return options
+
+
+def cmd_main(argv, prog="dyngen") -> int:
+    """Generate, then extract and export when the YAML has what extraction needs."""
+    parser = _generate_parser(prog)
+    parser.description = ("The main job: generate the C model, then, when the YAML has identified "
+                          "coefficients and parameter bounds, extract consistent link parameters and export them.")
+    _extract_options(parser)
+    args = parser.parse_args(argv)
+    result = _generate(args)
+    if result.robot.identified and result.robot.lower is not None:
+        _extract(args, result.robot, result.bases, result.folder)
+    return 0
+
+
+def cmd_extract(argv, prog="dyngen extract") -> int:
+    parser = _generate_parser(prog)
+    parser.description = ("Extract physically consistent link parameters from the identified coefficients of "
+                          "ROBOT.yaml (generating its C model first), and export them as YAML.")
+    _extract_options(parser)
+    args = parser.parse_args(argv)
+    args.quiet_generate = True
+    result = _generate(args)
+    _extract(args, result.robot, result.bases, result.folder)
+    return 0
+
+
+def _extract(args, robot, bases, folder) -> None:
+    from pathlib import Path
+
+    import numpy as np
+    import yaml
+
+    from .atomic import write_file
+    from .extraction import report
+    from .extraction.run import extract
+
+    options = _options_from(args, robot)
+    progress = Progress(quiet=args.quiet)
+    start = time.perf_counter()
+    progress.say(f"extracting {robot.name}: {options.procedure}, {options.restarts} restarts, seed {options.seed}")
+
+    def on_progress(stage, done, total):
+        progress.update(f"stage {stage}: restart {done}/{total}")
+
+    with progress.step("build and run the NLopt extractor"):
+        extraction = extract(robot, bases, folder, options, on_progress)
+    seconds = time.perf_counter() - start
+    out = Path(args.out) / robot.name
+    write_file(out / "extracted.yaml", report.extracted_yaml(robot, extraction, options, seconds))
+    columns = {"dyngen": extraction.p}
+    compare = args.compare or robot.extraction.get("compare")
+    if compare:
+        path = Path(compare) if args.compare else Path(args.robot).parent / compare
+        links = yaml.safe_load(path.read_text())["solution"]
+        columns = {path.name: np.array([v for link in links for v in (link["m"], *link["c"], *link["I"])]),
+                   **columns}
+    table = report.consistency_table(columns)
+    write_file(out / "consistency.md", table + "\n")
+    if not args.quiet:
+        print(report.summary(robot, extraction, options, seconds))
+        print("  physical consistency per link (lambda_min of tr(I)/2 E - I must be >= 0):")
+        print("\n".join("    " + line for line in table.splitlines()))
+        print(f"  parameters: {out}/extracted.yaml")
+
+
 def cmd_generate(argv, prog="dyngen generate") -> int:
+    args = _generate_parser(prog).parse_args(argv)
+    _generate(args)
+    return 0
+
+
+def _generate(args):
     from .description import load_robot
     from .generate import generate
 
-    args = _generate_parser(prog).parse_args(argv)
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
     robot = load_robot(args.robot)  # validate before announcing anything
@@ -45,7 +158,7 @@ def cmd_generate(argv, prog="dyngen generate") -> int:
     result = generate(robot, args.output, progress)
     if not args.quiet:
         _summary(result, time.perf_counter() - start)
-    return 0
+    return result
 
 
 def _summary(result, seconds: float) -> None:
@@ -59,7 +172,7 @@ def _summary(result, seconds: float) -> None:
     print(f"  coefficient expressions: {result.folder}/coefficients.md")
 
 
-COMMANDS = {"generate": cmd_generate}
+COMMANDS = {"generate": cmd_generate, "extract": cmd_extract}
 
 
 def main(argv=None) -> int:
@@ -73,8 +186,8 @@ def main(argv=None) -> int:
     try:
         if argv[0] in COMMANDS:
             return COMMANDS[argv[0]](argv[1:], prog=f"dyngen {argv[0]}")
-        return cmd_generate(argv, prog="dyngen")  # the main job
-    except InputError as err:
+        return cmd_main(argv, prog="dyngen")
+    except (InputError, Infeasible, DriverError) as err:
         print(f"dyngen: error: {err}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # e.g. `dyngen ... | head`

@@ -24,6 +24,12 @@ class Progress:
             self.stream.write(f"  {what} done ({time.perf_counter() - start:.2f} s)\n")
             self.stream.flush()
 
+    def update(self, text: str):
+        """A transient status line (shown on a terminal only)."""
+        if not self.quiet and self.tty:
+            self.stream.write(f"  {text}\033[K\r")
+            self.stream.flush()
+
     def say(self, text: str):
         if not self.quiet:
             self.stream.write(text + "\n")

@@ -16,7 +16,8 @@ from ..errors import InputError
 from .expressions import ExpressionError, exact_number
 from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
 
-_TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified"}
+_TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
+_EXTRACTION_KEYS = {"procedure", "restarts", "seed", "margin", "identities", "compare"}
 _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
@@ -113,8 +114,29 @@ class _Reader:
             if kind in ident:
                 identified[kind] = tuple(self.coefficient(c, f"identified.{kind}[{k}]")
                                          for k, c in enumerate(self.sequence(ident[kind], f"identified.{kind}")))
+        extraction = self.extraction(doc.get("extraction") or {})
         return Robot(name=name, source=self.source, convention=convention, joints=joints, gravity=gravity,
-                     nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified)
+                     nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified,
+                     extraction=extraction)
+
+    def extraction(self, value) -> dict:
+        value = dict(self.mapping(value, "extraction", _EXTRACTION_KEYS))
+        if "procedure" in value and value["procedure"] not in ("joint", "two-stage"):
+            self.fail("extraction.procedure", f'expected "joint" or "two-stage", got {_describe(value["procedure"])}')
+        for key in ("restarts", "seed"):
+            if key in value and (not isinstance(value[key], int) or isinstance(value[key], bool) or value[key] < 1):
+                self.fail(f"extraction.{key}", f"expected a positive whole number, got {_describe(value[key])}")
+        if "margin" in value:
+            value["margin"] = self.number(value["margin"], "extraction.margin")
+        if "identities" in value:
+            ids = self.sequence(value["identities"], "extraction.identities")
+            for k, text in enumerate(ids):
+                if not isinstance(text, str) or text.count("=") != 1:
+                    self.fail(f"extraction.identities[{k}]", f'expected "expression = expression", got {_describe(text)}')
+            value["identities"] = tuple(ids)
+        if "compare" in value and not isinstance(value["compare"], str):
+            self.fail("extraction.compare", f"expected a file name, got {_describe(value['compare'])}")
+        return value
 
     def joint(self, value, field) -> Joint:
         value = self.mapping(value, field, _JOINT_KEYS)

@@ -74,6 +74,7 @@ class Robot:
     upper: Optional[tuple[LinkValues, ...]] = None
     total_mass: Optional[tuple[float, float]] = None
     identified: dict = field(default_factory=dict)  # kind -> tuple[IdentifiedCoefficient]
+    extraction: dict = field(default_factory=dict)  # settings: procedure, restarts, seed, margin, identities, compare
 
     @property
     def dof(self) -> int:

@@ -24,13 +24,13 @@ class Infeasible(Exception):
 
 @dataclass
 class Options:
-    procedure: str = "two-stage"  # "two-stage" (eqs. 16 then 19) or "joint"
-    restarts: int = 32
+    procedure: str = "joint"  # "joint" (one stage, all coefficients) or "two-stage" (eqs. 16 then 19)
+    restarts: int = 16
     seed: int = 1
     threads: int = 0  # 0: all cores
     global_algorithm: str = "isres"  # or "none" (local refinement from the random starts only)
     global_maxeval: int = 1500
-    local_maxeval: int = 4000
+    local_maxeval: int = 1000
     margin: float = 1e-7  # kg m^2: smallest eigenvalue of tr(I)/2 E - I accepted as consistent
     mass_margin: float = 1e-3  # kg: smallest link mass accepted
     tolerance: float = 1e-10  # constraint violation still counted as satisfied
