@@ -19,7 +19,7 @@ from dyngen.atomic import write_folder  # noqa: E402
 from dyngen.description import load_robot  # noqa: E402
 from dyngen.generate import build  # noqa: E402
 
-EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
+EXAMPLES = sorted(p for p in (ROOT / "examples").glob("*.yaml") if "\njoints:" in p.read_text())  # robots only
 ARM_NAMES = [p.stem for p in EXAMPLES]
 
 

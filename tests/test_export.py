@@ -3,8 +3,6 @@ generated Newton-Euler C for every example arm, and the exported DH frames are t
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import mujoco
 import numpy as np
 import pinocchio as pin
@@ -178,8 +176,8 @@ def test_synthetic_arms_match_generated_c_and_dh_frames(synthetic, tmp_path):
     p = random_parameters(synthetic.robot.dof, seed=8)
     exported = (p, {path.suffix: path for path in write_all(synthetic.robot, p, tmp_path)})
     check_inverse_dynamics(synthetic, *exported)
-    check_dh_frames(synthetic, exported)
-    check_limits_and_gravity(synthetic, exported)
+    check_dh_frames(synthetic.robot, exported[1])
+    check_limits_and_gravity(synthetic.robot, exported[1])
 
 
 @pytest.mark.parametrize("convention", sorted(GENERIC))
@@ -188,26 +186,26 @@ def test_generic_angles_match_lagrangian_and_dh_frames(convention, tmp_path):
     path.write_text(GENERIC[convention])
     robot, arm = load_robot(path), Arm.from_yaml(path)
     p = random_parameters(robot.dof, seed=6)
-    exported = (p, {path.suffix: path for path in write_all(robot, p, tmp_path)})
-    pmodel, pdata = load_pinocchio(exported[1][".urdf"], robot)
-    mmodel, mdata = load_mujoco(exported[1][".xml"])
+    paths = {path.suffix: path for path in write_all(robot, p, tmp_path)}
+    pmodel, pdata = load_pinocchio(paths[".urdf"], robot)
+    mmodel, mdata = load_mujoco(paths[".xml"])
     rng = np.random.default_rng(4)
     for _ in range(N_STATES):
         q, qd, qdd = random_state(robot, rng)
         tau = lag.inverse_dynamics(arm, q, qd, qdd, p)
         assert rel_err(pin.rnea(pmodel, pdata, q, qd, qdd), tau) < TOL
         assert rel_err(mujoco_inverse(mmodel, mdata, q, qd, qdd), tau) < TOL
-    check_dh_frames(SimpleNamespace(robot=robot), exported)
-    check_limits_and_gravity(SimpleNamespace(robot=robot), exported)
+    check_dh_frames(robot, paths)
+    check_limits_and_gravity(robot, paths)
 
 
 def test_exported_dh_frames_match_dh_kinematics(built, exported):
-    check_dh_frames(built, exported)
+    check_dh_frames(built.robot, exported[1])
 
 
-def check_dh_frames(built, exported):
-    _, paths = exported
-    robot = built.robot
+def check_dh_frames(robot, paths):
+    """DH frames 1..N of both files (URDF links, MJCF sites) at random q equal the product
+    of dyngen.derivation.kinematics.transform; the URDF base is frame 0."""
     pmodel, pdata = load_pinocchio(paths[".urdf"], robot)
     mmodel, mdata = load_mujoco(paths[".xml"])
     rng = np.random.default_rng(9)
@@ -227,12 +225,10 @@ def check_dh_frames(built, exported):
 
 
 def test_limits_and_gravity_are_exported(built, exported):
-    check_limits_and_gravity(built, exported)
+    check_limits_and_gravity(built.robot, exported[1])
 
 
-def check_limits_and_gravity(built, exported):
-    _, paths = exported
-    robot = built.robot
+def check_limits_and_gravity(robot, paths):
     pmodel, _ = load_pinocchio(paths[".urdf"], robot)
     mmodel, _ = load_mujoco(paths[".xml"])
     assert np.allclose(mmodel.opt.gravity, [float(g) for g in robot.gravity])
@@ -246,7 +242,7 @@ def test_inconsistent_parameters_are_refused_naming_the_link(tmp_path):
     robot = load_robot(ROOT / "examples" / "stanford.yaml")
     p = nominal_parameters(ROOT / "examples" / "stanford.yaml")  # link 5 inconsistent as published
     for export in (to_urdf, to_mjcf):
-        with pytest.raises(ValueError, match=r"link 5: inertia about the CoM is not positive definite \(principal moments 0\.0, "):
+        with pytest.raises(ValueError, match=r"link 5: inertia about the CoM is not positive definite"):
             export(robot, p)
     with pytest.raises(ValueError, match="link 5"):
         write_all(robot, p, tmp_path)

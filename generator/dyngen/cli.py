@@ -84,8 +84,12 @@ def cmd_main(argv, prog="dyngen") -> int:
                           "coefficients and parameter bounds, extract consistent link parameters and export them.")
     _extract_options(parser)
     args = parser.parse_args(argv)
-    result = _generate(args)
-    if result.robot.identified and result.robot.lower is not None:
+    robot = _load(args)
+    extracting = bool(robot.identified) and robot.lower is not None
+    if extracting:
+        _precheck(args, robot)
+    result = _generate(args, robot)
+    if extracting:
         _extract(args, result.robot, result.bases, result.folder)
     return 0
 
@@ -96,10 +100,24 @@ def cmd_extract(argv, prog="dyngen extract") -> int:
                           "ROBOT.yaml (generating its C model first), and export them as YAML.")
     _extract_options(parser)
     args = parser.parse_args(argv)
-    args.quiet_generate = True
-    result = _generate(args)
+    robot = _load(args)
+    _precheck(args, robot)
+    result = _generate(args, robot)
     _extract(args, result.robot, result.bases, result.folder)
     return 0
+
+
+def _load(args):
+    from .description import load_robot
+
+    return load_robot(args.robot)
+
+
+def _precheck(args, robot) -> None:
+    """Bounds that admit no consistent parameters fail here, before anything runs or is written."""
+    from .extraction.problem import build_problem
+
+    build_problem(robot, _options_from(args, robot))
 
 
 def _extract(args, robot, bases, folder) -> None:
@@ -134,26 +152,29 @@ def _extract(args, robot, bases, folder) -> None:
                    **columns}
     table = report.consistency_table(columns)
     write_file(out / "consistency.md", table + "\n")
+    exported = []
+    if not robot.gravity_symbols:  # simulators need a numeric gravity
+        from .export import write_all
+
+        exported = write_all(robot, extraction.p, out)
     if not args.quiet:
         print(report.summary(robot, extraction, options, seconds))
         print("  physical consistency per link (lambda_min of tr(I)/2 E - I must be >= 0):")
         print("\n".join("    " + line for line in table.splitlines()))
-        print(f"  parameters: {out}/extracted.yaml")
+        print(f"  parameters: {out}/extracted.yaml" + "".join(f", {p}" for p in exported))
 
 
 def cmd_generate(argv, prog="dyngen generate") -> int:
     args = _generate_parser(prog).parse_args(argv)
-    _generate(args)
+    _generate(args, _load(args))
     return 0
 
 
-def _generate(args):
-    from .description import load_robot
+def _generate(args, robot):
     from .generate import generate
 
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
-    robot = load_robot(args.robot)  # validate before announcing anything
     progress.say(f"dyngen {__version__}: generating {args.robot}")
     result = generate(robot, args.output, progress)
     if not args.quiet:
