@@ -73,7 +73,8 @@ struct Problem {
     double mass_lo = 0, mass_hi = 0, margin = 0;
     std::vector<Block> blocks;
     std::vector<std::vector<Term>> equalities;
-    int restarts = 64, threads = 0, global_maxeval = 3000, local_maxeval = 2000;
+    int restarts = 64, threads = 0, global_maxeval = 3000, local_maxeval = 2000, hops = 0;
+    double hop_size = 0.1;
     unsigned long seed = 1;
     std::string global_algorithm = "isres";
     double tolerance = 1e-9;
@@ -162,6 +163,8 @@ Problem read_problem(const std::string &path) {
     r.expect("global_maxeval"); P.global_maxeval = static_cast<int>(r.integer());
     r.expect("local_maxeval"); P.local_maxeval = static_cast<int>(r.integer());
     r.expect("tolerance"); P.tolerance = r.number();
+    r.expect("hops"); P.hops = static_cast<int>(r.integer());
+    P.hop_size = r.number();
     r.expect("end");
     return P;
 }
@@ -354,6 +357,8 @@ std::vector<double> free_part(const Problem &P, const Eigen::VectorXd &p) {
     return x;
 }
 
+std::vector<double> free_part(const Problem &P, const Eigen::VectorXd &p);
+
 Outcome run_restart(const Problem &P, int restart) {
     Context c{&P};
     std::vector<EqualityData> eq;
@@ -379,12 +384,29 @@ Outcome run_restart(const Problem &P, int restart) {
     nlopt_set_maxeval(local, P.local_maxeval);
     nlopt_set_ftol_rel(local, 1e-15);
     nlopt_set_xtol_rel(local, 1e-13);
-    nlopt_optimize(local, x.data(), &value);
+    auto settle = [&](std::vector<double> &y) {
+        nlopt_optimize(local, y.data(), &value);
+        Outcome o;
+        o.p = c.full(y.data());
+        o.cost = fit_cost(P, o.p, nullptr);
+        o.violation = violation(P, o.p);
+        return o;
+    };
+    Outcome out = settle(x);
+    // Basin hopping: kick the local minimum by hop_size of each range and settle again.
+    std::normal_distribution<double> kick(0.0, P.hop_size);
+    for (int h = 0; h < P.hops; ++h) {
+        std::vector<double> y = free_part(P, out.p);
+        for (unsigned k = 0; k < n; ++k) {
+            const int j = P.free[k];
+            y[k] = std::clamp(y[k] + kick(rng) * (P.upper[j] - P.lower[j]), P.lower[j], P.upper[j]);
+        }
+        const Outcome hop = settle(y);
+        const bool feasible = hop.violation <= P.tolerance, was = out.violation <= P.tolerance;
+        if ((feasible && (!was || hop.cost < out.cost)) || (!feasible && !was && hop.violation < out.violation))
+            out = hop;
+    }
     nlopt_destroy(local);
-    Outcome out;
-    out.p = c.full(x.data());
-    out.cost = fit_cost(P, out.p, nullptr);
-    out.violation = violation(P, out.p);
     return out;
 }
 

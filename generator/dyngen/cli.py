@@ -52,6 +52,8 @@ def _extract_options(parser: argparse.ArgumentParser) -> None:
                        help="global NLopt stage before the local SLSQP refinement (default isres)")
     group.add_argument("--global-maxeval", type=int, default=1500, metavar="N", help="budget of the global stage")
     group.add_argument("--local-maxeval", type=int, default=1000, metavar="N", help="budget of the local stage")
+    group.add_argument("--hops", type=int, default=0, metavar="N",
+                       help="basin-hopping kicks of each restart's local minimum (default 0)")
     group.add_argument("--margin", type=float,
                        help="consistency margin: smallest eigenvalue of tr(I)/2 E - I [kg m^2] (default 1e-7)")
     group.add_argument("--identity", action="append", default=None, metavar="EQ",
@@ -65,7 +67,7 @@ def _options_from(args, robot):
 
     settings = dict(robot.extraction)
     options = Options(threads=args.threads, global_algorithm=args.global_algorithm,
-                      global_maxeval=args.global_maxeval, local_maxeval=args.local_maxeval)
+                      global_maxeval=args.global_maxeval, local_maxeval=args.local_maxeval, hops=args.hops)
     for key in ("procedure", "restarts", "seed", "margin"):
         value = getattr(args, key)
         if value is None:

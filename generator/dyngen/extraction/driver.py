@@ -85,7 +85,8 @@ def problem_text(problem: Problem, stage: Stage, options: Options) -> str:
             f"{c!r} {len(idx)} " + " ".join(map(str, idx)) for c, idx in terms))
     lines += [f"restarts {options.restarts}", f"seed {options.seed}", f"threads {options.threads}",
               f"global_algorithm {options.global_algorithm}", f"global_maxeval {options.global_maxeval}",
-              f"local_maxeval {options.local_maxeval}", f"tolerance {options.tolerance!r}", "end"]
+              f"local_maxeval {options.local_maxeval}", f"tolerance {options.tolerance!r}",
+              f"hops {options.hops} {options.hop_size!r}", "end"]
     return "\n".join(lines) + "\n"
 
 
