@@ -1,0 +1,546 @@
+#!/usr/bin/env python3
+"""Benchmark: dyngen's generated C against Pinocchio (C++) on the same arms.
+
+For every example arm (examples/*.yaml, or --arms): generate the C into a temporary folder,
+build the same arm as a Pinocchio model (tests/oracles/pinocchio_arm.py, exported to a text
+file the C++ side reads), compile ONE executable (generated C + bench/harness.cpp +
+bench/pinocchio_side.cpp) with the same compiler family and the same flags on both sides,
+check that both sides agree on every state (relative 1e-9), then time, on the same random
+states:
+
+    <name>_rnea         vs pinocchio::rnea
+    <name>_gravity      vs pinocchio::computeGeneralizedGravity
+    <name>_mass_matrix  vs pinocchio::crba (upper triangle only, as crba fills it)
+
+Reported: the median over batches of the per-batch ns/call, the ratio pinocchio/dyngen and
+dyngen's operation counts (manifest.json). --callgrind adds instructions per call measured
+with valgrind (load independent). The table goes to bench/results/dynamics.md.
+
+    python bench/bench_dynamics.py [--arms lwr panda ...] [--callgrind]
+
+Pinocchio is compiled header-only from the installed `pin` wheel's headers (its compile
+definitions are read from the wheel's CMake config), so its algorithms are built by the same
+g++ with the same flags; the compiled Pinocchio object does not depend on the arm and is
+cached in bench/.build/ (the first run spends about a minute compiling it).
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import platform
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+BENCH = Path(__file__).resolve().parent
+ROOT = BENCH.parent
+sys.path.insert(0, str(ROOT / "tests"))
+
+FUNCTIONS = ("rnea", "gravity", "mass_matrix")
+PIN_NAMES = {"rnea": "pinocchio::rnea", "gravity": "computeGeneralizedGravity", "mass_matrix": "pinocchio::crba"}
+DEFAULT_FLAGS = "-O2 -DNDEBUG"
+
+
+def log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def run(cmd, **kw) -> subprocess.CompletedProcess:
+    res = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    if res.returncode != 0:
+        raise SystemExit(f"command failed ({res.returncode}): {shlex.join(map(str, cmd))}\n{res.stdout}{res.stderr}")
+    return res
+
+
+# --- the installed Pinocchio, Eigen and Boost (no hard-coded paths) -----------------------
+
+def pinocchio_toolchain() -> dict:
+    """Include dirs and compile definitions of the installed Pinocchio (pip wheel `pin`),
+    found from the location of the pinocchio Python package and its CMake config."""
+    import pinocchio
+
+    prefix = None
+    for parent in Path(pinocchio.__file__).resolve().parents:
+        if (parent / "include" / "pinocchio" / "algorithm" / "rnea.hpp").is_file():
+            prefix = parent
+            break
+    if prefix is None:
+        raise SystemExit("cannot find Pinocchio's C++ headers next to the pinocchio Python package "
+                         f"({pinocchio.__file__}); install the `pin` wheel")
+    defines, includes = [], [prefix / "include"]
+    configs = [p for d in ("lib", "lib64", "share") for p in (prefix / d).glob("**/pinocchio/pinocchioTargets.cmake")]
+    if configs:
+        text = configs[0].read_text()
+        block = re.search(r"set_target_properties\(pinocchio::pinocchio_headers PROPERTIES(.*?)\n\)", text, re.S)
+        if block:
+            m = re.search(r'INTERFACE_COMPILE_DEFINITIONS "([^"]*)"', block.group(1))
+            if m:
+                defines = [d for d in m.group(1).split(";") if d and "$<" not in d]
+            m = re.search(r'INTERFACE_INCLUDE_DIRECTORIES "([^"]*)"', block.group(1))
+            if m:
+                includes = [Path(d.replace("${_IMPORT_PREFIX}", str(prefix)))
+                            for d in m.group(1).split(";") if d and "$<" not in d]
+    if not defines:  # the definitions of pinocchio::pinocchio_headers in the 4.x wheels
+        log("warning: pinocchio::pinocchio_headers not found in a CMake config; using the 4.x definitions")
+        defines = ["BOOST_MPL_LIMIT_LIST_SIZE=30", "BOOST_MPL_LIMIT_VECTOR_SIZE=30",
+                   "BOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "BOOST_FUSION_INVOKE_MAX_ARITY=12"]
+    if not (prefix / "include" / "boost" / "version.hpp").is_file():
+        raise SystemExit(f"no Boost headers in {prefix / 'include'} (the cmeel-boost wheel, a dependency of pin)")
+    eigen = find_eigen(prefix)
+    includes.append(eigen)
+    return {
+        "prefix": prefix,
+        "version": pinocchio.__version__,
+        "defines": defines,
+        "includes": includes,
+        "eigen": eigen,
+        "eigen_version": header_version(eigen / "Eigen" / "src" / "Core" / "util" / "Macros.h",
+                                        ("EIGEN_WORLD_VERSION", "EIGEN_MAJOR_VERSION", "EIGEN_MINOR_VERSION")),
+        "boost_version": re.search(r'#define BOOST_LIB_VERSION "([^"]+)"',
+                                   (prefix / "include" / "boost" / "version.hpp").read_text()).group(1),
+    }
+
+
+def find_eigen(prefix: Path) -> Path:
+    """Eigen's headers: the cmeel prefix (pip install cmeel-eigen), else pkg-config eigen3,
+    else the usual system folders."""
+    candidates = [prefix / "include" / "eigen3", Path(sysconfig.get_paths()["data"]) / "include" / "eigen3"]
+    if shutil.which("pkg-config"):
+        res = subprocess.run(["pkg-config", "--cflags-only-I", "eigen3"], capture_output=True, text=True)
+        if res.returncode == 0:
+            candidates += [Path(tok[2:]) for tok in res.stdout.split() if tok.startswith("-I")]
+    candidates += [Path("/usr/include/eigen3"), Path("/usr/local/include/eigen3")]
+    for c in candidates:
+        if (c / "Eigen" / "Core").is_file():
+            return c
+    raise SystemExit("Eigen headers not found: `pip install cmeel-eigen` (or apt install libeigen3-dev)")
+
+
+def header_version(path: Path, macros) -> str:
+    text = path.read_text(errors="replace")
+    parts = []
+    for name in macros:
+        m = re.search(rf"#define {name} (\d+)", text)
+        parts.append(m.group(1) if m else "?")
+    return ".".join(parts)
+
+
+def compiler_version(cc: str) -> str:
+    return run([cc, "--version"]).stdout.splitlines()[0].strip()
+
+
+def machine() -> str:
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.machine()}"
+
+
+# --- per arm: generated C, the Pinocchio model file, parameters and joint ranges ----------
+
+def arm_yaml(name: str) -> Path:
+    path = Path(name)
+    if path.suffix in (".yaml", ".yml") and path.is_file():
+        return path.resolve()
+    path = ROOT / "examples" / f"{name}.yaml"
+    if not path.is_file():
+        raise SystemExit(f"no such arm: {name} (looked for {path})")
+    return path
+
+
+def example_arms() -> list:
+    """examples/*.yaml that are robot descriptions (dyngen loads them); others are skipped."""
+    from dyngen.description import load_robot
+
+    names = []
+    for path in sorted((ROOT / "examples").glob("*.yaml")):
+        try:
+            load_robot(path)
+        except Exception as err:  # noqa: BLE001 - any failure: not an arm for this benchmark
+            log(f"skipping examples/{path.name}: not loadable as a robot description ({err})")
+            continue
+        names.append(path.stem)
+    return names
+
+
+def dynamic_parameters(yaml_path: Path, n: int) -> tuple[np.ndarray, str]:
+    from oracles.arm import nominal_parameters
+    from oracles.random_params import random_parameters
+
+    doc = yaml.safe_load(yaml_path.read_text())
+    if (doc.get("parameters") or {}).get("nominal"):
+        return nominal_parameters(yaml_path), "nominal (YAML)"
+    return random_parameters(n, seed=0), "random, physically consistent (seed 0)"
+
+
+def joint_ranges(yaml_path: Path) -> tuple[list, list]:
+    """q ranges of the random states: the YAML's joint limits, else [-pi, pi] (revolute)
+    or [-0.5, 0.5] m (prismatic)."""
+    from oracles.arm import evaluate
+
+    lo, hi = [], []
+    for j in yaml.safe_load(yaml_path.read_text())["joints"]:
+        lim = j.get("limits") or {}
+        if "lower" in lim and "upper" in lim:
+            lo.append(evaluate(lim["lower"]))
+            hi.append(evaluate(lim["upper"]))
+        elif j["type"] == "revolute":
+            lo.append(-np.pi)
+            hi.append(np.pi)
+        else:
+            lo.append(-0.5)
+            hi.append(0.5)
+    return lo, hi
+
+
+def fmt(values) -> str:
+    return " ".join(repr(float(v)) for v in np.asarray(values, dtype=float).ravel())
+
+
+def write_model(path: Path, model) -> None:
+    """The Pinocchio model as text for pinocchio_side.cpp: per joint its parent, type (RZ or
+    PZ), placement in the parent joint's frame (R row-major, t) and body inertia in the joint
+    frame (mass, lever = centre of mass, 3x3 inertia about the centre of mass). Every number
+    is written with repr() (round-trip exact), so the C++ model is the identical model."""
+    lines = [f"joints {model.njoints - 1}", "gravity " + fmt(model.gravity.linear)]
+    for j in range(1, model.njoints):
+        kind = model.joints[j].shortname()
+        jtype = {"JointModelRZ": "RZ", "JointModelPZ": "PZ"}.get(kind)
+        if jtype is None:
+            raise SystemExit(f"unexpected joint type {kind}")
+        M, Y = model.jointPlacements[j], model.inertias[j]
+        lines.append(f"joint {model.parents[j]} {jtype}  {fmt(M.rotation)}  {fmt(M.translation)}  "
+                     f"{fmt([Y.mass])}  {fmt(Y.lever)}  {fmt(Y.inertia)}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def prepare_arm(yaml_path: Path, gen_root: Path, model_dir: Path) -> dict:
+    from dyngen.generate import generate
+    from oracles import pinocchio_arm
+    from oracles.arm import Arm
+
+    result = generate(yaml_path, gen_root)
+    folder = result.folder
+    manifest = json.loads((folder / "manifest.json").read_text())
+    name, n = manifest["robot"], manifest["dof"]
+    if manifest.get("gravity_symbols"):
+        raise SystemExit(f"{name}: symbolic gravity {manifest['gravity_symbols']} is not supported here")
+    p, p_source = dynamic_parameters(yaml_path, n)
+    model, _ = pinocchio_arm.build(Arm.from_yaml(yaml_path), p)
+    write_model(model_dir / f"{name}.model", model)
+    ops = {f["name"][len(name) + 1:]: f["ops"] for f in manifest["functions"]}
+    lo, hi = joint_ranges(yaml_path)
+    return {"name": name, "n": n, "folder": folder, "p": p, "p_source": p_source, "ops": ops,
+            "qlo": lo, "qhi": hi, "joint_types": "".join("R" if t == "revolute" else "P"
+                                                         for t in manifest["joint_types"])}
+
+
+def arms_inc(arms: list) -> str:
+    out = ["// Written by bench_dynamics.py: the arms of this run.", ""]
+    for a in arms:
+        name, n = a["name"], a["n"]
+        out += [
+            f'#include "{name}.h"',
+            f"struct Arm_{name} {{",
+            f'  static constexpr const char *name = "{name}";',
+            f"  static constexpr int n = {n};",
+            f"  static const double p[{10 * n}];",
+            f"  static const double qlo[{n}];",
+            f"  static const double qhi[{n}];",
+            f"  static void std_from_dyn(const double *p, double *s) {{ {name}_standard_from_dynamic(p, s); }}",
+            "  static void rnea(const double *q, const double *qd, const double *qdd, const double *s, double *tau) {",
+            f"    {name}_rnea(q, qd, qdd, s, tau);",
+            "  }",
+            f"  static void gravity(const double *q, const double *s, double *g) {{ {name}_gravity(q, s, g); }}",
+            f"  static void mass_matrix(const double *q, const double *s, double *M) {{ {name}_mass_matrix(q, s, M); }}",
+            "};",
+            f"const double Arm_{name}::p[{10 * n}] = {{{', '.join(repr(float(x)) for x in a['p'])}}};",
+            f"const double Arm_{name}::qlo[{n}] = {{{', '.join(repr(float(x)) for x in a['qlo'])}}};",
+            f"const double Arm_{name}::qhi[{n}] = {{{', '.join(repr(float(x)) for x in a['qhi'])}}};",
+            "",
+        ]
+    out.append("#define BENCH_ARMS(X) " + " ".join(f"X(Arm_{a['name']})" for a in arms))
+    return "\n".join(out) + "\n"
+
+
+# --- build --------------------------------------------------------------------------------
+
+def pinocchio_library(tool: dict) -> Path:
+    """The folder of the wheel's libpinocchio_default.so (precompiled instantiations)."""
+    for lib in sorted(tool["prefix"].glob("lib*/libpinocchio_default.so*")):
+        return lib.parent
+    raise SystemExit(f"libpinocchio_default.so not found under {tool['prefix']}")
+
+
+def wheel_compiler(tool: dict) -> str:
+    """The compiler that built libpinocchio_default (its .comment section), if readable."""
+    lib = pinocchio_library(tool) / "libpinocchio_default.so"
+    try:
+        found = sorted(set(re.findall(rb"GCC: \([^)]*\) [0-9][^\x00]*", lib.read_bytes())))
+    except OSError:
+        found = []
+    return ", ".join(f.decode(errors="replace") for f in found) or "an unknown compiler"
+
+
+def pinocchio_object(cxx: str, flags: list, tool: dict, rebuild: bool, use_lib: bool):
+    """(object path, Popen or None): the compiled pinocchio_side.cpp, from the cache in
+    bench/.build/ when the sources, compiler, flags and library versions are unchanged.
+    use_lib: declare Pinocchio's explicit instantiations extern (as its CMake target
+    pinocchio::pinocchio_default does), so rnea, crba, ... run from the wheel's library."""
+    extra = ["PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION"] if use_lib else []
+    cmd = [cxx, "-std=c++17", *flags, *(f"-D{d}" for d in [*tool["defines"], *extra]),
+           *(f"-I{i}" for i in tool["includes"]), "-c", str(BENCH / "pinocchio_side.cpp")]
+    key = hashlib.sha256("\n".join([
+        (BENCH / "pinocchio_side.cpp").read_text(), (BENCH / "pinocchio_side.hpp").read_text(),
+        compiler_version(cxx), shlex.join(cmd), tool["version"], tool["eigen_version"], tool["boost_version"],
+    ]).encode()).hexdigest()[:16]
+    cache = BENCH / ".build"
+    cache.mkdir(exist_ok=True)
+    obj = cache / f"pinocchio_side-{key}.o"
+    if obj.is_file() and not rebuild:
+        log(f"Pinocchio side: cached {obj.relative_to(ROOT)}")
+        return obj, None
+    log("Pinocchio side: compiling pinocchio_side.cpp (header-only Pinocchio, about a minute) ...")
+    tmp = cache / f"pinocchio_side-{key}.{os.getpid()}.tmp.o"
+    proc = subprocess.Popen(cmd + ["-o", str(tmp)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc.bench_cmd, proc.bench_tmp, proc.bench_obj = cmd, tmp, obj
+    return obj, proc
+
+
+def finish_pinocchio_object(proc) -> None:
+    if proc is None:
+        return
+    out, _ = proc.communicate()
+    if proc.returncode != 0:
+        raise SystemExit(f"compiling the Pinocchio side failed:\n{shlex.join(proc.bench_cmd)}\n{out}")
+    os.replace(proc.bench_tmp, proc.bench_obj)
+
+
+def build(arms: list, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path, pin_proc, libs: list) -> Path:
+    objs = []
+    for a in arms:
+        for src in (f"{a['name']}_dynamics.c", f"{a['name']}_parameters.c"):
+            obj = work / "obj" / (src[:-2] + ".o")
+            run([cc, "-std=c99", *flags, "-c", str(a["folder"] / src), "-o", str(obj)])
+            objs.append(obj)
+    (work / "arms.inc").write_text(arms_inc(arms))
+    harness = work / "obj" / "harness.o"
+    run([cxx, "-std=c++17", *flags, f"-I{work}", f"-I{BENCH}", *(f"-I{a['folder']}" for a in arms),
+         "-c", str(BENCH / "harness.cpp"), "-o", str(harness)])
+    finish_pinocchio_object(pin_proc)
+    exe = work / "bench_dynamics"
+    run([cxx, *flags, str(harness), str(pin_obj), *map(str, objs), "-o", str(exe), *libs, "-lm"])
+    return exe
+
+
+# --- measurements -------------------------------------------------------------------------
+
+def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> tuple[dict, dict]:
+    res = subprocess.run([str(exe), "time", str(models), str(states), str(batches), str(warmup)],
+                         capture_output=True, text=True)
+    times, errors = {}, {}
+    for line in res.stdout.splitlines():
+        tok = line.split()
+        if tok and tok[0] == "TIME":
+            times[(tok[1], tok[2])] = (float(tok[3]), float(tok[4]))
+        elif tok and tok[0] == "VERIFY":
+            errors[(tok[1], tok[2])] = float(tok[3])
+    if res.returncode != 0:
+        raise SystemExit(f"benchmark run failed ({res.returncode}):\n{res.stdout}{res.stderr}")
+    return times, errors
+
+
+def callgrind_ir(exe: Path, models: Path, states: int, arm: str, function: str, side: str, calls: int,
+                 work: Path) -> int:
+    out = work / "callgrind" / f"{arm}.{function}.{side}.{calls}.out"
+    run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(exe), "callgrind", str(models),
+         str(states), arm, function, side, str(calls)])
+    for line in out.read_text().splitlines():
+        if line.startswith(("summary:", "totals:")):
+            return int(line.split()[1])
+    raise SystemExit(f"no instruction total in {out}")
+
+
+def callgrind_all(exe: Path, models: Path, states: int, arms: list, calls: int, work: Path) -> dict:
+    """{(arm, function): (dyngen Ir/call, pinocchio Ir/call)}: (Ir of `calls` calls minus Ir of
+    the same run with 0 calls) / calls."""
+    if not shutil.which("valgrind"):
+        raise SystemExit("--callgrind needs valgrind")
+    (work / "callgrind").mkdir(exist_ok=True)
+    jobs = [(a["name"], "rnea", "dyngen", 0) for a in arms]
+    jobs += [(a["name"], f, side, calls) for a in arms for f in FUNCTIONS for side in ("dyngen", "pinocchio")]
+    with ThreadPoolExecutor(max_workers=max(1, min(2, os.cpu_count() or 1))) as pool:
+        irs = dict(zip(jobs, pool.map(lambda j: callgrind_ir(exe, models, states, *j, work), jobs)))
+    out = {}
+    for a in arms:
+        base = irs[(a["name"], "rnea", "dyngen", 0)]
+        for f in FUNCTIONS:
+            out[(a["name"], f)] = tuple((irs[(a["name"], f, side, calls)] - base) / calls
+                                        for side in ("dyngen", "pinocchio"))
+    return out
+
+
+# --- report -------------------------------------------------------------------------------
+
+def table(arms: list, times: dict, irs: dict | None) -> list:
+    head = ["arm", "function", "dyngen ns/call", "Pinocchio ns/call", "ratio (Pin/dyngen)",
+            "dyngen mul", "dyngen add"]
+    if irs:
+        head += ["dyngen Ir/call", "Pinocchio Ir/call", "Ir ratio"]
+    rows = [head]
+    for a in arms:
+        for f in FUNCTIONS:
+            d, p = times[(a["name"], f)]
+            ops = a["ops"][f]
+            row = [a["name"], f, f"{d:.1f}", f"{p:.1f}", f"{p / d:.2f}x",
+                   str(ops["mul"]), str(ops["add"])]
+            if irs:
+                di, pi = irs[(a["name"], f)]
+                row += [f"{di:.0f}", f"{pi:.0f}", f"{pi / di:.2f}x"]
+            rows.append(row)
+    return rows
+
+
+def markdown(rows: list) -> str:
+    right = [False, False] + [True] * (len(rows[0]) - 2)
+    lines = ["| " + " | ".join(rows[0]) + " |",
+             "|" + "|".join("---:" if r else "---" for r in right) + "|"]
+    lines += ["| " + " | ".join(r) + " |" for r in rows[1:]]
+    return "\n".join(lines)
+
+
+def plain(rows: list) -> str:
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    return "\n".join("  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths)))
+                     for r in rows)
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    work = Path(args.keep).resolve() if args.keep else Path(tempfile.mkdtemp(prefix="dyngen-bench-"))
+    try:
+        return bench(args, work)
+    finally:
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--arms", nargs="+", default=None,
+                    help="example names (examples/NAME.yaml) or YAML paths; default: all examples")
+    ap.add_argument("--callgrind", action="store_true", help="also count instructions per call with valgrind")
+    ap.add_argument("--calls", type=int, default=1000, help="calls per function under callgrind (default 1000)")
+    ap.add_argument("--states", type=int, default=1000, help="random states per batch (default 1000)")
+    ap.add_argument("--batches", type=int, default=200, help="timed batches per function and side (default 200)")
+    ap.add_argument("--warmup", type=int, default=10, help="untimed batches first (default 10)")
+    ap.add_argument("--flags", default=DEFAULT_FLAGS,
+                    help=f"compiler flags, the same for both sides (default: {DEFAULT_FLAGS!r})")
+    ap.add_argument("--pinocchio-lib", action="store_true",
+                    help="time the wheel's precompiled Pinocchio algorithms (libpinocchio_default, built by the "
+                         "wheel's own compiler and flags) instead of compiling Pinocchio's headers with --flags")
+    ap.add_argument("--rebuild", action="store_true", help="recompile the cached Pinocchio side")
+    ap.add_argument("--keep", metavar="DIR", help="build in DIR and keep it (default: a temporary folder)")
+    ap.add_argument("--output", default=str(BENCH / "results" / "dynamics.md"),
+                    help="markdown results file (default bench/results/dynamics.md); '' to skip")
+    return ap.parse_args(argv)
+
+
+def bench(args, work: Path) -> int:
+    start = time.perf_counter()
+    cc, cxx = os.environ.get("CC", "gcc"), os.environ.get("CXX", "g++")
+    flags = shlex.split(args.flags)
+    tool = pinocchio_toolchain()
+    pin_obj, pin_proc = pinocchio_object(cxx, flags, tool, args.rebuild, args.pinocchio_lib)
+    libs = []
+    if args.pinocchio_lib:
+        libdir = pinocchio_library(tool)
+        libs = [f"-L{libdir}", "-lpinocchio_default", f"-Wl,-rpath,{libdir}"]
+    try:
+        names = args.arms or example_arms()
+        for sub in ("gen", "models", "obj"):
+            (work / sub).mkdir(parents=True, exist_ok=True)
+        arms = []
+        for name in names:
+            log(f"generating {name} ...")
+            arms.append(prepare_arm(arm_yaml(name), work / "gen", work / "models"))
+        log("compiling the benchmark ...")
+        exe = build(arms, work, cc, cxx, flags, pin_obj, pin_proc, libs)
+        pin_proc = None
+    finally:
+        if pin_proc is not None and pin_proc.poll() is None:
+            pin_proc.kill()
+            pin_proc.wait()
+
+    log(f"verifying and timing ({args.states} states x {args.batches} batches per function and side) ...")
+    times, errors = timing(exe, work / "models", args.states, args.batches, args.warmup)
+    irs = None
+    if args.callgrind:
+        log(f"callgrind ({args.calls} calls per function and side, minus a 0-call baseline) ...")
+        irs = callgrind_all(exe, work / "models", args.states, arms, args.calls, work)
+    rows = table(arms, times, irs)
+
+    cc_v, cxx_v = compiler_version(cc), compiler_version(cxx)
+    info = [
+        f"- machine: {machine()}",
+        f"- C compiler: `{cc}` ({cc_v}), `-std=c99 {args.flags}` (generated C)",
+        f"- C++ compiler: `{cxx}` ({cxx_v}), `-std=c++17 {args.flags}` (harness and Pinocchio)",
+        (f"- Pinocchio {tool['version']} (pip wheel `pin`), PRECOMPILED: rnea, crba, computeGeneralizedGravity "
+         f"run from the wheel's {pinocchio_library(tool) / 'libpinocchio_default.so'} (built by "
+         f"{wheel_compiler(tool)} with the wheel's flags, NOT the flags above); definitions "
+         f"{' '.join('-D' + d for d in tool['defines'])} -DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION"
+         if args.pinocchio_lib else
+         f"- Pinocchio {tool['version']} (pip wheel `pin`), header-only: its algorithms are compiled here with the "
+         f"flags above, not taken from the wheel's precompiled library; definitions "
+         f"{' '.join('-D' + d for d in tool['defines'])}"),
+        f"- Eigen {tool['eigen_version']} ({tool['eigen']}), Boost {tool['boost_version'].replace('_', '.')}",
+        f"- {args.states} random states within the joint limits (qd in [-2, 2], qdd in [-5, 5]), "
+        f"the same for both sides; {args.batches} timed batches per function and side after {args.warmup} "
+        "warm-up batches, interleaved; ns/call = median over batches of (batch time / states)",
+        "- every call is an out-of-line call into another translation unit on both sides; the outputs are "
+        "summed into a volatile sink (for the inertia matrix: the upper triangle on both sides)",
+        "- crba fills only the upper triangle of M; the generated mass matrix writes the full matrix",
+        "- parameters: " + "; ".join(f"{a['name']} {a['p_source']}" for a in arms),
+        "- agreement checked before timing, on every state (max relative error "
+        "|dyngen - Pinocchio| / max(1, |Pinocchio|)): " + "; ".join(
+            f"{a['name']} " + ", ".join(f"{f} {errors[(a['name'], f)]:.1e}" for f in FUNCTIONS) for a in arms),
+    ]
+    if irs:
+        info.append(f"- Ir/call: callgrind instructions of a run with {args.calls} calls of one function minus "
+                    "a run with 0 calls (same set-up), divided by the number of calls")
+    print()
+    print(plain(rows))
+    print()
+    print("\n".join(info))
+    if args.output:
+        out = Path(args.output)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text("# dyngen generated C vs Pinocchio\n\n"
+                       "Written by `python bench/bench_dynamics.py"
+                       + (" --callgrind" if args.callgrind else "") + "`.\n\n"
+                       + "\n".join(info) + "\n\n" + markdown(rows) + "\n\n"
+                       "ratio = Pinocchio ns/call / dyngen ns/call (above 1: the generated C is faster).\n")
+        log(f"wrote {out}")
+    log(f"done in {time.perf_counter() - start:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
