@@ -159,11 +159,36 @@ def _extract(args, robot, bases, folder) -> None:
         from .export import write_all
 
         exported = write_all(robot, extraction.p, out)
+    validation = _validate(robot, folder, extraction, out, progress)
     if not args.quiet:
         print(report.summary(robot, extraction, options, seconds))
         print("  physical consistency per link (lambda_min of tr(I)/2 E - I must be >= 0):")
         print("\n".join("    " + line for line in table.splitlines()))
         print(f"  parameters: {out}/extracted.yaml" + "".join(f", {p}" for p in exported))
+        if validation:
+            worst = ", ".join(f"{x:.1e}" for x in validation["max_abs"])
+            print(f"  Sec. IV validation on the Table V trajectory: max |N-E(extracted) - coefficients model| "
+                  f"per joint [Nm]: {worst}")
+            print(f"  figures: {validation['paths']['trajectory']}, {validation['paths']['torques']}")
+
+
+def _validate(robot, folder, extraction, out, progress):
+    """The paper's Sec. IV check, for 7-joint arms whose gravity and inertia coefficients were identified."""
+    import numpy as np
+
+    from .validation import validate
+
+    targets = extraction.targets
+    if robot.dof != 7 or robot.gravity_symbols or not {"gravity", "inertia"} <= set(targets):
+        return None
+    pi_hat = {}
+    for kind in ("gravity", "inertia"):
+        W, v = targets[kind].W, targets[kind].v
+        if W.shape[0] < W.shape[1] or np.linalg.matrix_rank(W) < W.shape[1]:
+            return None  # the identified set does not determine every coefficient
+        pi_hat[kind] = np.linalg.lstsq(W, v, rcond=None)[0]
+    with progress.step("validate on the Table V trajectory (Sec. IV)"):
+        return validate(robot, folder, extraction.p, pi_hat["gravity"], pi_hat["inertia"], out)
 
 
 def cmd_generate(argv, prog="dyngen generate") -> int:

@@ -20,10 +20,14 @@ derivative="exact" uses stencils that are exact for those function classes, with
              (5-point periodic spectral differentiation);
   prismatic: f'(x) = [f(x+h) - f(x-h)] / (2 h),  h = 0.1 (exact for quadratics).
 
-Only rounding remains: the torque error is ~1e-15 relative to |M| |qd|^2 (the tests measure
-~1e-13 relative to the torque peak against Newton-Euler with the same parameters).
+Only rounding remains. Measured against Newton-Euler with the same parameters on the Table V
+trajectory (25 Hz, random consistent parameters, joints 1..N of the knots): max |difference| /
+max |tau| = 5e-16 to 1e-15 (LWR, Panda, UR5, Stanford arm), 2e-14 (PUMA 560);
+tests/test_validation.py asserts 1e-10 for the LWR.
 derivative="fd4" is the generic 4-point central stencil [8(f(x+h) - f(x-h)) - (f(x+2h) - f(x-2h))] / (12 h),
-h = 1e-3, for any smooth M: truncation ~h^4 f^(5) / 30 and rounding ~eps |M| / h, ~1e-12 relative.
+h = 1e-3, for any smooth M: truncation ~h^4 f^(5) / 30 and rounding ~eps |M| / h; measured as above
+5e-14 to 8e-14 (LWR, Panda, UR5, Stanford), 3e-12 (PUMA 560), at the same cost (4 evaluations of
+Y_m per joint and sample; ~1.2 s for the 2801 samples of Table V at 100 Hz).
 """
 
 from __future__ import annotations
