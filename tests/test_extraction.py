@@ -167,3 +167,14 @@ def test_unidentifiable_coefficient_is_rejected(lwr, tmp_path):
     from dyngen.errors import InputError
     with pytest.raises(InputError, match=r"identified.gravity\[0\].coefficient: \"m1\" is not identifiable"):
         extract(load_robot(path), lwr.bases, lwr.c.folder, Options(**FAST))
+
+
+def test_residuals_shown_next_to_the_papers(lwr, lwr_extraction):
+    from dyngen.extraction.report import residual_comparison
+
+    rows = residual_comparison(lwr.robot, lwr_extraction, {"paper": P_PAPER, "dyngen": lwr_extraction.p},
+                               lwr.c.folder)
+    assert len(rows) == 8 and all("paper" in r and "dyngen" in r for r in rows)
+    inertia = [r for r in rows if r.startswith("inertia")]
+    # the inertia targets are the paper solution's own coefficients: its residual there is zero
+    assert all(float(r.split("paper ")[1].split(",")[0]) == 0 for r in inertia)

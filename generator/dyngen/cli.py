@@ -152,6 +152,7 @@ def _extract(args, robot, bases, folder) -> None:
         links = yaml.safe_load(path.read_text())["solution"]
         columns = {path.name: np.array([v for link in links for v in (link["m"], *link["c"], *link["I"])]),
                    **columns}
+    residual_rows = report.residual_comparison(robot, extraction, columns, folder)
     table = report.consistency_table(columns)
     write_file(out / "consistency.md", table + "\n")
     exported = []
@@ -162,6 +163,9 @@ def _extract(args, robot, bases, folder) -> None:
     validation = _validate(robot, folder, extraction, out, progress)
     if not args.quiet:
         print(report.summary(robot, extraction, options, seconds))
+        if residual_rows:
+            print("  largest coefficient residuals (W pi(p) - pi_hat), dyngen next to the compared solution:")
+            print("\n".join("    " + line for line in residual_rows))
         print("  physical consistency per link (lambda_min of tr(I)/2 E - I must be >= 0):")
         print("\n".join("    " + line for line in table.splitlines()))
         print(f"  parameters: {out}/extracted.yaml" + "".join(f", {p}" for p in exported))

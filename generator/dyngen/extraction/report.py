@@ -65,3 +65,20 @@ def summary(robot, extraction, options, seconds: float) -> str:
         lines.append(f"  {kind} coefficients: |residual| {np.linalg.norm(r):.3e} (relative {rel:.2e}); "
                      f"largest at {robot.identified[kind][worst].coefficient} = {r[worst]:+.2e}")
     return "\n".join(lines)
+
+
+def residual_comparison(robot, extraction, columns: dict, folder, top: int = 4) -> list[str]:
+    """The coefficients dyngen's parameters miss most, with every compared solution's residual there."""
+    from ..runtime import load
+
+    if len(columns) < 2:
+        return []
+    model = load(folder)
+    rows = []
+    for kind, target in extraction.targets.items():
+        residual = {label: target.W @ model(f"pi_{kind}", p) - target.v for label, p in columns.items()}
+        ours = residual["dyngen"]
+        for k in np.argsort(-np.abs(ours))[:top]:
+            cells = ", ".join(f"{label} {r[k]:+.2e}" for label, r in residual.items())
+            rows.append(f"{kind}: {robot.identified[kind][k].coefficient}: {cells}")
+    return rows
