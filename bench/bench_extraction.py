@@ -20,7 +20,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import yaml
 from scipy.optimize import dual_annealing, minimize
 
 ROOT = Path(__file__).resolve().parents[1]

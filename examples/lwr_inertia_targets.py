@@ -8,11 +8,9 @@ Run: python examples/lwr_inertia_targets.py  (rewrites the block between the mar
 
 from pathlib import Path
 
-import numpy as np
-import yaml
-
 from dyngen.description import load_robot
 from dyngen.emission.coefficients import grouped_text
+from dyngen.extraction.report import read_solution
 from dyngen.generate import build
 from dyngen.parameters import PER_LINK, standard_from_dynamic, standard_name
 
@@ -20,16 +18,11 @@ HERE = Path(__file__).resolve().parent
 BEGIN, END = "  # BEGIN inertia targets (examples/lwr_inertia_targets.py)\n", "  # END inertia targets\n"
 
 
-def paper_solution() -> np.ndarray:
-    links = yaml.safe_load((HERE / "lwr_paper_solution.yaml").read_text())["solution"]
-    return np.array([v for link in links for v in (link["m"], *link["c"], *link["I"])], dtype=float)
-
-
 def main():
     robot = load_robot(HERE / "lwr.yaml")
     bases, _ = build(robot)
     base = bases["inertia"]
-    s = standard_from_dynamic(paper_solution())
+    s = standard_from_dynamic(read_solution(HERE / "lwr_paper_solution.yaml"))
     names = [standard_name(i + 1, k) for i in range(robot.dof) for k in range(PER_LINK)]
     lines = [BEGIN, "  # The paper does not print pi_hat_m: these are pi_inertia(p) of the paper's own final solution\n  # (examples/lwr_paper_solution.yaml: Tables II, IV, eq. 20, eq. 15), by examples/lwr_inertia_targets.py.\n  inertia:\n"]
     for row in base.K:

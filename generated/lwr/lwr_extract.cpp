@@ -327,7 +327,6 @@ struct Outcome {
 };
 
 void add_constraints(nlopt_opt opt, Context &c, std::vector<EqualityData> &eq_data, double tol) {
-    const unsigned n = static_cast<unsigned>(c.P->free.size());
     std::vector<double> tols(kLinks, tol);
     nlopt_add_inequality_mconstraint(opt, kLinks, consistency, &c, tols.data());
     if (c.P->has_total_mass) {
@@ -335,7 +334,6 @@ void add_constraints(nlopt_opt opt, Context &c, std::vector<EqualityData> &eq_da
         nlopt_add_inequality_constraint(opt, mass_below, &c, tol);
     }
     for (auto &e : eq_data) nlopt_add_equality_constraint(opt, equality, &e, tol);
-    (void)n;
 }
 
 nlopt_opt make(nlopt_algorithm algorithm, const Problem &P) {
@@ -356,8 +354,6 @@ std::vector<double> free_part(const Problem &P, const Eigen::VectorXd &p) {
     for (size_t k = 0; k < P.free.size(); ++k) x[k] = p[P.free[k]];
     return x;
 }
-
-std::vector<double> free_part(const Problem &P, const Eigen::VectorXd &p);
 
 Outcome run_restart(const Problem &P, int restart) {
     Context c{&P};

@@ -81,31 +81,29 @@ def _options_from(args, robot):
 
 def cmd_main(argv, prog="dyngen") -> int:
     """Generate, then extract and export when the YAML has what extraction needs."""
-    parser = _generate_parser(prog)
-    parser.description = ("The main job: generate the C model, then, when the YAML has identified "
-                          "coefficients and parameter bounds, extract consistent link parameters and export them.")
-    _extract_options(parser)
-    args = parser.parse_args(argv)
-    robot = _load(args)
-    extracting = bool(robot.identified) and robot.lower is not None
-    if extracting:
-        _precheck(args, robot)
-    result = _generate(args, robot)
-    if extracting:
-        _extract(args, result.robot, result.bases, result.folder)
-    return 0
+    return _generate_and_extract(argv, prog, required=False, description=(
+        "The main job: generate the C model, then, when the YAML has identified coefficients and "
+        "parameter bounds, extract consistent link parameters, validate and export them."))
 
 
 def cmd_extract(argv, prog="dyngen extract") -> int:
+    return _generate_and_extract(argv, prog, required=True, description=(
+        "Extract physically consistent link parameters from the identified coefficients of ROBOT.yaml "
+        "(generating its C model first), validate and export them."))
+
+
+def _generate_and_extract(argv, prog, required: bool, description: str) -> int:
     parser = _generate_parser(prog)
-    parser.description = ("Extract physically consistent link parameters from the identified coefficients of "
-                          "ROBOT.yaml (generating its C model first), and export them as YAML.")
+    parser.description = description
     _extract_options(parser)
     args = parser.parse_args(argv)
     robot = _load(args)
-    _precheck(args, robot)
+    extracting = required or (bool(robot.identified) and robot.lower is not None)
+    if extracting:
+        _precheck(args, robot)  # bad bounds fail before anything runs or is written
     result = _generate(args, robot)
-    _extract(args, result.robot, result.bases, result.folder)
+    if extracting:
+        _extract(args, result.robot, result.bases, result.folder)
     return 0
 
 
@@ -124,9 +122,6 @@ def _precheck(args, robot) -> None:
 
 def _extract(args, robot, bases, folder) -> None:
     from pathlib import Path
-
-    import numpy as np
-    import yaml
 
     from .atomic import write_file
     from .extraction import report
@@ -149,9 +144,7 @@ def _extract(args, robot, bases, folder) -> None:
     compare = args.compare or robot.extraction.get("compare")
     if compare:
         path = Path(compare) if args.compare else Path(args.robot).parent / compare
-        links = yaml.safe_load(path.read_text())["solution"]
-        columns = {path.name: np.array([v for link in links for v in (link["m"], *link["c"], *link["I"])]),
-                   **columns}
+        columns = {path.name: report.read_solution(path), **columns}
     residual_rows = report.residual_comparison(robot, extraction, columns, folder)
     table = report.consistency_table(columns)
     write_file(out / "consistency.md", table + "\n")

@@ -35,7 +35,7 @@ class Printer(C99CodePrinter):
         return self.names.get(expr, expr.name)
 
     def _print_Rational(self, expr):
-        return f"{self.macro}_K({_decimal(expr)})"
+        return f"{self.macro}_K({decimal_text(expr)})"
 
     def _print_Integer(self, expr):
         return str(int(expr))
@@ -65,7 +65,7 @@ class Printer(C99CodePrinter):
         return f"{self.macro}_COS({self._print(expr.args[0])})"
 
 
-def _decimal(r: sp.Rational) -> str:
+def decimal_text(r: sp.Rational) -> str:
     """39/100 -> 0.39 when the decimal terminates; otherwise a quotient the compiler folds."""
     p, q = int(r.p), int(r.q)
     twos = fives = 0

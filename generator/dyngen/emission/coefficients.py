@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..parameters import standard_in_dynamic_symbols
-from .c_code import _decimal
+from .c_code import decimal_text
 
 
 def grouped_text(row, names) -> str:
@@ -20,7 +20,7 @@ def grouped_text(row, names) -> str:
             terms += [(k, name) for name in group]
         else:
             body = group[0] if len(group) == 1 else "(" + " + ".join(group) + ")"
-            terms.append((k, f"{_decimal(abs(k))}*{body}"))
+            terms.append((k, f"{decimal_text(abs(k))}*{body}"))
     text = ""
     for k, term in terms:
         if not text:

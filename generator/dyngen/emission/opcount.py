@@ -46,13 +46,12 @@ def _count(e, c):
         c["add"] += len(e.args) - 1
     elif e.is_Mul:
         coeff, factors = e.as_coeff_mul()
-        n = len(factors) - 1 + (0 if abs(coeff) == 1 else 1)
-        numer = [f for f in factors if not (f.is_Pow and f.exp.is_negative)]
-        denom = [f for f in factors if f.is_Pow and f.exp.is_negative]
-        c["div"] += 1 if denom else 0
-        c["mul"] += max(n - len(denom) + (0 if numer or abs(coeff) != 1 else 0), 0) - (1 if denom and not numer and abs(coeff) == 1 else 0)
+        denominators = [f for f in factors if f.is_Pow and f.exp.is_negative]
+        numerators = len(factors) - len(denominators) + (0 if abs(coeff) == 1 else 1)
+        c["mul"] += max(numerators - 1, 0) + max(len(denominators) - 1, 0)
+        c["div"] += 1 if denominators else 0
         for f in factors:
-            _count(f, c)
+            _count(f.base if f in denominators else f, c)
         return
     elif e.is_Pow:
         if e.exp.is_Integer and e.exp > 0:

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 
 from .torques import compare, from_coefficients, newton_euler
 from .trajectory import TABLE_V, TABLE_V_KNOTS, TABLE_V_TIMES, cubic_through_knots, table_v
