@@ -11,8 +11,9 @@
 //                    the inertia about the centre of mass is realisable by a positive density)
 //                polynomial identities h(p) = 0    (e.g. eq. 15)
 // from many random starts p = LB + (UB - LB) u (eq. 17): a global NLopt algorithm (ISRES) and a
-// local refinement (SLSQP with the generated Jacobians), restarts in parallel, one seed per
-// restart so that the result does not depend on the number of threads. Among near-optimal
+// local refinement (SLSQP with the generated Jacobians; in the standard parameters s, where the
+// cost is a convex quadratic, whenever all parameters are free), restarts in parallel, one seed
+// per restart so that the result does not depend on the number of threads. Among near-optimal
 // solutions it then prefers the one closest to the reference (nominal) parameters.
 // pi_b are the generated base coefficient functions of lwr_parameters.c (lwr.h).
 
@@ -77,6 +78,7 @@ struct Problem {
     double hop_size = 0.1;
     unsigned long seed = 1;
     std::string global_algorithm = "isres";
+    double cost_scale = 1;  // sum_b ||v_b||^2: the optimisers see the relative cost
     double tolerance = 1e-9;
 };
 
@@ -166,6 +168,9 @@ Problem read_problem(const std::string &path) {
     r.expect("hops"); P.hops = static_cast<int>(r.integer());
     P.hop_size = r.number();
     r.expect("end");
+    double norm = 0;
+    for (const Block &b : P.blocks) norm += b.v.squaredNorm();
+    if (norm > 0) P.cost_scale = norm;
     return P;
 }
 
@@ -173,11 +178,21 @@ Problem read_problem(const std::string &path) {
 
 struct Context {
     const Problem *P;
-    double cost_cap = 0;  // for the reference stage: cost(p) <= cost_cap
+    double cost_cap = 0;  // for the reference stage: objective (relative cost) <= cost_cap
+    // The optimisers see x in the unit box, p_j = LB_j + (UB_j - LB_j) x_k: masses (kg), centres
+    // of mass (m) and inertias (kg m^2) differ by orders of magnitude, and SLSQP's quasi-Newton
+    // steps stall on such badly scaled variables.
     Eigen::VectorXd full(const double *x) const {
         Eigen::VectorXd p = P->value;
-        for (size_t k = 0; k < P->free.size(); ++k) p[P->free[k]] = x[k];
+        for (size_t k = 0; k < P->free.size(); ++k) p[P->free[k]] = P->lower[P->free[k]] + span(k) * x[k];
         return p;
+    }
+    double span(size_t k) const { return P->upper[P->free[k]] - P->lower[P->free[k]]; }
+    std::vector<double> unit(const Eigen::VectorXd &p) const {  // the inverse of full()
+        std::vector<double> x(P->free.size(), 0.0);
+        for (size_t k = 0; k < x.size(); ++k)
+            if (span(k) > 0) x[k] = (p[P->free[k]] - P->lower[P->free[k]]) / span(k);
+        return x;
     }
 };
 
@@ -201,13 +216,14 @@ double fit_cost(const Problem &P, const Eigen::VectorXd &p, Eigen::VectorXd *gra
     return cost;
 }
 
+// The relative cost over the unit box (both scalings keep SLSQP's tolerances meaningful).
 double objective(unsigned n, const double *x, double *grad, void *data) {
     const Context &c = *static_cast<Context *>(data);
     Eigen::VectorXd g;
     const double cost = fit_cost(*c.P, c.full(x), grad ? &g : nullptr);
     if (grad)
-        for (unsigned k = 0; k < n; ++k) grad[k] = g[c.P->free[k]];
-    return cost;
+        for (unsigned k = 0; k < n; ++k) grad[k] = g[c.P->free[k]] * c.span(k) / c.P->cost_scale;
+    return cost / c.P->cost_scale;
 }
 
 // Distance to the reference parameters (the second, preference stage).
@@ -216,9 +232,9 @@ double distance(unsigned n, const double *x, double *grad, void *data) {
     double d = 0;
     for (unsigned k = 0; k < n; ++k) {
         const int j = c.P->free[k];
-        const double e = x[k] - c.P->reference[j];
+        const double e = c.P->lower[j] + c.span(k) * x[k] - c.P->reference[j];
         d += c.P->weight[j] * e * e;
-        if (grad) grad[k] = 2.0 * c.P->weight[j] * e;
+        if (grad) grad[k] = 2.0 * c.P->weight[j] * e * c.span(k);
     }
     return d;
 }
@@ -263,13 +279,13 @@ double total_mass(const Eigen::VectorXd &p) {
 
 double mass_above(unsigned n, const double *x, double *grad, void *data) {
     const Context &c = *static_cast<Context *>(data);
-    for (unsigned k = 0; grad && k < n; ++k) grad[k] = c.P->free[k] % 10 == 0 ? 1.0 : 0.0;
+    for (unsigned k = 0; grad && k < n; ++k) grad[k] = c.P->free[k] % 10 == 0 ? c.span(k) : 0.0;
     return total_mass(c.full(x)) - c.P->mass_hi;
 }
 
 double mass_below(unsigned n, const double *x, double *grad, void *data) {
     const Context &c = *static_cast<Context *>(data);
-    for (unsigned k = 0; grad && k < n; ++k) grad[k] = c.P->free[k] % 10 == 0 ? -1.0 : 0.0;
+    for (unsigned k = 0; grad && k < n; ++k) grad[k] = c.P->free[k] % 10 == 0 ? -c.span(k) : 0.0;
     return c.P->mass_lo - total_mass(c.full(x));
 }
 
@@ -294,7 +310,7 @@ double equality(unsigned n, const double *x, double *grad, void *data) {
             g[t.index[a]] += rest;
         }
     }
-    for (unsigned k = 0; grad && k < n; ++k) grad[k] = g[e.context->P->free[k]];
+    for (unsigned k = 0; grad && k < n; ++k) grad[k] = g[e.context->P->free[k]] * e.context->span(k);
     return h;
 }
 
@@ -310,8 +326,7 @@ double violation(const Problem &P, const Eigen::VectorXd &p) {
     if (P.has_total_mass) worst = std::max({worst, total_mass(p) - P.mass_hi, P.mass_lo - total_mass(p)});
     Context c{&P};
     for (const auto &poly : P.equalities) {
-        std::vector<double> x(P.free.size());
-        for (size_t k = 0; k < P.free.size(); ++k) x[k] = p[P.free[k]];
+        std::vector<double> x = c.unit(p);
         EqualityData e{&c, &poly};
         worst = std::max(worst, std::fabs(equality(static_cast<unsigned>(x.size()), x.data(), nullptr, &e)));
     }
@@ -341,18 +356,251 @@ nlopt_opt make(nlopt_algorithm algorithm, const Problem &P) {
     nlopt_opt opt = nlopt_create(algorithm, n);
     std::vector<double> lo(n), hi(n);
     for (unsigned k = 0; k < n; ++k) {
-        lo[k] = P.lower[P.free[k]];
-        hi[k] = P.upper[P.free[k]];
+        lo[k] = 0.0;
+        hi[k] = 1.0;
     }
     nlopt_set_lower_bounds(opt, lo.data());
     nlopt_set_upper_bounds(opt, hi.data());
     return opt;
 }
 
-std::vector<double> free_part(const Problem &P, const Eigen::VectorXd &p) {
-    std::vector<double> x(P.free.size());
-    for (size_t k = 0; k < P.free.size(); ++k) x[k] = p[P.free[k]];
-    return x;
+// ---- local refinement in the standard parameters ---------------------------------------------
+// Per link s = (m, h = m c, S = I + m (c^T c E - c c^T)), ordered m, hx, hy, hz, Sxx, Sxy, Sxz,
+// Syy, Syz, Szz. The coefficients are linear in s, so the fit cost is a convex quadratic there,
+// and so are the constraints that matter most: consistency (a positive semidefinite
+// pseudo-inertia), the mass and centre-of-mass bounds (h between LB_c m and UB_c m), the total
+// mass. In p the products m c and m c c make local minima: a restart whose wrist mass shrank to
+// its lower bound could not fit the first moments again (PUMA 560: 0 of 16 restarts reached a
+// relative error of 1e-9 in p, see the benchmark). Only the inertia bounds (and identities) are
+// not convex in s. Used when every parameter is free (the joint procedure).
+
+// p of one link from its s, and dp/ds (10x10, row-major) when asked.
+void dynamic_from_standard(const double *s, double *p, double *dpds) {
+    const double m = s[0], h[3] = {s[1], s[2], s[3]};
+    p[0] = m;
+    for (int a = 0; a < 3; ++a) p[1 + a] = h[a] / m;
+    // I = S - (h^T h E - h h^T) / m; entries xx, xy, xz, yy, yz, zz
+    const int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+    for (int e = 0; e < 6; ++e) {
+        const int a = row[e], b = col[e];
+        const double q = (a == b ? h[0] * h[0] + h[1] * h[1] + h[2] * h[2] : 0.0) - h[a] * h[b];
+        p[4 + e] = s[4 + e] - q / m;
+        if (!dpds) continue;
+        double *d = dpds + 10 * (4 + e);
+        std::fill(d, d + 10, 0.0);
+        d[0] = q / (m * m);
+        for (int k = 0; k < 3; ++k) {
+            double dq = (a == b ? 2 * h[k] : 0.0) - (k == a ? h[b] : 0.0) - (k == b ? h[a] : 0.0);
+            d[1 + k] = -dq / m;
+        }
+        d[4 + e] = 1.0;
+    }
+    if (!dpds) return;
+    std::fill(dpds, dpds + 40, 0.0);
+    dpds[0] = 1.0;
+    for (int a = 0; a < 3; ++a) {
+        dpds[10 * (1 + a) + 0] = -h[a] / (m * m);
+        dpds[10 * (1 + a) + 1 + a] = 1.0 / m;
+    }
+}
+
+struct StandardContext {  // the optimiser's y in the unit box: s = lo + span y
+    const Problem *P;
+    Eigen::VectorXd lo, span;
+    explicit StandardContext(const Problem &problem) : P(&problem), lo(kParameters), span(kParameters) {
+        // A box around every s the p bounds allow (loose: the constraints below are exact).
+        for (int link = 0; link < kLinks; ++link) {
+            const int o = 10 * link;
+            const double m_lo = P->lower[o], m_hi = P->upper[o];
+            double c2_max[3];
+            for (int a = 0; a < 3; ++a) {
+                const double cl = P->lower[o + 1 + a], cu = P->upper[o + 1 + a];
+                const double h1 = std::min({cl * m_lo, cl * m_hi, cu * m_lo, cu * m_hi});
+                const double h2 = std::max({cl * m_lo, cl * m_hi, cu * m_lo, cu * m_hi});
+                lo[o + 1 + a] = h1;
+                span[o + 1 + a] = h2 - h1;
+                c2_max[a] = std::max(cl * cl, cu * cu);
+            }
+            lo[o] = m_lo;
+            span[o] = m_hi - m_lo;
+            const int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+            for (int e = 0; e < 6; ++e) {
+                const int a = row[e], b = col[e];
+                double shift_lo = 0, shift_hi = 0;  // of m (c^T c delta_ab - c_a c_b)
+                if (a == b) {
+                    shift_hi = m_hi * (c2_max[0] + c2_max[1] + c2_max[2] - c2_max[a]);
+                } else {
+                    const double cross = m_hi * std::sqrt(c2_max[a] * c2_max[b]);
+                    shift_lo = -cross;
+                    shift_hi = cross;
+                }
+                lo[o + 4 + e] = P->lower[o + 4 + e] + shift_lo;
+                span[o + 4 + e] = P->upper[o + 4 + e] + shift_hi - lo[o + 4 + e];
+            }
+        }
+    }
+    // p from y, and dp/dy (block diagonal, one 10x10 row-major block per link) when asked.
+    Eigen::VectorXd p_of(const double *y, std::vector<double> *dpdy = nullptr) const {
+        Eigen::VectorXd p(kParameters);
+        if (dpdy) dpdy->assign(static_cast<size_t>(kLinks) * 100, 0.0);
+        for (int link = 0; link < kLinks; ++link) {
+            double s[10];
+            for (int k = 0; k < 10; ++k) s[k] = lo[10 * link + k] + span[10 * link + k] * y[10 * link + k];
+            double *block = dpdy ? dpdy->data() + 100 * link : nullptr;
+            dynamic_from_standard(s, p.data() + 10 * link, block);
+            if (block)
+                for (int b = 0; b < 10; ++b)
+                    for (int a = 0; a < 10; ++a) block[10 * b + a] *= span[10 * link + a];
+        }
+        return p;
+    }
+    std::vector<double> y_of(const Eigen::VectorXd &p) const {
+        std::vector<double> y(kParameters, 0.0);
+        lwr_real s[kParameters];
+        lwr_standard_from_dynamic(p.data(), s);
+        for (int k = 0; k < kParameters; ++k)
+            if (span[k] > 0) y[k] = std::clamp((s[k] - lo[k]) / span[k], 0.0, 1.0);
+        return y;
+    }
+    // d f/d y from d f/d p.
+    void chain(const Eigen::VectorXd &dfdp, const std::vector<double> &dpdy, double *out) const {
+        for (int link = 0; link < kLinks; ++link)
+            for (int a = 0; a < 10; ++a) {
+                double sum = 0;
+                for (int b = 0; b < 10; ++b) sum += dfdp[10 * link + b] * dpdy[100 * link + 10 * b + a];
+                out[10 * link + a] = sum;
+            }
+    }
+};
+
+double standard_objective(unsigned, const double *y, double *grad, void *data) {
+    const StandardContext &c = *static_cast<StandardContext *>(data);
+    std::vector<double> dpdy;
+    const Eigen::VectorXd p = c.p_of(y, grad ? &dpdy : nullptr);
+    Eigen::VectorXd g;
+    const double cost = fit_cost(*c.P, p, grad ? &g : nullptr);
+    if (grad) {
+        c.chain(g, dpdy, grad);
+        for (int k = 0; k < kParameters; ++k) grad[k] /= c.P->cost_scale;
+    }
+    return cost / c.P->cost_scale;
+}
+
+// Per link, 19 constraints <= 0: consistency, the centre-of-mass bounds as LB_c m - h and
+// h - UB_c m (linear in s), and the inertia bounds LB_I - I(s), I(s) - UB_I.
+constexpr int kPerLinkConstraints = 19;
+void standard_constraints(unsigned m, double *result, unsigned n, const double *y, double *grad, void *data) {
+    const StandardContext &c = *static_cast<StandardContext *>(data);
+    const Problem &P = *c.P;
+    std::vector<double> dpdy;
+    const Eigen::VectorXd p = c.p_of(y, grad ? &dpdy : nullptr);
+    if (grad) std::fill(grad, grad + static_cast<size_t>(m) * n, 0.0);
+    for (int link = 0; link < kLinks; ++link) {
+        const int o = 10 * link, first = kPerLinkConstraints * link;
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(density_matrix(p, link));
+        result[first] = P.margin - eig.eigenvalues()[0];
+        double s[10];
+        for (int k = 0; k < 10; ++k) s[k] = c.lo[o + k] + c.span[o + k] * y[o + k];
+        for (int a = 0; a < 3; ++a) {
+            result[first + 1 + 2 * a] = P.lower[o + 1 + a] * s[0] - s[1 + a];
+            result[first + 2 + 2 * a] = s[1 + a] - P.upper[o + 1 + a] * s[0];
+        }
+        for (int e = 0; e < 6; ++e) {
+            result[first + 7 + 2 * e] = P.lower[o + 4 + e] - p[o + 4 + e];
+            result[first + 8 + 2 * e] = p[o + 4 + e] - P.upper[o + 4 + e];
+        }
+        if (!grad) continue;
+        const double *J = dpdy.data() + 100 * link;  // dp/dy of this link
+        auto row = [&](int r) { return grad + static_cast<size_t>(first + r) * n + o; };
+        const Eigen::Vector3d v = eig.eigenvectors().col(0);
+        const double dl[6] = {0.5 - v[0] * v[0], -2 * v[0] * v[1], -2 * v[0] * v[2],
+                              0.5 - v[1] * v[1], -2 * v[1] * v[2], 0.5 - v[2] * v[2]};
+        for (int a = 0; a < 10; ++a) {
+            double sum = 0;
+            for (int e = 0; e < 6; ++e) sum += dl[e] * J[10 * (4 + e) + a];
+            row(0)[a] = -sum;
+        }
+        for (int a = 0; a < 3; ++a) {
+            row(1 + 2 * a)[0] = P.lower[o + 1 + a] * c.span[o];
+            row(1 + 2 * a)[1 + a] = -c.span[o + 1 + a];
+            row(2 + 2 * a)[0] = -P.upper[o + 1 + a] * c.span[o];
+            row(2 + 2 * a)[1 + a] = c.span[o + 1 + a];
+        }
+        for (int e = 0; e < 6; ++e)
+            for (int a = 0; a < 10; ++a) {
+                row(7 + 2 * e)[a] = -J[10 * (4 + e) + a];
+                row(8 + 2 * e)[a] = J[10 * (4 + e) + a];
+            }
+    }
+}
+
+double standard_total_mass(unsigned n, const double *y, double *grad, void *data) {  // sign * (sum m - bound)
+    const auto &[c, sign] = *static_cast<std::pair<const StandardContext *, double> *>(data);
+    double total = 0;
+    for (int link = 0; link < kLinks; ++link) total += c->lo[10 * link] + c->span[10 * link] * y[10 * link];
+    for (unsigned k = 0; grad && k < n; ++k) grad[k] = k % 10 == 0 ? sign * c->span[k] : 0.0;
+    return sign > 0 ? total - c->P->mass_hi : c->P->mass_lo - total;
+}
+
+struct StandardEquality {
+    const StandardContext *context;
+    const std::vector<Term> *poly;
+};
+double standard_equality(unsigned n, const double *y, double *grad, void *data) {
+    const StandardEquality &e = *static_cast<StandardEquality *>(data);
+    std::vector<double> dpdy;
+    const Eigen::VectorXd p = e.context->p_of(y, grad ? &dpdy : nullptr);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(kParameters);
+    double h = 0;
+    for (const Term &t : *e.poly) {
+        double product = t.coefficient;
+        for (int i : t.index) product *= p[i];
+        h += product;
+        for (size_t a = 0; a < t.index.size(); ++a) {
+            double rest = t.coefficient;
+            for (size_t b = 0; b < t.index.size(); ++b)
+                if (b != a) rest *= p[t.index[b]];
+            g[t.index[a]] += rest;
+        }
+    }
+    if (grad) e.context->chain(g, dpdy, grad);
+    (void)n;
+    return h;
+}
+
+// SLSQP over y from the parameters p0; the result back in p, clipped to the bounds (the
+// constraints hold to the tolerance in s, which can be a little more in p for a light link).
+Eigen::VectorXd standard_local(const Problem &P, const Eigen::VectorXd &p0) {
+    StandardContext c(P);
+    nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, kParameters);
+    nlopt_set_lower_bounds1(opt, 0.0);
+    nlopt_set_upper_bounds1(opt, 1.0);
+    nlopt_set_min_objective(opt, standard_objective, &c);
+    std::vector<double> tols(static_cast<size_t>(kPerLinkConstraints) * kLinks, P.tolerance);
+    nlopt_add_inequality_mconstraint(opt, static_cast<unsigned>(tols.size()), standard_constraints, &c, tols.data());
+    std::pair<const StandardContext *, double> above{&c, 1.0}, below{&c, -1.0};
+    if (P.has_total_mass) {
+        nlopt_add_inequality_constraint(opt, standard_total_mass, &above, P.tolerance);
+        nlopt_add_inequality_constraint(opt, standard_total_mass, &below, P.tolerance);
+    }
+    std::vector<StandardEquality> eq;
+    for (const auto &poly : P.equalities) eq.push_back({&c, &poly});
+    for (auto &e : eq) nlopt_add_equality_constraint(opt, standard_equality, &e, P.tolerance);
+    nlopt_set_maxeval(opt, P.local_maxeval);
+    nlopt_set_ftol_rel(opt, 1e-15);
+    nlopt_set_xtol_rel(opt, 1e-13);
+    std::vector<double> y = c.y_of(p0);
+    // SLSQP's quasi-Newton model can go stale on the way (runs stopping at relative errors of
+    // 1e-7); a fresh run from where it stopped continues while it still gains.
+    double value = HUGE_VAL;
+    for (int round = 0; round < 4; ++round) {
+        const double before = value;
+        nlopt_optimize(opt, y.data(), &value);
+        if (!(value < 0.5 * before) || value < 1e-30) break;
+    }
+    nlopt_destroy(opt);
+    Eigen::VectorXd p = c.p_of(y.data());
+    return p.cwiseMax(P.lower).cwiseMin(P.upper);
 }
 
 Outcome run_restart(const Problem &P, int restart) {
@@ -363,7 +611,7 @@ Outcome run_restart(const Problem &P, int restart) {
     std::mt19937_64 rng(P.seed * 1000003ULL + static_cast<unsigned long>(restart));
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<double> x(n);
-    for (unsigned k = 0; k < n; ++k) x[k] = P.lower[P.free[k]] + (P.upper[P.free[k]] - P.lower[P.free[k]]) * u(rng);
+    for (unsigned k = 0; k < n; ++k) x[k] = u(rng);  // eq. (17) in the unit box
     double value = 0;
     if (P.global_algorithm == "isres" && P.global_maxeval > 0) {
         nlopt_srand(P.seed * 7919ULL + static_cast<unsigned long>(restart));  // thread-local in NLopt
@@ -374,6 +622,9 @@ Outcome run_restart(const Problem &P, int restart) {
         nlopt_optimize(global, x.data(), &value);
         nlopt_destroy(global);
     }
+    // The local refinement: in s when every parameter is free, else in p (the second stage of
+    // the two-stage procedure fixes some masses and centres of mass, which is not a box in s).
+    const bool in_standard = P.free.size() == static_cast<size_t>(kParameters);
     nlopt_opt local = make(NLOPT_LD_SLSQP, P);
     nlopt_set_min_objective(local, objective, &c);
     add_constraints(local, c, eq, P.tolerance);
@@ -381,9 +632,13 @@ Outcome run_restart(const Problem &P, int restart) {
     nlopt_set_ftol_rel(local, 1e-15);
     nlopt_set_xtol_rel(local, 1e-13);
     auto settle = [&](std::vector<double> &y) {
-        nlopt_optimize(local, y.data(), &value);
         Outcome o;
-        o.p = c.full(y.data());
+        if (in_standard) {
+            o.p = standard_local(P, c.full(y.data()));
+        } else {
+            nlopt_optimize(local, y.data(), &value);
+            o.p = c.full(y.data());
+        }
         o.cost = fit_cost(P, o.p, nullptr);
         o.violation = violation(P, o.p);
         return o;
@@ -392,11 +647,8 @@ Outcome run_restart(const Problem &P, int restart) {
     // Basin hopping: kick the local minimum by hop_size of each range and settle again.
     std::normal_distribution<double> kick(0.0, P.hop_size);
     for (int h = 0; h < P.hops; ++h) {
-        std::vector<double> y = free_part(P, out.p);
-        for (unsigned k = 0; k < n; ++k) {
-            const int j = P.free[k];
-            y[k] = std::clamp(y[k] + kick(rng) * (P.upper[j] - P.lower[j]), P.lower[j], P.upper[j]);
-        }
+        std::vector<double> y = c.unit(out.p);
+        for (unsigned k = 0; k < n; ++k) y[k] = std::clamp(y[k] + kick(rng), 0.0, 1.0);
         const Outcome hop = settle(y);
         const bool feasible = hop.violation <= P.tolerance, was = out.violation <= P.tolerance;
         if ((feasible && (!was || hop.cost < out.cost)) || (!feasible && !was && hop.violation < out.violation))
@@ -409,7 +661,7 @@ Outcome run_restart(const Problem &P, int restart) {
 // Among solutions with cost <= cap, the one closest to the reference parameters.
 Outcome prefer_reference(const Problem &P, const Outcome &best) {
     Context c{&P};
-    c.cost_cap = best.cost * (1 + 1e-6) + 1e-20;
+    c.cost_cap = best.cost / P.cost_scale * (1 + 1e-6) + 1e-30;
     std::vector<EqualityData> eq;
     for (const auto &poly : P.equalities) eq.push_back({&c, &poly});
     nlopt_opt opt = make(NLOPT_LD_SLSQP, P);
@@ -418,7 +670,7 @@ Outcome prefer_reference(const Problem &P, const Outcome &best) {
     nlopt_add_inequality_constraint(opt, cost_cap_constraint, &c, 0.0);
     nlopt_set_maxeval(opt, P.local_maxeval);
     nlopt_set_ftol_rel(opt, 1e-14);
-    std::vector<double> x = free_part(P, best.p);
+    std::vector<double> x = c.unit(best.p);
     double value = 0;
     nlopt_optimize(opt, x.data(), &value);
     nlopt_destroy(opt);
@@ -426,7 +678,7 @@ Outcome prefer_reference(const Problem &P, const Outcome &best) {
     out.p = c.full(x.data());
     out.cost = fit_cost(P, out.p, nullptr);
     out.violation = violation(P, out.p);
-    if (out.violation <= P.tolerance && out.cost <= c.cost_cap * (1 + 1e-9)) return out;
+    if (out.violation <= P.tolerance && out.cost / P.cost_scale <= c.cost_cap * (1 + 1e-9)) return out;
     return best;
 }
 

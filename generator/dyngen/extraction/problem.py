@@ -31,7 +31,7 @@ class Options:
     global_algorithm: str = "isres"  # or "none" (local refinement from the random starts only)
     global_maxeval: int = 1500
     local_maxeval: int = 1000
-    hops: int = 0  # basin-hopping kicks of each restart's local minimum (2 lifted 13/16 to 14/16 on the LWR)
+    hops: int = 0  # basin-hopping kicks of each restart's local minimum
     hop_size: float = 0.1  # kick standard deviation, as a fraction of each parameter's range
     margin: float = 1e-7  # kg m^2: smallest eigenvalue of tr(I)/2 E - I accepted as consistent
     mass_margin: float = 1e-3  # kg: smallest link mass accepted
