@@ -81,7 +81,7 @@ CASES = [
     Case("coulomb", Effects(coulomb={1: 1.0, 6: 1.0})),
     Case("viscous", Effects(viscous={1: 0.5, 6: 0.5})),
     Case("stribeck", Effects(coulomb={4: 0.8}, stribeck={4: (0.8, 0.1)})),
-    Case("armature", Effects(armature={1: 0.05})),
+    Case("armature", Effects(armature={1: 0.1})),
     Case("offset", Effects(offset={5: 0.8})),
     Case("gain", Effects(gain={2: 0.05})),
     Case("payload", Effects(payload=PAYLOAD)),
@@ -216,8 +216,8 @@ def simulated_parameters(case: Case, p_model, seed: int) -> np.ndarray:
     return perturbed(p_model, case.coefficient_error, seed) if case.coefficient_error else p_model
 
 
-def case_files(case: Case, index: int, robot, p_model, trajs, noise: float, seed: int) -> dict[str, str]:
-    p_true = simulated_parameters(case, p_model, seed)
+def case_files(case: Case, index: int, robot, p_true, trajs, noise: float, seed: int) -> dict[str, str]:
+    """The case's CSVs and MuJoCo model; noise seeded by (seed, case index, trajectory index)."""
     files = {f"{case.name}.mujoco.xml": simulator_xml(robot, p_true, case.effects)}
     for k, (kind, traj) in enumerate(trajs.items()):
         m = measure(robot, p_true, traj, case.effects, noise, seed=[seed, index, k])
@@ -238,14 +238,14 @@ def write_cases(folder, rate_hz: float = 1000.0, noise: float = NOISE, seed: int
                             f"robot: {robot.name}\nsolution:\n" + links_yaml(p_model)}
     robot_path = Path(robot_path).resolve()
     doc = {"robot": str(robot_path.relative_to(ROOT) if robot_path.is_relative_to(ROOT) else robot_path),
-           "params": "params.yaml", "rate_hz": rate_hz, "noise_sigma": noise, "seed": seed,
+           "params": "params.yaml", "rate_hz": float(rate_hz), "noise_sigma": noise, "seed": seed,
            "trajectories": {"fit": {"kind": "fourier", "seed": FIT_SEED, "seconds": fit_seconds,
                                     "base_hz": 0.1, "harmonics": 5},
                             "holdout": {"kind": "table_v", "seconds": float(TABLE_V_TIMES[-1])}},
            "laws": LAWS, "cases": []}
     for index, case in enumerate(cases):
         p_true = simulated_parameters(case, p_model, seed)
-        files.update(case_files(case, index, robot, p_model, trajs, noise, seed))
+        files.update(case_files(case, index, robot, p_true, trajs, noise, seed))
         doc["cases"].append({"name": case.name, "fit": f"{case.name}.fit.csv", "holdout": f"{case.name}.holdout.csv",
                              "noise_sigma": noise, "effects": truth(case, robot, p_model, p_true, pi_full)})
     files["truth.json"] = json.dumps(doc, indent=1) + "\n"
