@@ -220,7 +220,8 @@ def test_coefficient_errors_scale_masses_and_inertias_by_ten_percent():
     np.testing.assert_array_equal(Q[:, 1:4], P[:, 1:4])
     ratio = Q[:, 4:] / np.where(P[:, 4:] == 0, 1, P[:, 4:])
     for row, p_row in zip(ratio, P[:, 4:]):
-        assert np.allclose(np.abs(row[p_row != 0] - 1), 0.1, rtol=1e-12) and len(set(np.round(row[p_row != 0], 12))) == 1
+        scales = row[p_row != 0]
+        assert np.allclose(np.abs(scales - 1), 0.1, rtol=1e-12) and np.ptp(scales) < 1e-12  # one factor per link
     assert is_consistent(Q) and len(set(np.sign(Q[:, 0] - P[:, 0]))) == 2  # both signs occur
 
 

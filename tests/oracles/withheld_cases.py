@@ -186,7 +186,8 @@ def truth(case: Case, robot, p_model, p_true, pi_full=None) -> list[dict]:
         out.append(_joint_entry("gain", e.gain, gain=lambda v: v))
     if e.payload is not None:
         out.append({"effect": "payload", "joints": [robot.dof],
-                    "values": {"p": [float(x) for x in e.payload], "s": [float(x) for x in standard_of_body(e.payload)]}})
+                    "values": {"p": [float(x) for x in e.payload],
+                               "s": [float(x) for x in standard_of_body(e.payload)]}})
     if e.tilt_deg:
         g0 = [float(x) for x in robot.gravity]
         out.append({"effect": "tilt", "joints": [],
