@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -42,6 +43,9 @@ namespace {
 
 constexpr int kParameters = LWR_N_PARAMETERS;
 constexpr int kLinks = LWR_DOF;
+// Relative cost at which a local run stops: a relative coefficient error of 1e-12, far below
+// what identification resolves.
+constexpr double kStopCost = 1e-24;
 
 struct Kind {
     const char *name;
@@ -589,6 +593,7 @@ Eigen::VectorXd standard_local(const Problem &P, const Eigen::VectorXd &p0) {
     nlopt_set_maxeval(opt, P.local_maxeval);
     nlopt_set_ftol_rel(opt, 1e-15);
     nlopt_set_xtol_rel(opt, 1e-13);
+    nlopt_set_stopval(opt, kStopCost);
     std::vector<double> y = c.y_of(p0);
     // SLSQP's quasi-Newton model can go stale on the way (runs stopping at relative errors of
     // 1e-7); a fresh run from where it stopped continues while it still gains.
@@ -596,7 +601,7 @@ Eigen::VectorXd standard_local(const Problem &P, const Eigen::VectorXd &p0) {
     for (int round = 0; round < 4; ++round) {
         const double before = value;
         nlopt_optimize(opt, y.data(), &value);
-        if (!(value < 0.5 * before) || value < 1e-30) break;
+        if (!(value < 0.5 * before) || value <= kStopCost) break;
     }
     nlopt_destroy(opt);
     Eigen::VectorXd p = c.p_of(y.data());
@@ -631,6 +636,7 @@ Outcome run_restart(const Problem &P, int restart) {
     nlopt_set_maxeval(local, P.local_maxeval);
     nlopt_set_ftol_rel(local, 1e-15);
     nlopt_set_xtol_rel(local, 1e-13);
+    nlopt_set_stopval(local, kStopCost);
     auto settle = [&](std::vector<double> &y) {
         Outcome o;
         if (in_standard) {
@@ -709,7 +715,9 @@ int main(int argc, char **argv) {
         for (int k = next++; k < P.restarts; k = next++) {
             outcomes[k] = run_restart(P, k);
             const int finished = ++done;
-            std::cerr << "progress " << finished << ' ' << P.restarts << '\n';
+            // One write per line: concurrent `<<` chains on std::cerr interleave between threads.
+            const std::string line = "progress " + std::to_string(finished) + ' ' + std::to_string(P.restarts) + '\n';
+            std::fputs(line.c_str(), stderr);
         }
     };
     std::vector<std::thread> pool;
