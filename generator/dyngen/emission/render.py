@@ -95,9 +95,9 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
     files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(**common)
+    check = selftest_data(robot, derivation, models)
     files[f"{P}_selftest.c"] = env.get_template("selftest.c.j2").render(
-        data=selftest_data(robot, derivation, models), call=_selftest_calls(P, functions), n_states=N_STATES,
-        tolerance=TOLERANCE, **common)
+        data=check, call=_selftest_calls(P, functions), n_states=N_STATES, tolerance=TOLERANCE, **common)
     files[f"{P}.hpp"] = env.get_template("eigen.hpp.j2").render(
         eigen=eigen_interface(P, functions), **common)
     files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=sorted(sources), **common)
@@ -105,6 +105,7 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     manifest = _manifest(robot, functions, kinds, std_names, n_stacked)
     manifest["files"] = {"library": sorted(sources), "header": f"{P}.h", "eigen_header": f"{P}.hpp",
                          "selftest": f"{P}_selftest.c", "cmake": "CMakeLists.txt"}
+    manifest["selftest"] = check.as_dict() | {"tolerance": TOLERANCE}
     files["manifest.json"] = json.dumps(manifest, indent=1) + "\n"
     return Emitted(files, functions, manifest)
 

@@ -29,6 +29,12 @@ class SelfTestData:
     g: list  # per state, gravity(q)
     M: list  # per state, mass_matrix(q), row-major
 
+    def as_dict(self) -> dict:
+        """For manifest.json, so that anyone can check the embedded values."""
+        return {"p": self.p, "gravity_symbols": self.gravity,
+                "states": [{"q": q, "qd": qd, "qdd": qdd, "tau": tau, "g": g, "M": M}
+                           for (q, qd, qdd), tau, g, M in zip(self.states, self.tau, self.g, self.M)]}
+
 
 def fixed_parameters(robot) -> list[float]:
     """The YAML's nominal parameters, or fixed physically consistent ones (m > 0, inertia
