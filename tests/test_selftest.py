@@ -13,10 +13,13 @@ import subprocess
 
 import numpy as np
 import pytest
-from conftest import ROOT, build_arm
+from conftest import ROOT
 from oracles import lagrangian as lag
+from oracles.arm import Arm
 
-from dyngen.generate import generate
+from dyngen.atomic import write_folder
+from dyngen.description import load_robot
+from dyngen.generate import build, generate
 
 LWR_FOLDER = ROOT / "generated" / "lwr"
 
@@ -47,10 +50,12 @@ def test_embedded_values_with_symbolic_gravity(tmp_path):
     yaml = tmp_path / "lwr.yaml"
     yaml.write_text((ROOT / "examples" / "lwr.yaml").read_text().replace("gravity: [0, 0, -9.81]",
                                                                         "gravity: [gx, gy, gz]"))
-    built = build_arm(yaml, tmp_path / "out", {"gx": 9.81, "gy": -2.5, "gz": 1.25})  # the values the self-test uses
-    assert built.emitted.manifest["selftest"]["gravity_symbols"] == [9.81, -2.5, 1.25]
-    check_embedded_values(built.emitted.manifest, built.arm)
-    assert run_selftest_with_cc(tmp_path / "out" / "generated" / "lwr", tmp_path / "bin").returncode == 0
+    _, emitted = build(load_robot(yaml))
+    assert emitted.manifest["selftest"]["gravity_symbols"] == [9.81, -2.5, 1.25]  # gx, gy, gz in the self-test
+    check_embedded_values(emitted.manifest, Arm.from_yaml(yaml, {"gx": 9.81, "gy": -2.5, "gz": 1.25}))
+    write_folder(tmp_path / "lwr", emitted.files)
+    result = run_selftest_with_cc(tmp_path / "lwr", tmp_path / "bin")
+    assert result.returncode == 0 and "PASS" in result.stdout, result.stdout
 
 
 def cmake_build_and_ctest(folder, build_dir, *options) -> str:
