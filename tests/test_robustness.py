@@ -24,7 +24,6 @@ import os
 import subprocess
 from pathlib import Path
 
-import pytest
 
 from dyngen.runtime import library_sources
 
