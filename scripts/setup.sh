@@ -12,6 +12,9 @@ command -v cmake >/dev/null 2>&1 || need_apt+=(cmake)
 [ -f /usr/include/nlopt.h ] || need_apt+=(libnlopt-dev)
 [ -d /usr/include/eigen3 ] || need_apt+=(libeigen3-dev)
 command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
+# Firmware checks: the ARM cross compiler and newlib's headers and libm (tests/test_firmware.py)
+command -v arm-none-eabi-gcc >/dev/null 2>&1 || need_apt+=(gcc-arm-none-eabi)
+[ -f /usr/include/newlib/math.h ] || need_apt+=(libnewlib-arm-none-eabi)
 
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "setup: installing system packages: ${need_apt[*]}"

@@ -35,6 +35,9 @@
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
+ * Float accuracy: every output within 2e-5 * max|output| of the double build (normwise
+ * relative; tested on random states, docs/conventions.md). C++/Eigen wrappers: lwr.hpp.
+ * Self-test: lwr_selftest.c (cmake -S . -B build && cmake --build build && ctest --test-dir build).
  */
 #ifndef LWR_H
 #define LWR_H

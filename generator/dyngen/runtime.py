@@ -2,6 +2,7 @@
 
     model = load("generated/lwr")
     tau = model("rnea", q, qd, qdd, s)
+    model32 = load("generated/lwr", real="float")   # the <ROBOT>_USE_FLOAT build, float32 arrays
 """
 
 from __future__ import annotations
@@ -18,14 +19,18 @@ import cffi
 import numpy as np
 
 
+REALS = {"double": np.float64, "float": np.float32}  # C type of <robot>_real -> numpy dtype
+
+
 class Compiled:
-    def __init__(self, folder: Path, library: Path):
+    def __init__(self, folder: Path, library: Path, real: str = "double"):
         self.folder = Path(folder)
         self.manifest = json.loads((self.folder / "manifest.json").read_text())
         self.prefix = self.manifest["robot"]
         self.functions = {f["name"]: f for f in self.manifest["functions"]}
+        self.real, self.dtype = real, REALS[real]
         self.ffi = cffi.FFI()
-        self.ffi.cdef("\n".join(_prototype(f) for f in self.manifest["functions"]))
+        self.ffi.cdef("\n".join(_prototype(f, real) for f in self.manifest["functions"]))
         self.lib = self.ffi.dlopen(str(library))
 
     def __call__(self, name: str, *arrays) -> np.ndarray:
@@ -34,35 +39,45 @@ class Compiled:
             raise TypeError(f"{name} takes {[i['name'] for i in spec['inputs']]}")
         keep, args = [], []
         for array, inp in zip(arrays, spec["inputs"]):
-            a = np.ascontiguousarray(array, dtype=np.float64).ravel()
+            a = np.ascontiguousarray(array, dtype=self.dtype).ravel()
             if a.size != inp["length"]:
                 raise ValueError(f"{name}: {inp['name']} needs {inp['length']} values, got {a.size}")
             keep.append(a)
-            args.append(self.ffi.cast("const double *", self.ffi.from_buffer(a)))
-        out = np.zeros(spec["output"]["shape"], dtype=np.float64)
-        getattr(self.lib, spec["name"])(*args, self.ffi.cast("double *", self.ffi.from_buffer(out)))
+            args.append(self.ffi.cast(f"const {self.real} *", self.ffi.from_buffer(a)))
+        out = np.zeros(spec["output"]["shape"], dtype=self.dtype)
+        getattr(self.lib, spec["name"])(*args, self.ffi.cast(f"{self.real} *", self.ffi.from_buffer(out)))
         return out
 
 
-def _prototype(f) -> str:
-    args = [f"const double *{a['name']}" for a in f["inputs"]] + [f"double *{f['output']['name']}"]
+def _prototype(f, real: str) -> str:
+    args = [f"const {real} *{a['name']}" for a in f["inputs"]] + [f"{real} *{f['output']['name']}"]
     return f"void {f['name']}({', '.join(args)});"
 
 
-def load(folder, cache_dir: Path | None = None) -> Compiled:
+def library_sources(folder) -> list[Path]:
+    """The C files of the model library (the manifest's list: the self-test is not one of them)."""
     folder = Path(folder)
-    sources = sorted(folder.glob("*.c"))
+    files = json.loads((folder / "manifest.json").read_text()).get("files", {})
+    return [folder / name for name in files["library"]] if "library" in files else sorted(folder.glob("*.c"))
+
+
+def load(folder, cache_dir: Path | None = None, real: str = "double") -> Compiled:
+    """real: "double", or "float" for the build with <ROBOT>_USE_FLOAT defined."""
+    folder = Path(folder)
+    sources = library_sources(folder)
+    robot = json.loads((folder / "manifest.json").read_text())["robot"]
+    flags = [f"-D{robot.upper()}_USE_FLOAT"] if real == "float" else []
     digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources + [folder / "manifest.json"])).hexdigest()[:16]
     cache_dir = Path(cache_dir or Path(tempfile.gettempdir()) / "dyngen-libraries")
-    library = cache_dir / f"lib{folder.name}-{digest}.so"
+    library = cache_dir / f"lib{folder.name}-{real}-{digest}.so"
     if not library.exists():
         cache_dir.mkdir(parents=True, exist_ok=True)
         work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
         try:
             tmp = work / library.name
-            subprocess.run(["cc", "-O2", "-std=c99", "-shared", "-fPIC", "-I", str(folder), *map(str, sources),
+            subprocess.run(["cc", "-O2", "-std=c99", "-shared", "-fPIC", *flags, "-I", str(folder), *map(str, sources),
                             "-o", str(tmp), "-lm"], check=True, capture_output=True, text=True)
             os.replace(tmp, library)
         finally:
             shutil.rmtree(work, ignore_errors=True)
-    return Compiled(folder, library)
+    return Compiled(folder, library, real)

@@ -14,6 +14,8 @@ from ..parameters import PER_LINK, dynamic_name, standard_name
 from ..reduction.identifiability import classify
 from .c_code import render_function
 from .coefficients import dynamic_names_text, grouped_text
+from .eigen import eigen_interface
+from .selftest import N_STATES, TOLERANCE, c_numbers, selftest_data
 
 TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
 KIND_LABELS = {"gravity": "gravity vector g(q) = Y_g(q) pi_gravity",
@@ -29,8 +31,10 @@ class Emitted:
 
 
 def environment() -> jinja2.Environment:
-    return jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)), trim_blocks=True,
-                              lstrip_blocks=True, keep_trailing_newline=True, undefined=jinja2.StrictUndefined)
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)), trim_blocks=True,
+                             lstrip_blocks=True, keep_trailing_newline=True, undefined=jinja2.StrictUndefined)
+    env.filters["c_numbers"] = c_numbers
+    return env
 
 
 def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emitted:
@@ -91,11 +95,32 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
     files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(**common)
+    check = selftest_data(robot, derivation, models)
+    files[f"{P}_selftest.c"] = env.get_template("selftest.c.j2").render(
+        data=check, call=_selftest_calls(P, functions), n_states=N_STATES, tolerance=TOLERANCE, **common)
+    files[f"{P}.hpp"] = env.get_template("eigen.hpp.j2").render(
+        eigen=eigen_interface(P, functions), **common)
     files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=sorted(sources), **common)
     files["coefficients.md"] = env.get_template("coefficients.md.j2").render(**common)
     manifest = _manifest(robot, functions, kinds, std_names, n_stacked)
+    manifest["files"] = {"library": sorted(sources), "header": f"{P}.h", "eigen_header": f"{P}.hpp",
+                         "selftest": f"{P}_selftest.c", "cmake": "CMakeLists.txt"}
+    manifest["selftest"] = check.as_dict() | {"tolerance": TOLERANCE}
     files["manifest.json"] = json.dumps(manifest, indent=1) + "\n"
     return Emitted(files, functions, manifest)
+
+
+def _selftest_calls(P: str, functions) -> dict:
+    """Short name -> the C call the self-test makes; its arrays are named like the arguments."""
+    outputs = {"standard_from_dynamic": "s", "rnea": "tau", "gravity": "g", "mass_matrix": "M",
+               "regressor_gravity": "Y_gravity", "regressor_inertia": "Y_inertia", "regressor": "Y_full",
+               "pi_gravity": "pi_gravity", "pi_inertia": "pi_inertia", "pi_full": "pi_full"}
+    calls = {}
+    for f in functions:
+        short = f.name[len(P) + 1:]
+        if short in outputs:
+            calls[short] = f"{f.name}({', '.join([name for name, _, _ in f.inputs] + [outputs[short]])})"
+    return calls
 
 
 def _gravity_text(g) -> str:
