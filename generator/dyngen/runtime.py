@@ -2,6 +2,10 @@
 
     model = load("generated/lwr")
     tau = model("rnea", q, qd, qdd, s)
+    taus = model.batch("rnea", Q, QD, QDD, s)   # Q: (T, N) samples; s shared by every sample
+
+A small C loop per function (written here, not part of the generated folder) runs the
+samples of `batch`, so long recordings do not pay Python's per-call cost.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ class Compiled:
         self.functions = {f["name"]: f for f in self.manifest["functions"]}
         self.ffi = cffi.FFI()
         self.ffi.cdef("\n".join(_prototype(f) for f in self.manifest["functions"]))
+        self.ffi.cdef("\n".join(_batch_prototype(f) + ";" for f in self.manifest["functions"]))
         self.lib = self.ffi.dlopen(str(library))
 
     def __call__(self, name: str, *arrays) -> np.ndarray:
@@ -44,6 +49,52 @@ class Compiled:
         return out
 
 
+    def batch(self, name: str, *arrays) -> np.ndarray:
+        """The function at T samples: each input is (T, length) or (length,) (the same for
+        every sample); returns (T, *output shape)."""
+        spec = self.functions[f"{self.prefix}_{name}"]
+        if len(arrays) != len(spec["inputs"]):
+            raise TypeError(f"{name} takes {[i['name'] for i in spec['inputs']]}")
+        shaped = [np.ascontiguousarray(a, dtype=np.float64) for a in arrays]
+        counts = {a.shape[0] for a, inp in zip(shaped, spec["inputs"]) if a.ndim == 2}
+        if len(counts) > 1:
+            raise ValueError(f"{name}: inputs have different sample counts {sorted(counts)}")
+        samples = counts.pop() if counts else 1
+        keep, args = [], []
+        for a, inp in zip(shaped, spec["inputs"]):
+            if a.shape[-1] != inp["length"] or a.ndim not in (1, 2):
+                raise ValueError(f"{name}: {inp['name']} needs {inp['length']} values per sample, got shape {a.shape}")
+            keep.append(a)
+            args += [self.ffi.cast("const double *", self.ffi.from_buffer(a)), inp["length"] if a.ndim == 2 else 0]
+        out = np.zeros((samples, *spec["output"]["shape"]), dtype=np.float64)
+        getattr(self.lib, _batch_name(spec))(samples, *args, self.ffi.cast("double *", self.ffi.from_buffer(out)))
+        return out
+
+
+def _batch_name(f) -> str:
+    return f"dyngen_batch_{f['name']}"
+
+
+def _batch_prototype(f) -> str:
+    args = ["long samples"] + [f"const double *{a['name']}, long {a['name']}_stride" for a in f["inputs"]]
+    args.append(f"double *{f['output']['name']}")
+    return f"void {_batch_name(f)}({', '.join(args)})"
+
+
+def _batch_source(manifest) -> str:
+    """C loops over samples; a stride of 0 passes the same input to every sample."""
+    lines = [f'#include "{manifest["robot"]}.h"']
+    for f in manifest["functions"]:
+        size = 1
+        for d in f["output"]["shape"]:
+            size *= d
+        call = ", ".join([f"{a['name']} + k * {a['name']}_stride" for a in f["inputs"]]
+                         + [f"{f['output']['name']} + k * {size}"])
+        lines += [f"{_batch_prototype(f)};", f"{_batch_prototype(f)}",
+                  "{", "    long k;", f"    for (k = 0; k < samples; ++k) {f['name']}({call});", "}"]
+    return "\n".join(lines) + "\n"
+
+
 def _prototype(f) -> str:
     args = [f"const double *{a['name']}" for a in f["inputs"]] + [f"double *{f['output']['name']}"]
     return f"void {f['name']}({', '.join(args)});"
@@ -52,7 +103,9 @@ def _prototype(f) -> str:
 def load(folder, cache_dir: Path | None = None) -> Compiled:
     folder = Path(folder)
     sources = sorted(folder.glob("*.c"))
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources + [folder / "manifest.json"])).hexdigest()[:16]
+    batch = _batch_source(json.loads((folder / "manifest.json").read_text()))
+    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources + [folder / "manifest.json"])
+                            + batch.encode()).hexdigest()[:16]
     cache_dir = Path(cache_dir or Path(tempfile.gettempdir()) / "dyngen-libraries")
     library = cache_dir / f"lib{folder.name}-{digest}.so"
     if not library.exists():
@@ -60,7 +113,9 @@ def load(folder, cache_dir: Path | None = None) -> Compiled:
         work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
         try:
             tmp = work / library.name
+            (work / "dyngen_batch.c").write_text(batch)
             subprocess.run(["cc", "-O2", "-std=c99", "-shared", "-fPIC", "-I", str(folder), *map(str, sources),
+                            str(work / "dyngen_batch.c"),
                             "-o", str(tmp), "-lm"], check=True, capture_output=True, text=True)
             os.replace(tmp, library)
         finally:
