@@ -87,10 +87,10 @@ def cmd_identify(argv, prog="dyngen identify") -> int:
 
     robot = load_robot(args.robot)
     progress = Progress(quiet=args.quiet)
+    required = tuple(_inertia_names(robot)) if args.kind == "inertia" else ()
+    # Bad input fails before anything is announced or written.
+    signals = _read(args.data, robot, args, require_torques=args.kind != "inertia", required=required)
     progress.say(f"dyngen identify: {robot.name}, {args.kind} coefficients from {len(args.data)} recording(s)")
-    with progress.step("read and condition the recordings"):
-        required = tuple(_inertia_names(robot)) if args.kind == "inertia" else ()
-        signals = _read(args.data, robot, args, require_torques=args.kind != "inertia", required=required)
     model = _model(args, robot, progress)
     if args.kind == "inertia":
         assert stacked_inertia_columns(model.manifest) == list(required)
@@ -151,11 +151,10 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     p = read_link_parameters(args.params, robot.dof)
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
+    fit = _read(args.data, robot, args)  # bad input fails before anything is announced or written
+    held = _read(args.holdout, robot, args) if args.holdout else None
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit and "
                  f"{len(args.holdout or [])} held-out recording(s)")
-    with progress.step("read and condition the recordings"):
-        fit = _read(args.data, robot, args)
-        held = _read(args.holdout, robot, args) if args.holdout else None
     model = _model(args, robot, progress)
     options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
                       sign_velocity=args.sign_velocity,

@@ -134,7 +134,7 @@ def _check_values(name, header, data) -> None:
     bad = np.argwhere(~np.isfinite(data))
     if bad.size:
         row, col = bad[0]
-        raise InputError(name, f"line {row + 2}, column {header[col]}", f"{data[row, col]} (NaN or infinite value)")
+        raise InputError(name, f"line {row + 2}, column {header[col]}", f"{float(data[row, col])} (NaN or infinite value)")
 
 
 def _check_time(name, t) -> None:
@@ -144,4 +144,4 @@ def _check_time(name, t) -> None:
     bad = np.flatnonzero(steps <= 0)
     if bad.size:
         k = bad[0]
-        raise InputError(name, f"line {k + 3}, column t", f"time does not increase ({t[k + 1]!r} after {t[k]!r})")
+        raise InputError(name, f"line {k + 3}, column t", f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})")

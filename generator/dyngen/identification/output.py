@@ -20,7 +20,7 @@ def identified_yaml(robot_name: str, estimates: dict, sources: list[str], condit
                      f"{est.scaled_condition:.3g}), residual RMS {est.residual_rms:.4g}, {est.rows} rows")
         for k, (name, value, std) in enumerate(zip(est.names, est.values, est.std)):
             note = "not excited by the data: value not determined" if k in est.unexcited else f"std {std:.3g}"
-            lines.append(f'    - {{coefficient: "{name}", value: {value!r}}}   # {note}')
+            lines.append(f'    - {{coefficient: "{name}", value: {float(value)!r}}}   # {note}')
     return "\n".join(lines) + "\n"
 
 
