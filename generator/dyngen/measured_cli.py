@@ -138,8 +138,8 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
                              "armature, gain, payload, tilt, time_shift, coefficients)")
     parser.add_argument("--min-gain", type=float, default=None, metavar="G",
                         help="least held-out gain to select an effect (default 0.05: 5%% of a joint's mean square)")
-    parser.add_argument("--sign-velocity", type=float, default=0.01, metavar="V",
-                        help="sign(qd) is smoothed as tanh(qd / V) (default 0.01 rad/s)")
+    parser.add_argument("--sign-velocity", type=float, default=0.002, metavar="V",
+                        help="sign(qd) is smoothed as tanh(qd / V) (default 0.002 rad/s)")
     args = parser.parse_args(argv)
     from .description import load_robot
     from .diagnosis import Options, diagnose

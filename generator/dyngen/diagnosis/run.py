@@ -21,7 +21,7 @@ class Options:
     effects: tuple | None = None  # effect names to try (default: all)
     min_gain: float = MIN_GAIN
     alpha: float = ALPHA
-    sign_velocity: float = 0.01  # rad/s: tanh smoothing of sign(qd)
+    sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd)
     block_seconds: float = 2.0  # without held-out files: blocks of this length, every third held out
 
 

@@ -50,7 +50,11 @@ class Selection:
 
 
 def solve(design, chosen) -> Fit:
-    """Weighted least squares of the chosen candidates on the fit samples (moments only)."""
+    """Weighted least squares of the chosen candidates on the fit samples (moments only).
+
+    The covariance is the sandwich H^-1 (sum_j w_j^4 s_j^2 G_j) H^-1 with s_j^2 joint j's own
+    residual variance: joints differ in noise, and the weights (from the nominal residual,
+    which contains the very effects sought) are not their noise levels."""
     slots = np.concatenate([c.slots for c in chosen]) if chosen else np.zeros(0, dtype=int)
     H = design.H[np.ix_(slots, slots)]
     g = design.g[slots]
@@ -60,11 +64,11 @@ def solve(design, chosen) -> Fit:
     fit = design.fit
     w2 = design.weights ** 2
     G = fit.G[:, slots][:, :, slots]
-    sse = float(w2 @ (fit.c - 2 * fit.b[:, slots] @ x + np.einsum("k,jkl,l->j", x, G, x)))
-    rank = int(np.linalg.matrix_rank(H / np.outer(d, d), tol=1e-10)) if slots.size else 0
-    rows = fit.count * len(design.weights)
-    sigma2 = max(sse, 0.0) / max(rows - rank, 1)
-    return Fit(x, slots, sigma2 * inverse, sigma2)
+    sse = np.maximum(fit.c - 2 * fit.b[:, slots] @ x + np.einsum("k,jkl,l->j", x, G, x), 0.0)
+    s2 = sse / max(fit.count - len(slots), 1)  # per joint
+    middle = np.einsum("j,jkl->kl", w2 ** 2 * s2, G)
+    covariance = inverse @ middle @ inverse
+    return Fit(x, slots, covariance, float(w2 @ s2) / len(s2))
 
 
 def _inverse(Hs: np.ndarray) -> np.ndarray:

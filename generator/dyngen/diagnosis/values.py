@@ -10,8 +10,8 @@ from .effects.tilt import tilt_angles_deg
 
 def derived(robot, effect: str, values: dict, std: dict) -> dict:
     if effect == "tilt" and None not in values.values():
-        a1, a2 = tilt_angles_deg(robot, [values["dg1"], values["dg2"]])
-        s1, s2 = tilt_angles_deg(robot, [std["dg1"], std["dg2"]])
+        a1, a2 = tilt_angles_deg(robot, [values["dg1"], values["dg2"], values["dgn"]])
+        s1, s2 = tilt_angles_deg(robot, [std["dg1"], std["dg2"], 0.0])
         return {"tilt_deg": [a1, a2], "tilt_std_deg": [abs(s1), abs(s2)],
                 "tilt_total_deg": float(np.hypot(a1, a2))}
     if effect == "payload" and values.get("m") not in (None, 0.0):

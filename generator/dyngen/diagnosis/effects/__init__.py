@@ -17,7 +17,7 @@ from .friction import Armature, Coulomb, Stribeck, Viscous
 from .sensor import Gain, Offset, TimeShift
 from .tilt import Tilt, gravity_matrix
 
-STRIBECK_VELOCITIES = (0.01, 0.03, 0.1, 0.3)  # rad/s (m/s): the variants tried
+STRIBECK_VELOCITIES = (0.03, 0.1, 0.3)  # rad/s (m/s): the variants tried (well above Context.sign_velocity)
 
 
 def library(names=None) -> list[Effect]:

@@ -16,7 +16,7 @@ class Context:
     robot: object  # dyngen.description.Robot
     p: np.ndarray
     s: np.ndarray
-    sign_velocity: float = 0.01  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
+    sign_velocity: float = 0.002  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
 
     def sign(self, qd: np.ndarray) -> np.ndarray:
         return np.tanh(qd / self.sign_velocity)

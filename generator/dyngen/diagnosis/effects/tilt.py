@@ -2,9 +2,11 @@
 
 The gravity torque is linear in the gravity vector: g(q) = G(q) gvec, with column k of G the
 joint torques that a unit gravity along base axis k would cause. A tilt by small angles turns
-gvec by d gvec, perpendicular to it, so the residual is G(q) d gvec: two columns, G(q) u1 and
-G(q) u2 with u1, u2 unit vectors perpendicular to the model's gravity. The fitted values are
-the components of d gvec [m/s^2]; the tilt angles are their ratio to |gvec|.
+gvec by d gvec, perpendicular to it, so the residual is G(q) d gvec: three columns, G(q) u1, G(q) u2 and
+G(q) n, with u1, u2 unit vectors perpendicular to the model's gravity and n along it. The
+fitted values are the components of d gvec [m/s^2]; the third takes the second-order change
+along gravity (|gvec| (1 - cos angle)), so the tilt is exact, not only to first order. The
+tilt angles follow from the rotated vector gvec + d gvec.
 
 G(q) comes from plain forward kinematics of the DH table (numpy, vectorised over samples):
 for joint i with axis z through o, and every link k it carries, with centre of mass p_k,
@@ -21,13 +23,14 @@ from .base import Effect
 
 class Tilt(Effect):
     name, scope = "tilt", "arm"
-    parameters = ("dg1", "dg2")
-    units = ("m/s^2", "m/s^2")
+    parameters = ("dg1", "dg2", "dgn")
+    units = ("m/s^2", "m/s^2", "m/s^2")
 
     def columns(self, context, signals, tau_model):
         G = gravity_matrix(context.robot, context.p, signals.q)  # (T, N, 3)
         u1, u2 = tilt_directions(context.robot)
-        return np.stack([G @ u1, G @ u2], axis=-1)
+        n = np.cross(u1, u2)
+        return np.stack([G @ u1, G @ u2, G @ n], axis=-1)
 
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
@@ -42,9 +45,12 @@ def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
 
 
 def tilt_angles_deg(robot, dg) -> tuple[float, float]:
-    """Rotation angles [deg] of gravity towards u1 and u2 for the fitted components dg."""
+    """Rotation angles [deg] of gravity towards u1 and u2 for the fitted components (dg1,
+    dg2, dgn): the angles of the rotated vector's u1 and u2 components against its component
+    along the model's gravity."""
     g = np.linalg.norm([float(x) for x in robot.gravity])
-    return tuple(float(np.degrees(np.arcsin(np.clip(d / g, -1, 1)))) for d in dg)
+    along = g + dg[2]
+    return float(np.degrees(np.arctan2(dg[0], along))), float(np.degrees(np.arctan2(dg[1], along)))
 
 
 def _dh(robot, q):
