@@ -94,8 +94,9 @@ def markdown(d, sources: dict) -> str:
             joints = ", ".join(map(str, e["joints"])) or "-"
             change = ", ".join(f"J{j}: {e['rms_before'][j - 1]:.3f} -> {e['rms_after'][j - 1]:.3f}" for j in e["joints"])
             lines.append(f"| {e['effect']} | {joints} | {_value_text(e)} | {e['heldout_gain']:.3f} | {change} |")
-        lines += ["", "Held-out gain: the decrease, summed over joints, of the held-out mean square residual "
-                  "relative to its value without this effect (all other selected effects kept). Standard deviations "
+        lines += ["", "Held-out gain: the decrease of the held-out mean square residual relative to its value without "
+                  "this effect (all other selected effects kept), on its joint (per-joint effects) or summed over "
+                  "joints (arm-wide effects). Standard deviations "
                   f"are scaled for the residual's correlation in time ({d.correlation_samples:.0f} samples).", ""]
     if d.dropped:
         lines += [f"Selected at first, then dropped as not significant: {', '.join(d.dropped)}.", ""]

@@ -13,7 +13,7 @@ from . import design as dz
 from . import phases
 from .correlation import integrated_time
 from .effects import Context, library
-from .selection import ALPHA, MIN_GAIN, forward, prune, solve
+from .selection import ALPHA, MIN_GAIN, forward, heldout_gain, prune, solve
 
 
 @dataclass(frozen=True)
@@ -189,6 +189,7 @@ def _describe(robot, design, chosen, final, cand, tau_corr, min_gain) -> dict:
     mse_without = design.held.mse(rest.slots, rest.x) if others else design.held.c / max(design.held.count, 1)
     mse_with = design.held.mse(final.slots, final.x)
     gain_per_joint = (mse_without - mse_with) / np.maximum(mse_without, 1e-300)
+    gain = heldout_gain(cand, mse_without, mse_with)
     joints = [cand.joint + 1] if cand.joint is not None else \
         [j + 1 for j in range(len(gain_per_joint)) if gain_per_joint[j] >= min_gain]
     names = list(cand.effect.parameters)
@@ -198,7 +199,7 @@ def _describe(robot, design, chosen, final, cand, tau_corr, min_gain) -> dict:
         "effect": cand.effect.name, "joints": joints, "variant": cand.effect.fixed(),
         "values": values, "std": stds, "units": dict(zip(names, cand.effect.units)),
         "derived": derived(robot, cand.effect.name, values, stds),
-        "heldout_gain": float(np.sum(gain_per_joint)),
+        "heldout_gain": gain,
         "rms_before": np.sqrt(mse_without).tolist(), "rms_after": np.sqrt(mse_with).tolist(),
     }
 

@@ -2,9 +2,9 @@
 
 Fit: weighted least squares on the fit samples, every joint's rows divided by the RMS of
 its nominal residual there (so a joint with a large residual does not drown the others).
-Score: on the held-out samples, the sum over joints of the residual's mean square relative to
-its value before the step. A step adds the candidate with the largest held-out gain (score
-decrease) if
+Gain: on the held-out samples, the decrease of the residual's mean square relative to its
+value before the step, on the candidate's own joint (per-joint effects) or summed over joints
+(arm-wide effects). A step adds the candidate with the largest held-out gain if
 
   - the gain is at least `min_gain` (default 0.05: 5 % of one joint's current held-out mean
     square), so an effect must generalise, not merely fit, and
@@ -111,6 +111,14 @@ def heldout_mse(design, chosen) -> np.ndarray:
     return design.held.mse(fit.slots, fit.x) if chosen else design.held.c / max(design.held.count, 1)
 
 
+def heldout_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
+    """Relative decrease of the held-out mean square: on the candidate's own joint for a
+    per-joint effect (a refit of arm-wide effects must not lend it credit from other joints),
+    summed over joints for an arm-wide effect."""
+    relative = (before - after) / np.maximum(before, 1e-300)
+    return float(relative[candidate.joint] if candidate.joint is not None else relative.sum())
+
+
 def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps: int = 30) -> Selection:
     """Forward steps; the significance test here assumes uncorrelated residuals (prune() then
     applies the honest, correlation-scaled test to what was selected)."""
@@ -126,7 +134,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             chosen = selection.chosen + [cand]
             fit = solve(design, chosen)
             mse = design.held.mse(fit.slots, fit.x)
-            gain = float(np.sum((current - mse) / np.maximum(current, 1e-300)))
+            gain = heldout_gain(cand, current, mse)
             if not selection.chosen:
                 selection.first_gains[cand.key] = gain
             if gain >= min_gain and cand.effect.plausible(fit.x[-cand.size:]):
@@ -144,8 +152,9 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
 
 
 def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list, float, list]:
-    """Backward elimination with deviations scaled by the correlation time of the residual the
-    chosen effects leave (correlation(chosen, fit) -> samples): drop the least significant
+    """Backward elimination: drop an effect whose held-out gain, with all the others kept, is
+    not positive; then, with deviations scaled by the correlation time of the residual the
+    chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
     effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
     chosen, dropped = list(chosen), []
     while True:
@@ -153,6 +162,12 @@ def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list
         tau = correlation(chosen, fit)
         if not chosen:
             return chosen, tau, dropped
+        with_all = design.held.mse(fit.slots, fit.x)
+        # An effect that no longer helps on held-out data once the others are in goes first.
+        gains = [heldout_gain(c, heldout_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
+        if min(gains) <= 0:
+            dropped.append(chosen.pop(int(np.argmin(gains))).key)
+            continue
         pvalues = [p_value(fit, c, chosen, tau) for c in chosen]
         worst = int(np.argmax(pvalues))
         if pvalues[worst] <= alpha:
