@@ -9,7 +9,7 @@
  * f: 5 values per joint, joint 1 first: Fc, Fv, Fs, vs, eps
  *   Fc   Coulomb friction [Nm or N]
  *   Fv   viscous friction [Nm s/rad or N s/m]
- *   Fs   Stribeck (static minus Coulomb) friction [Nm or N]; ignored when vs <= 0
+ *   Fs   Stribeck friction (breakaway minus Coulomb) [Nm or N]; ignored when vs <= 0
  *   vs   Stribeck velocity [rad/s or m/s]
  *   eps  smoothing velocity of the sign [rad/s or m/s]
  * The friction torque adds to the rigid-body torque: tau = rnea(q, qd, qdd, s) + friction(qd, f).
