@@ -20,6 +20,10 @@ dyngen: robot dynamic models as exact, standalone C from a DH table.
   dyngen generate ROBOT.yaml [-o DIR]  derive, reduce to base coefficients, emit C into DIR/<name>/
   dyngen extract ROBOT.yaml [options]  physically consistent link parameters from the identified
                                        coefficients, written to OUT/<name>/
+  dyngen identify ROBOT.yaml --data a.csv [--kind full|gravity|inertia]
+                                       base coefficients by least squares from recordings
+  dyngen diagnose ROBOT.yaml --params P.yaml --data a.csv [--holdout b.csv]
+                                       where the measured-model gap lies and which effect explains it
 
 Run `dyngen COMMAND --help` for a command's options. The YAML schema and the parameter
 conventions are in docs/conventions.md; examples/ has the KUKA LWR IV+ and other arms.
@@ -217,7 +221,19 @@ def _summary(result, seconds: float) -> None:
     print(f"  coefficient expressions: {result.folder}/coefficients.md")
 
 
-COMMANDS = {"generate": cmd_generate, "extract": cmd_extract}
+def cmd_identify(argv, prog="dyngen identify") -> int:
+    from .measured_cli import cmd_identify as run
+
+    return run(argv, prog)
+
+
+def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
+    from .measured_cli import cmd_diagnose as run
+
+    return run(argv, prog)
+
+
+COMMANDS = {"generate": cmd_generate, "extract": cmd_extract, "identify": cmd_identify, "diagnose": cmd_diagnose}
 
 
 def main(argv=None) -> int:

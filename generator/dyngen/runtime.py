@@ -2,7 +2,11 @@
 
     model = load("generated/lwr")
     tau = model("rnea", q, qd, qdd, s)
+    taus = model.batch("rnea", Q, QD, QDD, s)   # Q: (T, N) samples; s shared by every sample
     model32 = load("generated/lwr", real="float")   # the <ROBOT>_USE_FLOAT build, float32 arrays
+
+A small C loop per function (written here, not part of the generated folder) runs the
+samples of `batch`, so long recordings do not pay Python's per-call cost.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ class Compiled:
         self.real, self.dtype = real, REALS[real]
         self.ffi = cffi.FFI()
         self.ffi.cdef("\n".join(_prototype(f, real) for f in self.manifest["functions"]))
+        self.ffi.cdef("\n".join(_batch_prototype(f, real) + ";" for f in self.manifest["functions"]))
         self.lib = self.ffi.dlopen(str(library))
 
     def __call__(self, name: str, *arrays) -> np.ndarray:
@@ -48,10 +53,55 @@ class Compiled:
         getattr(self.lib, spec["name"])(*args, self.ffi.cast(f"{self.real} *", self.ffi.from_buffer(out)))
         return out
 
+    def batch(self, name: str, *arrays) -> np.ndarray:
+        """The function at T samples: each input is (T, length) or (length,) (the same for
+        every sample); returns (T, *output shape)."""
+        spec = self.functions[f"{self.prefix}_{name}"]
+        if len(arrays) != len(spec["inputs"]):
+            raise TypeError(f"{name} takes {[i['name'] for i in spec['inputs']]}")
+        shaped = [np.ascontiguousarray(a, dtype=self.dtype) for a in arrays]
+        counts = {a.shape[0] for a, inp in zip(shaped, spec["inputs"]) if a.ndim == 2}
+        if len(counts) > 1:
+            raise ValueError(f"{name}: inputs have different sample counts {sorted(counts)}")
+        samples = counts.pop() if counts else 1
+        keep, args = [], []
+        for a, inp in zip(shaped, spec["inputs"]):
+            if a.shape[-1] != inp["length"] or a.ndim not in (1, 2):
+                raise ValueError(f"{name}: {inp['name']} needs {inp['length']} values per sample, got shape {a.shape}")
+            keep.append(a)
+            args += [self.ffi.cast(f"const {self.real} *", self.ffi.from_buffer(a)), inp["length"] if a.ndim == 2 else 0]
+        out = np.zeros((samples, *spec["output"]["shape"]), dtype=self.dtype)
+        getattr(self.lib, _batch_name(spec))(samples, *args, self.ffi.cast(f"{self.real} *", self.ffi.from_buffer(out)))
+        return out
+
 
 def _prototype(f, real: str) -> str:
     args = [f"const {real} *{a['name']}" for a in f["inputs"]] + [f"{real} *{f['output']['name']}"]
     return f"void {f['name']}({', '.join(args)});"
+
+
+def _batch_name(f) -> str:
+    return f"dyngen_batch_{f['name']}"
+
+
+def _batch_prototype(f, real: str) -> str:
+    args = ["long samples"] + [f"const {real} *{a['name']}, long {a['name']}_stride" for a in f["inputs"]]
+    args.append(f"{real} *{f['output']['name']}")
+    return f"void {_batch_name(f)}({', '.join(args)})"
+
+
+def _batch_source(manifest, real: str) -> str:
+    """C loops over samples; a stride of 0 passes the same input to every sample."""
+    lines = [f'#include "{manifest["robot"]}.h"']
+    for f in manifest["functions"]:
+        size = 1
+        for d in f["output"]["shape"]:
+            size *= d
+        call = ", ".join([f"{a['name']} + k * {a['name']}_stride" for a in f["inputs"]]
+                         + [f"{f['output']['name']} + k * {size}"])
+        lines += [f"{_batch_prototype(f, real)};", f"{_batch_prototype(f, real)}",
+                  "{", "    long k;", f"    for (k = 0; k < samples; ++k) {f['name']}({call});", "}"]
+    return "\n".join(lines) + "\n"
 
 
 def library_sources(folder) -> list[Path]:
@@ -65,9 +115,11 @@ def load(folder, cache_dir: Path | None = None, real: str = "double") -> Compile
     """real: "double", or "float" for the build with <ROBOT>_USE_FLOAT defined."""
     folder = Path(folder)
     sources = library_sources(folder)
-    robot = json.loads((folder / "manifest.json").read_text())["robot"]
-    flags = [f"-D{robot.upper()}_USE_FLOAT"] if real == "float" else []
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources + [folder / "manifest.json"])).hexdigest()[:16]
+    manifest = json.loads((folder / "manifest.json").read_text())
+    flags = [f"-D{manifest['robot'].upper()}_USE_FLOAT"] if real == "float" else []
+    batch = _batch_source(manifest, real)
+    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources + [folder / "manifest.json"])
+                            + batch.encode()).hexdigest()[:16]
     cache_dir = Path(cache_dir or Path(tempfile.gettempdir()) / "dyngen-libraries")
     library = cache_dir / f"lib{folder.name}-{real}-{digest}.so"
     if not library.exists():
@@ -75,8 +127,10 @@ def load(folder, cache_dir: Path | None = None, real: str = "double") -> Compile
         work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
         try:
             tmp = work / library.name
-            subprocess.run(["cc", "-O2", "-std=c99", "-shared", "-fPIC", *flags, "-I", str(folder), *map(str, sources),
-                            "-o", str(tmp), "-lm"], check=True, capture_output=True, text=True)
+            (work / "dyngen_batch.c").write_text(batch)
+            subprocess.run(["cc", "-O2", "-std=c99", "-shared", "-fPIC", *flags, "-I", str(folder),
+                            *map(str, sources), str(work / "dyngen_batch.c"), "-o", str(tmp), "-lm"],
+                           check=True, capture_output=True, text=True)
             os.replace(tmp, library)
         finally:
             shutil.rmtree(work, ignore_errors=True)

@@ -18,6 +18,7 @@ from .eigen import eigen_interface
 from .selftest import N_STATES, TOLERANCE, c_numbers, selftest_data
 
 TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
+FRICTION_PER_JOINT = 5  # Fc, Fv, Fs, vs, eps (templates/friction.c.j2)
 KIND_LABELS = {"gravity": "gravity vector g(q) = Y_g(q) pi_gravity",
                "inertia": "stacked inertia matrix m~(q) = Y_m(q) pi_inertia",
                "full": "inverse dynamics tau = Y(q, qd, qdd) pi_full"}
@@ -86,7 +87,7 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     common = dict(robot=robot, P=P, M=P.upper(), version=__version__, source=robot.source, kinds=kinds,
                   n_stacked=n_stacked, gravity_symbols=gravity_symbols,
                   joint_types="".join("R" if j.revolute else "P" for j in joints),
-                  gravity_text=", ".join(_gravity_text(g) for g in robot.gravity))
+                  gravity_text=", ".join(_gravity_text(g) for g in robot.gravity), FRICTION_PER_JOINT=FRICTION_PER_JOINT)
     sources = {f"{P}_parameters.c": ("parameters and base coefficients", parameters),
                f"{P}_regressors.c": ("base regressors", regressor_fns),
                f"{P}_dynamics.c": ("inverse dynamics, gravity and inertia matrix", dynamics)}
@@ -94,16 +95,19 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     for filename, (summary, fns) in sources.items():
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
+    files[f"{P}_friction.c"] = env.get_template("friction.c.j2").render(**common)
     files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(**common)
     check = selftest_data(robot, derivation, models)
     files[f"{P}_selftest.c"] = env.get_template("selftest.c.j2").render(
         data=check, call=_selftest_calls(P, functions), n_states=N_STATES, tolerance=TOLERANCE, **common)
     files[f"{P}.hpp"] = env.get_template("eigen.hpp.j2").render(
         eigen=eigen_interface(P, functions), **common)
-    files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=sorted(sources), **common)
+    library = sorted([*sources, f"{P}_friction.c"])
+    files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=library, **common)
     files["coefficients.md"] = env.get_template("coefficients.md.j2").render(**common)
     manifest = _manifest(robot, functions, kinds, std_names, n_stacked)
-    manifest["files"] = {"library": sorted(sources), "header": f"{P}.h", "eigen_header": f"{P}.hpp",
+    manifest["functions"].append(_friction_manifest(P, n))
+    manifest["files"] = {"library": library, "header": f"{P}.h", "eigen_header": f"{P}.hpp",
                          "selftest": f"{P}_selftest.c", "cmake": "CMakeLists.txt"}
     manifest["selftest"] = check.as_dict() | {"tolerance": TOLERANCE}
     files["manifest.json"] = json.dumps(manifest, indent=1) + "\n"
@@ -121,6 +125,16 @@ def _selftest_calls(P: str, functions) -> dict:
         if short in outputs:
             calls[short] = f"{f.name}({', '.join([name for name, _, _ in f.inputs] + [outputs[short]])})"
     return calls
+
+
+def _friction_manifest(P: str, n: int) -> dict:
+    """The optional friction routine (not a straight-line program: a loop over joints)."""
+    return {"name": f"{P}_friction", "doc": "Joint friction (Coulomb, viscous, Stribeck), templates/friction.c.j2.",
+            "inputs": [{"name": "qd", "length": n, "meaning": "joint velocities"},
+                       {"name": "f", "length": FRICTION_PER_JOINT * n,
+                        "meaning": "per joint Fc, Fv, Fs, vs, eps"}],
+            "output": {"name": "tau", "shape": [n], "meaning": "friction torques"},
+            "ops": None}
 
 
 def _gravity_text(g) -> str:

@@ -12,10 +12,12 @@ from .urdf import to_urdf
 __all__ = ["to_mjcf", "to_urdf", "write_all"]
 
 
-def write_all(robot, p, folder) -> list[Path]:
+def write_all(robot, p, folder, joint_dynamics=None) -> list[Path]:
     """Write <name>.urdf and <name>.xml (MJCF) into folder; both are built before either is
-    written, so an error (inconsistent p, symbolic gravity) leaves the folder untouched."""
-    texts = {f"{robot.name}.urdf": to_urdf(robot, p), f"{robot.name}.xml": to_mjcf(robot, p)}
+    written, so an error (inconsistent p, symbolic gravity) leaves the folder untouched.
+    joint_dynamics: optional per-joint friction and rotor inertia (see to_mjcf)."""
+    texts = {f"{robot.name}.urdf": to_urdf(robot, p, joint_dynamics=joint_dynamics),
+             f"{robot.name}.xml": to_mjcf(robot, p, joint_dynamics=joint_dynamics)}
     paths = []
     for name, text in texts.items():
         path = Path(folder) / name

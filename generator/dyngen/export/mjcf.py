@@ -23,8 +23,15 @@ def _range(joint) -> str:
     return f'limited="true" range="{frames.fmt(lim.lower)} {frames.fmt(lim.upper)}"'
 
 
-def to_mjcf(robot, p) -> str:
+def _num(values: dict, key: str) -> str:
+    value = values.get(key, 0.0)
+    return "0" if value == 0 else frames.fmt(value)
+
+
+def to_mjcf(robot, p, joint_dynamics=None) -> str:
     """MJCF text of `robot` with dynamic parameters p (10N, docs/conventions.md order).
+    joint_dynamics: optional per joint {"damping": viscous, "friction": Coulomb (MuJoCo's
+    frictionloss), "armature": rotor inertia} (e.g. from `dyngen diagnose`).
     ValueError if p is not physically consistent (names the link) or gravity has symbols."""
     gravity = frames.numeric_gravity(robot)
     P = frames.link_parameters(robot, p)
@@ -47,11 +54,13 @@ def to_mjcf(robot, p) -> str:
     for i, (joint, place, inertial) in enumerate(zip(robot.joints, places, inertials), start=1):
         I = inertial.inertia
         kind = "hinge" if joint.revolute else "slide"
+        dyn = joint_dynamics[i - 1] if joint_dynamics else {}
         lines += [
             f'{indent}<body name="link_{i}" {_pose(place.origin)}>',
             # Explicit zeros: MJCF defaults could otherwise add passive forces or rotor inertia.
             f'{indent}  <joint name="joint_{i}" type="{kind}" pos="0 0 0" axis="0 0 1" {_range(joint)} '
-            'armature="0" damping="0" frictionloss="0" stiffness="0"/>',
+            f'armature="{_num(dyn, "armature")}" damping="{_num(dyn, "damping")}" '
+            f'frictionloss="{_num(dyn, "friction")}" stiffness="0"/>',
             # fullinertia order is ixx iyy izz ixy ixz iyz (not URDF's ixx ixy ixz iyy iyz izz).
             f'{indent}  <inertial pos="{frames.vec(inertial.com)}" mass="{frames.fmt(inertial.mass)}" '
             f'fullinertia="{frames.vec([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])}"/>',

@@ -47,8 +47,10 @@ def _gravity_comment(robot) -> str:
     return f"gravity in frame base: {g} m/s^2; URDF has no gravity element: set it in the tool (most assume 0 0 -9.81)"
 
 
-def to_urdf(robot, p, name=None) -> str:
+def to_urdf(robot, p, name=None, joint_dynamics=None) -> str:
     """URDF text of `robot` with dynamic parameters p (10N, docs/conventions.md order).
+    joint_dynamics: optional per joint {"damping": viscous, "friction": Coulomb} (e.g. from
+    `dyngen diagnose`); URDF has no rotor inertia or Stribeck term.
     ValueError if p is not physically consistent (the message names the link)."""
     P = frames.link_parameters(robot, p)
     places = frames.placements(robot)
@@ -67,6 +69,7 @@ def to_urdf(robot, p, name=None) -> str:
     for i, (joint, place, inertial) in enumerate(zip(robot.joints, places, inertials), start=1):
         I = inertial.inertia
         kind = "revolute" if joint.revolute else "prismatic"
+        dyn = joint_dynamics[i - 1] if joint_dynamics else {}
         lines += [
             f'  <joint name="joint_{i}" type="{kind}">',
             f'    <parent link="{parent}"/>',
@@ -74,7 +77,8 @@ def to_urdf(robot, p, name=None) -> str:
             f"    {_origin(place.origin)}",
             '    <axis xyz="0 0 1"/>',
             f"    {_limit(joint)}",
-            '    <dynamics damping="0.0" friction="0.0"/>',
+            f'    <dynamics damping="{frames.fmt(dyn.get("damping", 0.0))}" '
+            f'friction="{frames.fmt(dyn.get("friction", 0.0))}"/>',
             "  </joint>",
             f'  <link name="link_{i}">',
             "    <inertial>",

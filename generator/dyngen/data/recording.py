@@ -1,0 +1,147 @@
+"""Read one CSV recording and check it: header `t, q1..qN, tau1..tauN`, optional `qd*`, `qdd*`
+(and any other columns, e.g. the stacked inertia matrix `M11, M12, ...` for identification).
+
+Every problem is an InputError naming the file, the line and the column, for example
+`run.csv: line 17, column tau3: not a number ("abc")` or
+`run.csv: line 1 (header): the robot has 7 joints but the file has q1..q6`.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+
+_NUMBERED = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
+
+
+@dataclass
+class Recording:
+    """The columns of one file, as floats; qd and qdd are None when the file has none."""
+
+    name: str  # the file name, for messages
+    t: np.ndarray  # (T,)
+    q: np.ndarray  # (T, N)
+    tau: np.ndarray | None  # (T, N); None when the file was read without torques
+    qd: np.ndarray | None = None
+    qdd: np.ndarray | None = None
+    extra: dict = field(default_factory=dict)  # other columns by name, (T,)
+
+
+def read_recording(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
+    """Read and check `path` for a robot of `dof` joints. `required` names further columns
+    (e.g. the stacked inertia entries) that must be present."""
+    path = Path(path)
+    name = path.name
+    try:
+        with open(path, newline="") as f:
+            header_line = f.readline()
+    except OSError as err:
+        raise InputError(str(path), "", f"cannot read the file ({err.strerror})") from None
+    header = [h.strip() for h in next(csv.reader([header_line]), [])]
+    columns = _check_header(name, header, dof, require_torques, required)
+    data = _numbers(path, name, header)
+    _check_values(name, header, data)
+    t = data[:, columns["t"]]
+    _check_time(name, t)
+
+    def block(prefix):
+        if f"{prefix}1" not in columns:
+            return None
+        return data[:, [columns[f"{prefix}{j}"] for j in range(1, dof + 1)]]
+
+    numbered = {f"{p}{j}" for p in ("q", "qd", "qdd", "tau") for j in range(1, dof + 1)}
+    extra = {h: data[:, k] for h, k in columns.items() if h != "t" and h not in numbered}
+    return Recording(name, t, block("q"), block("tau"), block("qd"), block("qdd"), extra)
+
+
+def _check_header(name, header, dof, require_torques, required) -> dict:
+    where = "line 1 (header)"
+    if not header or header == [""]:
+        raise InputError(name, where, "empty file; expected a header such as t, q1..qN, tau1..tauN")
+    columns = {}
+    for k, h in enumerate(header):
+        if not h:
+            raise InputError(name, where, f"column {k + 1} has no name")
+        if h in columns:
+            raise InputError(name, where, f"column {h} appears twice")
+        columns[h] = k
+    if "t" not in columns:
+        raise InputError(name, where, "no time column t")
+    found = {}
+    for h in columns:
+        m = _NUMBERED.match(h)
+        if m:
+            found.setdefault(m.group(1), set()).add(int(m.group(2)))
+    prefixes = ["q", "tau"] if require_torques else ["q"]
+    for prefix in ("q", "qd", "qdd", "tau"):
+        numbers = found.get(prefix, set())
+        if not numbers and prefix not in prefixes:
+            continue
+        expected = set(range(1, dof + 1))
+        if numbers - expected:
+            got = max(numbers)
+            raise InputError(name, where, f"the robot has {dof} joints but the file has {prefix}{got}")
+        if expected - numbers:
+            missing = ", ".join(f"{prefix}{j}" for j in sorted(expected - numbers))
+            if numbers:
+                raise InputError(name, where, f"the robot has {dof} joints but the file has only "
+                                 f"{prefix}{min(numbers)}..{prefix}{max(numbers)} (missing {missing})")
+            raise InputError(name, where, f"missing column(s) {missing}")
+    if "qdd" in found and "qd" not in found:
+        raise InputError(name, where, "qdd columns without qd columns")
+    missing = [c for c in required if c not in columns]
+    if missing:
+        raise InputError(name, where, f"missing column(s) {', '.join(missing)}")
+    return columns
+
+
+def _numbers(path, name, header) -> np.ndarray:
+    """Fast path with numpy; on failure, a slow pass that finds the exact line and column."""
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=float)
+    except ValueError:
+        data = None
+    if data is not None and data.shape[1] == len(header) and data.shape[0] > 0:
+        return data
+    rows = []
+    with open(path, newline="") as f:
+        reader = csv.reader(f)
+        next(reader)
+        for line, row in enumerate(reader, start=2):
+            if not row or all(not cell.strip() for cell in row):
+                continue
+            if len(row) != len(header):
+                raise InputError(name, f"line {line}", f"{len(row)} values, the header has {len(header)} columns")
+            values = []
+            for cell, column in zip(row, header):
+                try:
+                    values.append(float(cell))
+                except ValueError:
+                    raise InputError(name, f"line {line}, column {column}", f'not a number ("{cell.strip()}")') from None
+            rows.append(values)
+    if not rows:
+        raise InputError(name, "line 2", "no data rows after the header")
+    return np.array(rows, dtype=float)
+
+
+def _check_values(name, header, data) -> None:
+    bad = np.argwhere(~np.isfinite(data))
+    if bad.size:
+        row, col = bad[0]
+        raise InputError(name, f"line {row + 2}, column {header[col]}", f"{float(data[row, col])} (NaN or infinite value)")
+
+
+def _check_time(name, t) -> None:
+    if t.size < 2:
+        raise InputError(name, "column t", f"{t.size} sample(s); at least 2 are needed")
+    steps = np.diff(t)
+    bad = np.flatnonzero(steps <= 0)
+    if bad.size:
+        k = bad[0]
+        raise InputError(name, f"line {k + 3}, column t", f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})")

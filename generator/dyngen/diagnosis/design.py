@@ -1,0 +1,90 @@
+"""The least-squares design of every candidate at once, kept as per-joint moments.
+
+Each candidate (an effect on one joint, or an arm-wide effect) owns a few slots of one
+global parameter vector x. For joint j and a set of samples, with A_j the columns acting on
+joint j and r_j its residual, the moments
+
+    G_j = A_j^T A_j,  b_j = A_j^T r_j,  c_j = r_j^T r_j
+
+give the fit of any subset of candidates, and its residual on any joint, without touching the
+samples again: |r_j - A_j x|^2 = c_j - 2 x.b_j + x.G_j x. That is what makes forward selection
+over dozens of candidates cheap (diagnosing 30 s at 1 kHz takes about a second).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Candidate:
+    effect: object  # effects.Effect
+    joint: int | None  # 0-based joint for scope "joint"; None for arm-wide effects
+    start: int  # first slot in the global parameter vector
+    size: int
+
+    @property
+    def slots(self) -> np.ndarray:
+        return np.arange(self.start, self.start + self.size)
+
+    @property
+    def key(self) -> str:
+        return self.effect.key + ("" if self.joint is None else f" on joint {self.joint + 1}")
+
+    @property
+    def family(self) -> tuple:
+        """Variants of one effect on one joint exclude each other (e.g. Stribeck velocities)."""
+        return (self.effect.name, self.joint)
+
+
+@dataclass
+class Moments:
+    G: np.ndarray  # (N, K, K)
+    b: np.ndarray  # (N, K)
+    c: np.ndarray  # (N,)
+    count: int  # samples (per joint)
+
+    def mse(self, slots: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """Per joint mean squared residual after subtracting the candidates' fit x (at slots)."""
+        G = self.G[:, slots][:, :, slots]
+        b = self.b[:, slots]
+        sse = self.c - 2 * b @ x + np.einsum("k,jkl,l->j", x, G, x)
+        return np.maximum(sse, 0.0) / max(self.count, 1)
+
+
+def candidates_of(effects, n_joints: int, sizes: dict) -> list[Candidate]:
+    """sizes: effect key -> number of fitted values (known once its columns were computed)."""
+    out, start = [], 0
+    for effect in effects:
+        k = sizes[effect.key]
+        for joint in ([None] if effect.scope == "arm" else range(n_joints)):
+            out.append(Candidate(effect, joint, start, k))
+            start += k
+    return out
+
+
+def effect_columns(effects, context, segment) -> dict:
+    """effect key -> (T, N, k) columns on one segment."""
+    return {e.key: np.asarray(e.columns(context, segment.signals, segment.tau_model), dtype=float) for e in effects}
+
+
+def joint_matrix(candidates, columns: dict, joint: int) -> tuple[np.ndarray, np.ndarray]:
+    """(A_j, slots): the columns acting on `joint` and their global slots."""
+    blocks, slots = [], []
+    for c in candidates:
+        if c.joint is None or c.joint == joint:
+            blocks.append(columns[c.effect.key][:, joint, :])
+            slots.append(c.slots)
+    return np.concatenate(blocks, axis=1), np.concatenate(slots)
+
+
+def accumulate(moments: Moments, A: np.ndarray, slots: np.ndarray, r: np.ndarray, joint: int) -> None:
+    moments.G[joint][np.ix_(slots, slots)] += A.T @ A
+    moments.b[joint][slots] += A.T @ r
+    moments.c[joint] += r @ r
+
+
+def empty(n_joints: int, size: int) -> Moments:
+    return Moments(np.zeros((n_joints, size, size)), np.zeros((n_joints, size)), np.zeros(n_joints), 0)

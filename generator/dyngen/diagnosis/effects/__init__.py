@@ -1,0 +1,37 @@
+"""The library of candidate unmodelled effects, each a small model of the residual
+r = tau_measured - tau_model that is linear in its fitted values:
+
+    r ~= sum over effects of columns(context, signals) @ values
+
+An effect acts either on one joint at a time (scope "joint": friction, rotor inertia, sensor
+offset and gain; one candidate per joint) or on the whole arm with shared values (scope
+"arm": payload, tilted base, time shift, errors in the model's coefficients). Nonlinear
+parameters (the Stribeck velocity) are handled as a few fixed variants of one effect.
+"""
+
+from __future__ import annotations
+
+from .base import Context, Effect
+from .body import Coefficients, Payload
+from .friction import Armature, Coulomb, Stribeck, Viscous
+from .sensor import Gain, Offset, TimeShift
+from .tilt import Tilt, gravity_matrix
+
+STRIBECK_VELOCITIES = (0.03, 0.1, 0.3)  # rad/s (m/s): the variants tried (well above Context.sign_velocity)
+
+
+def library(names=None) -> list[Effect]:
+    """Every candidate effect (or those whose name is in `names`)."""
+    effects = [Offset(), Coulomb(), Viscous(), *[Stribeck(v) for v in STRIBECK_VELOCITIES], Armature(), Gain(),
+               Payload(), Tilt(), TimeShift(), Coefficients()]
+    if names is None:
+        return effects
+    known = {e.name for e in effects}
+    unknown = sorted(set(names) - known)
+    if unknown:
+        raise ValueError(f"unknown effect(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    return [e for e in effects if e.name in names]
+
+
+__all__ = ["Armature", "Coefficients", "Context", "Coulomb", "Effect", "Gain", "Offset", "Payload", "Stribeck",
+           "Tilt", "TimeShift", "Viscous", "gravity_matrix", "library", "STRIBECK_VELOCITIES"]

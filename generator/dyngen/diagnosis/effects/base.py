@@ -1,0 +1,50 @@
+"""What every effect shares: the context it is computed in, and its interface."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Context:
+    """What effects may use besides the signals: the compiled model, the robot, its link
+    parameters (dynamic p and standard s) and the smoothing velocity of sign(qd)."""
+
+    model: object  # dyngen.runtime.Compiled
+    robot: object  # dyngen.description.Robot
+    p: np.ndarray
+    s: np.ndarray
+    sign_velocity: float = 0.002  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
+
+    def sign(self, qd: np.ndarray) -> np.ndarray:
+        return np.tanh(qd / self.sign_velocity)
+
+
+class Effect:
+    """name: the effect's identifier in reports and JSON; scope: "joint" or "arm";
+    parameters and units: the fitted values' names and units (per joint for scope "joint")."""
+
+    name = ""
+    scope = "joint"
+    parameters: tuple = ()
+    units: tuple = ()
+    label = ""  # a variant's setting, e.g. "vs = 0.1 rad/s"
+
+    def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
+        """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the
+        candidate on joint j and acts on joint j only."""
+        raise NotImplementedError
+
+    def plausible(self, values: np.ndarray) -> bool:
+        """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
+        return True
+
+    def fixed(self) -> dict:
+        """Settings of a variant that are not fitted (e.g. the Stribeck velocity)."""
+        return {}
+
+    @property
+    def key(self) -> str:
+        return self.name + (f"[{self.label}]" if self.label else "")

@@ -1,0 +1,107 @@
+"""A tilted base: gravity in the base frame is not the model's direction.
+
+The gravity torque is linear in the gravity vector: g(q) = G(q) gvec, with column k of G the
+joint torques that a unit gravity along base axis k would cause. A tilt by small angles turns
+gvec by d gvec, perpendicular to it, so the residual is G(q) d gvec: three columns, G(q) u1, G(q) u2 and
+G(q) n, with u1, u2 unit vectors perpendicular to the model's gravity and n along it. The
+fitted values are the components of d gvec [m/s^2]; the third takes the second-order change
+along gravity (|gvec| (1 - cos angle)), so the tilt is exact, not only to first order. The
+tilt angles follow from the rotated vector gvec + d gvec.
+
+G(q) comes from plain forward kinematics of the DH table (numpy, vectorised over samples):
+for joint i with axis z through o, and every link k it carries, with centre of mass p_k,
+  revolute:  G_i = - sum_k m_k (z x (p_k - o))      prismatic:  G_i = - sum_k m_k z
+(the potential is V = -sum m_k gvec . p_k and g = dV/dq).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Effect
+
+
+class Tilt(Effect):
+    name, scope = "tilt", "arm"
+    parameters = ("dg1", "dg2", "dgn")
+    units = ("m/s^2", "m/s^2", "m/s^2")
+
+    def columns(self, context, signals, tau_model):
+        G = gravity_matrix(context.robot, context.p, signals.q)  # (T, N, 3)
+        u1, u2 = tilt_directions(context.robot)
+        n = np.cross(u1, u2)
+        return np.stack([G @ u1, G @ u2, G @ n], axis=-1)
+
+
+def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors perpendicular to the model's gravity (the base x or y axis made
+    perpendicular; for gravity along -z they are x and y)."""
+    g = np.array([float(x) for x in robot.gravity])
+    n = g / np.linalg.norm(g)
+    seed = np.eye(3)[int(np.argmin(np.abs(n)))]
+    u1 = seed - (seed @ n) * n
+    u1 /= np.linalg.norm(u1)
+    return u1, np.cross(n, u1)
+
+
+def tilt_angles_deg(robot, dg) -> tuple[float, float]:
+    """Rotation angles [deg] of gravity towards u1 and u2 for the fitted components (dg1,
+    dg2, dgn): the angles of the rotated vector's u1 and u2 components against its component
+    along the model's gravity."""
+    g = np.linalg.norm([float(x) for x in robot.gravity])
+    along = g + dg[2]
+    return float(np.degrees(np.arctan2(dg[0], along))), float(np.degrees(np.arctan2(dg[1], along)))
+
+
+def _dh(robot, q):
+    """Per joint: rotation (T, 3, 3) and origin (T, 3) of frame i, and joint axis and point."""
+    T = q.shape[0]
+    R = np.broadcast_to(np.eye(3), (T, 3, 3)).copy()
+    o = np.zeros((T, 3))
+    frames, axes = [], []
+    for i, joint in enumerate(robot.joints):
+        a, alpha, d, theta = (float(joint.a), float(joint.alpha), float(joint.d), float(joint.theta))
+        th = theta + (q[:, i] if joint.revolute else 0.0)
+        dd = d + (0.0 if joint.revolute else q[:, i])
+        th = np.broadcast_to(th, (T,))
+        dd = np.broadcast_to(dd, (T,))
+        if robot.convention == "standard":
+            axes.append((R[:, :, 2].copy(), o.copy()))  # joint i turns about z(i-1)
+            # Rz(th) Tz(d) Tx(a): the new origin is R (a cos th, a sin th, d)
+            o = o + np.einsum("tij,tj->ti", R, np.stack([a * np.cos(th), a * np.sin(th), dd], axis=1))
+            R = R @ _rz(th) @ _rx(alpha)
+        else:
+            R = R @ _rx(alpha)
+            o = o + a * R[:, :, 0]
+            R = R @ _rz(th)
+            axes.append((R[:, :, 2].copy(), o.copy()))  # joint i turns about z(i)
+            o = o + dd[:, None] * R[:, :, 2]
+        frames.append((R.copy(), o.copy()))
+    return frames, axes
+
+
+def _rz(th):
+    c, s = np.cos(th), np.sin(th)
+    z, one = np.zeros_like(th), np.ones_like(th)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, one], -1)], -2)
+
+
+def _rx(alpha):
+    c, s = np.cos(alpha), np.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def gravity_matrix(robot, p, q) -> np.ndarray:
+    """G (T, N, 3) with g(q) = G(q) gvec for link parameters p (dynamic, 10N)."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    links = np.asarray(p, dtype=float).reshape(-1, 10)
+    frames, axes = _dh(robot, q)
+    n = len(robot.joints)
+    G = np.zeros((q.shape[0], n, 3))
+    centres = [o + np.einsum("tij,j->ti", R, links[k, 1:4]) for k, (R, o) in enumerate(frames)]
+    for i, joint in enumerate(robot.joints):
+        z, o = axes[i]
+        for k in range(i, n):
+            m = links[k, 0]
+            G[:, i, :] -= m * (np.cross(z, centres[k] - o) if joint.revolute else z)
+    return G

@@ -1,0 +1,110 @@
+"""Figures like the paper's Figs. 4 and 5 (PNG, matplotlib Agg): measured against model torque
+per joint, and the residual before and after the selected effects, on held-out data, with
+the phases where the residual stands out shaded."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from . import phases  # noqa: E402
+
+DPI = 110
+MAX_POINTS = 4000  # samples drawn per curve (more only slow the drawing; a screen shows fewer)
+SHADED = {"reversal": "tab:orange", "standstill": "0.75"}
+
+
+def _shade(ax, t, mask, color):
+    """Shade the time intervals where mask is true."""
+    if not mask.any():
+        return
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
+    for start, stop in zip(edges[::2], edges[1::2]):
+        ax.axvspan(t[start], t[min(stop, t.size - 1)], color=color, alpha=0.18, lw=0)
+
+
+def _grid(n):
+    cols = 2
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(12, 2.2 * rows + 1.0), sharex=True, squeeze=False)
+    axes = axes.ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    return fig, axes
+
+
+def _save(fig, path, title) -> Path:
+    fig.suptitle(title, fontsize=12)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
+
+
+def figures(d, out_dir, robot_name: str) -> dict:
+    """torques.png (Fig. 4 style) and residuals.png (Fig. 5 style) of the first held-out segment."""
+    seg = next(s for s in d.segments if s.held.any())
+    m = np.flatnonzero(seg.held)
+    m = m[::max(1, m.size // MAX_POINTS)]
+    t = seg.signals.t[m]
+    measured, model = seg.signals.tau[m], seg.tau_model[m]
+    before = seg.residual[m]
+    after = before - seg.correction[m]
+    labels = phases.labels(t, seg.signals.q[m], seg.signals.qd[m], seg.signals.qdd[m])
+    n = measured.shape[1]
+    out = Path(out_dir)
+
+    fig, axes = _grid(n)
+    for j in range(n):
+        ax = axes[j]
+        for name, color in SHADED.items():
+            _shade(ax, t, labels[name][:, j], color)
+        ax.plot(t, measured[:, j], color="tab:blue", lw=1.4, label="measured")
+        ax.plot(t, model[:, j], color="tab:red", lw=1.0, ls="--", label="model (Newton-Euler)")
+        ax.plot(t, model[:, j] + seg.correction[m][:, j], color="tab:green", lw=0.9, label="model + selected effects")
+        ax.set_title(f"joint {j + 1}", loc="left", fontsize=10)
+        ax.set_ylabel("torque [Nm]")
+        ax.grid(True, alpha=0.3)
+    _legend(fig, axes[0])
+    paths = {"torques": _save(fig, out / "torques.png", f"{robot_name}: measured and model torques on "
+                                                          f"held-out data ({seg.signals.name})")}
+
+    fig, axes = _grid(n)
+    for j in range(n):
+        ax = axes[j]
+        for name, color in SHADED.items():
+            _shade(ax, t, labels[name][:, j], color)
+        ax.plot(t, before[:, j], color="tab:red", lw=1.0,
+                label="residual, nominal model")
+        ax.plot(t, after[:, j], color="tab:green", lw=1.0, label="residual with the selected effects")
+        ax.axhline(0, color="0.3", lw=0.6)
+        rms_b, rms_a = np.sqrt(np.mean(before[:, j] ** 2)), np.sqrt(np.mean(after[:, j] ** 2))
+        ax.set_title(f"joint {j + 1}: RMS {rms_b:.3f} -> {rms_a:.3f}", loc="left", fontsize=10)
+        ax.set_ylabel("residual [Nm]")
+        ax.grid(True, alpha=0.3)
+    _legend(fig, axes[0])
+    paths["residuals"] = _save(fig, out / "residuals.png", f"{robot_name}: residual tau_measured - tau_model "
+                                                             f"on held-out data ({seg.signals.name})")
+    return paths
+
+
+def _legend(fig, ax):
+    handles, names = ax.get_legend_handles_labels()
+    for name, color in SHADED.items():
+        handles.append(plt.Rectangle((0, 0), 1, 1, color=color, alpha=0.3))
+        names.append(f"{name} (shaded)")
+    fig.legend(handles, names, loc="upper center", ncol=len(handles), frameon=False, bbox_to_anchor=(0.5, 0.965),
+               fontsize=8)
+    visible = [a for a in fig.axes if a.get_visible()]
+    for col in (0, 1):  # the lowest visible panel of each column carries the time axis
+        column = [a for a in visible if a.get_subplotspec().colspan.start == col]
+        if column:
+            column[-1].set_xlabel("time [s]")
+            column[-1].xaxis.set_tick_params(labelbottom=True)

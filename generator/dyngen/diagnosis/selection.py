@@ -1,0 +1,175 @@
+"""Forward selection of effects by what they do on held-out data.
+
+Fit: weighted least squares on the fit samples, every joint's rows divided by the RMS of
+its nominal residual there (so a joint with a large residual does not drown the others).
+Gain: on the held-out samples, the decrease of the residual's mean square relative to its
+value before the step, on the candidate's own joint (per-joint effects) or summed over joints
+(arm-wide effects). A step adds the candidate with the largest held-out gain if
+
+  - the gain is at least `min_gain` (default 0.05: 5 % of one joint's current held-out mean
+    square), so an effect must generalise, not merely fit, and
+  - its fitted values are significant on the fit data (chi-square test of x_c^T Cov_cc^-1 x_c,
+    p < `alpha`), so noise alone does not qualify, and
+  - they are physically plausible (friction opposes motion, a rotor inertia is positive, a
+    sensor gain lies within 50 % of one: Effect.plausible), so a column that merely happens
+    to resemble the residual is not claimed as that effect.
+
+Then prune() drops, one by one, selected effects whose values are not significant once the
+deviations are scaled for the correlation in time of the residual they leave.
+
+Among candidates within 10 % of the best gain, the one with fewest values wins (a payload is
+preferred to the 43 coefficient errors that could also express it). Selection stops when no
+candidate qualifies: with data that hold no unmodelled effect, nothing is selected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import linalg, stats
+
+MIN_GAIN = 0.05
+ALPHA = 1e-3
+NEAR_BEST = 0.9
+
+
+@dataclass
+class Fit:
+    x: np.ndarray  # values at the chosen slots
+    slots: np.ndarray
+    covariance: np.ndarray  # white-residual covariance (scaled later for correlation)
+    sigma2: float
+
+
+@dataclass
+class Selection:
+    chosen: list  # Candidate, in the order selected
+    steps: list = field(default_factory=list)  # per step: {"candidate", "gain", "score"}
+    first_gains: dict = field(default_factory=dict)  # candidate key -> gain when tried alone
+
+
+def solve(design, chosen) -> Fit:
+    """Weighted least squares of the chosen candidates on the fit samples (moments only).
+
+    The covariance is the sandwich H^-1 (sum_j w_j^4 s_j^2 G_j) H^-1 with s_j^2 joint j's own
+    residual variance: joints differ in noise, and the weights (from the nominal residual,
+    which contains the very effects sought) are not their noise levels."""
+    slots = np.concatenate([c.slots for c in chosen]) if chosen else np.zeros(0, dtype=int)
+    H = design.H[np.ix_(slots, slots)]
+    g = design.g[slots]
+    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
+    inverse = _inverse(H / np.outer(d, d)) / np.outer(d, d)
+    x = inverse @ g
+    fit = design.fit
+    w2 = design.weights ** 2
+    G = fit.G[:, slots][:, :, slots]
+    sse = np.maximum(fit.c - 2 * fit.b[:, slots] @ x + np.einsum("k,jkl,l->j", x, G, x), 0.0)
+    s2 = sse / max(fit.count - len(slots), 1)  # per joint
+    middle = np.einsum("j,jkl->kl", w2 ** 2 * s2, G)
+    covariance = inverse @ middle @ inverse
+    return Fit(x, slots, covariance, float(w2 @ s2) / len(s2))
+
+
+def _inverse(Hs: np.ndarray) -> np.ndarray:
+    """Inverse of a unit-diagonal normal matrix; a pseudo-inverse when columns are dependent
+    (dependent columns then share no value instead of taking arbitrary large ones)."""
+    if Hs.size == 0:
+        return Hs
+    try:
+        factor = linalg.cho_factor(Hs, check_finite=False)
+        if np.min(np.abs(np.diag(factor[0]))) > 1e-5:  # condition below about 1e10
+            return linalg.cho_solve(factor, np.eye(len(Hs)), check_finite=False)
+    except linalg.LinAlgError:
+        pass
+    vals, vecs = np.linalg.eigh(Hs)
+    keep = vals > 1e-10 * max(vals.max(), 1e-300)
+    return (vecs[:, keep] / vals[keep]) @ vecs[:, keep].T
+
+
+def significant(fit: Fit, candidate, chosen, alpha: float = ALPHA, correlation: float = 1.0) -> bool:
+    return p_value(fit, candidate, chosen, correlation) < alpha
+
+
+def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
+    """Chi-square test of the candidate's values against zero, with the covariance scaled by
+    the residual's correlation time in samples (see correlation.py)."""
+    offset = sum(c.size for c in chosen[:chosen.index(candidate)])
+    k = slice(offset, offset + candidate.size)
+    x, C = fit.x[k], fit.covariance[k, k] * correlation
+    vals, vecs = np.linalg.eigh(C)
+    keep = vals > 1e-12 * max(vals.max(initial=0.0), 1e-300)
+    if not keep.any():
+        return 1.0
+    z = vecs[:, keep].T @ x
+    chi2 = float(np.sum(z ** 2 / vals[keep]))
+    return float(stats.chi2.sf(chi2, int(keep.sum())))
+
+
+def heldout_mse(design, chosen) -> np.ndarray:
+    fit = solve(design, chosen)
+    return design.held.mse(fit.slots, fit.x) if chosen else design.held.c / max(design.held.count, 1)
+
+
+def heldout_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
+    """Relative decrease of the held-out mean square: on the candidate's own joint for a
+    per-joint effect (a refit of arm-wide effects must not lend it credit from other joints),
+    summed over joints for an arm-wide effect."""
+    relative = (before - after) / np.maximum(before, 1e-300)
+    return float(relative[candidate.joint] if candidate.joint is not None else relative.sum())
+
+
+def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps: int = 30) -> Selection:
+    """Forward steps; the significance test here assumes uncorrelated residuals (prune() then
+    applies the honest, correlation-scaled test to what was selected)."""
+    selection = Selection([])
+    current = heldout_mse(design, [])
+    tau = 1.0
+    while len(selection.chosen) < max_steps:
+        families = {c.family for c in selection.chosen}
+        trials = []
+        for cand in design.candidates:
+            if cand.family in families:
+                continue
+            chosen = selection.chosen + [cand]
+            fit = solve(design, chosen)
+            mse = design.held.mse(fit.slots, fit.x)
+            gain = heldout_gain(cand, current, mse)
+            if not selection.chosen:
+                selection.first_gains[cand.key] = gain
+            if gain >= min_gain and cand.effect.plausible(fit.x[-cand.size:]):
+                trials.append((gain, cand, mse, fit, chosen))
+        qualified = [t for t in trials if significant(t[3], t[1], t[4], alpha, tau)]
+        if not qualified:
+            break
+        best = max(t[0] for t in qualified)
+        near = [t for t in qualified if t[0] >= NEAR_BEST * best]
+        gain, cand, mse, _, _ = min(near, key=lambda t: (t[1].size, -t[0]))
+        selection.chosen.append(cand)
+        selection.steps.append({"candidate": cand.key, "gain": gain, "heldout_rms": np.sqrt(mse).tolist()})
+        current = mse
+    return selection
+
+
+def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list, float, list]:
+    """Backward elimination: drop an effect whose held-out gain, with all the others kept, is
+    not positive; then, with deviations scaled by the correlation time of the residual the
+    chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
+    effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
+    chosen, dropped = list(chosen), []
+    while True:
+        fit = solve(design, chosen)
+        tau = correlation(chosen, fit)
+        if not chosen:
+            return chosen, tau, dropped
+        with_all = design.held.mse(fit.slots, fit.x)
+        # An effect that no longer helps on held-out data once the others are in goes first.
+        gains = [heldout_gain(c, heldout_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
+        if min(gains) <= 0:
+            dropped.append(chosen.pop(int(np.argmin(gains))).key)
+            continue
+        pvalues = [p_value(fit, c, chosen, tau) for c in chosen]
+        worst = int(np.argmax(pvalues))
+        if pvalues[worst] <= alpha:
+            return chosen, tau, dropped
+        dropped.append(chosen.pop(worst).key)

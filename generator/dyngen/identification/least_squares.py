@@ -1,0 +1,61 @@
+"""Ordinary least squares with what a user needs to trust it: the regressor's condition
+number, a standard deviation per coefficient, and the coefficients the data do not excite.
+
+    std_k = sqrt(sigma^2 [(A^T A)^-1]_kk),  sigma^2 = |b - A x|^2 / (rows - columns)
+
+(the textbook formula, which assumes uncorrelated residuals; filtered signals are correlated
+in time, so these deviations are lower bounds). A coefficient is *not excited* when the
+directions of A that carry it are weak: after scaling every column to unit norm, it loads by
+more than half on right singular vectors whose singular value is below `weak` times the
+largest. Such coefficients are solved in the minimum-norm sense and flagged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+WEAK = 1e-4  # relative singular value below which a direction counts as not excited
+
+
+@dataclass
+class Estimate:
+    names: list[str]  # coefficient expressions
+    values: np.ndarray
+    std: np.ndarray  # inf where not excited
+    condition: float  # condition number of A (columns as they are)
+    scaled_condition: float  # with every column scaled to unit norm
+    residual_rms: float
+    rows: int
+    unexcited: list[int]  # indices of coefficients the data do not excite
+
+    def warnings(self) -> list[str]:
+        return [f"the data do not excite coefficient {k} ({self.names[k]}); its value is not determined"
+                for k in self.unexcited]
+
+
+def fit(A: np.ndarray, b: np.ndarray, names: list[str], weak: float = WEAK) -> Estimate:
+    A = np.asarray(A, dtype=float)
+    b = np.asarray(b, dtype=float)
+    rows, cols = A.shape
+    norms = np.linalg.norm(A, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    U, sv, Vt = np.linalg.svd(A / scale, full_matrices=False)
+    strong = sv > weak * sv[0]
+    # Minimum-norm solution in the scaled variables over the excited directions only.
+    x_scaled = Vt[strong].T @ ((U[:, strong].T @ b) / sv[strong])
+    x = x_scaled / scale
+    residual = b - A @ x
+    dof = max(rows - int(strong.sum()), 1)
+    sigma2 = float(residual @ residual) / dof
+    loading = (Vt[~strong] ** 2).sum(axis=0)  # share of each coefficient in the weak directions
+    unexcited = [k for k in range(cols) if loading[k] > 0.5 or norms[k] == 0]
+    cov_scaled = (Vt[strong].T / sv[strong] ** 2) @ Vt[strong]
+    std = np.sqrt(sigma2 * np.diag(cov_scaled)) / scale
+    std[unexcited] = np.inf
+    raw = np.linalg.svd(A, compute_uv=False)
+    condition = float(raw[0] / raw[-1]) if raw[-1] > 0 else float("inf")
+    scaled_condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    return Estimate(list(names), x, std, condition, scaled_condition, float(np.sqrt(np.mean(residual ** 2))),
+                    rows, unexcited)

@@ -1,0 +1,179 @@
+"""`dyngen identify` and `dyngen diagnose`: the commands that take measured data."""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+from .errors import InputError
+from .progress import Progress
+
+
+def _data_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
+    parser.add_argument("--data", action="append", required=True, metavar="CSV",
+                        help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
+    group = parser.add_argument_group("signal conditioning (the paper: 4th order, 1 Hz)")
+    group.add_argument("--cutoff", type=float, metavar="HZ",
+                       help="zero-phase Butterworth low-pass on positions, velocities and torques alike "
+                            "(default: none)")
+    group.add_argument("--order", type=int, default=4, metavar="N", help="Butterworth order (default 4)")
+    group.add_argument("--differentiate", action="store_true",
+                       help="compute qd, qdd from q even when the file has them")
+    parser.add_argument("--model", metavar="DIR",
+                        help="an already generated folder of this robot (default: generate it first)")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+
+
+def _conditioning(args):
+    from .data import Conditioning
+
+    return Conditioning(cutoff=args.cutoff, order=args.order, differentiate=args.differentiate)
+
+
+def _conditioning_text(args) -> str:
+    text = "as recorded" if args.cutoff is None else f"Butterworth order {args.order}, {args.cutoff:g} Hz, zero phase"
+    return text + ("; qd, qdd differentiated from q" if args.differentiate else "")
+
+
+def _model(args, robot, progress):
+    """The compiled model: the given folder, or one generated now into a temporary folder."""
+    from .runtime import load
+
+    if args.model:
+        folder = Path(args.model)
+        if not (folder / "manifest.json").exists():
+            raise InputError(str(folder), "", "not a generated folder (no manifest.json)")
+        model = load(folder)
+        if model.manifest["robot"] != robot.name or model.manifest["dof"] != robot.dof:
+            raise InputError(str(folder), "manifest.json", f"the folder is for {model.manifest['robot']}, "
+                             f"not {robot.name} ({robot.dof} joints)")
+        return model
+    from .atomic import write_folder
+    from .generate import build
+
+    bases, emitted = build(robot, progress)
+    folder = Path(tempfile.mkdtemp(prefix="dyngen-")) / robot.name
+    write_folder(folder, emitted.files)
+    with progress.step("compile the generated C"):
+        return load(folder)
+
+
+def _read(paths, robot, args, require_torques=True, required=()):
+    from .data import condition, read_recording
+
+    return [condition(read_recording(p, robot.dof, require_torques, required), _conditioning(args)) for p in paths]
+
+
+def cmd_identify(argv, prog="dyngen identify") -> int:
+    parser = argparse.ArgumentParser(prog=prog, description=(
+        "Identify base coefficients by least squares (the paper's eq. 11) from recordings, and write "
+        "them as the `identified:` YAML block that `dyngen extract` reads. --kind full uses torque "
+        "trajectories (Y(q, qd, qdd) pi = tau); gravity reads the torques as gravity torques g(q) (static "
+        "poses or the FRI's g(q), eq. 9); inertia reads the stacked inertia matrix from columns M11, M12, ... "
+        "(eq. 10). Reports the regressor's condition number, every coefficient's standard deviation and "
+        "the coefficients the data do not excite."))
+    _data_options(parser)
+    parser.add_argument("--kind", choices=("full", "gravity", "inertia"), default="full",
+                        help="which coefficients (default full)")
+    parser.add_argument("-o", "--output", metavar="FILE",
+                        help="where to write the YAML (default out/<robot>/identified_<kind>.yaml)")
+    args = parser.parse_args(argv)
+    from .description import load_robot
+    from .identification import identified_yaml, identify, summary_table
+    from .identification.samples import stacked_inertia_columns
+
+    robot = load_robot(args.robot)
+    progress = Progress(quiet=args.quiet)
+    required = tuple(_inertia_names(robot)) if args.kind == "inertia" else ()
+    # Bad input fails before anything is announced or written.
+    signals = _read(args.data, robot, args, require_torques=args.kind != "inertia", required=required)
+    progress.say(f"dyngen identify: {robot.name}, {args.kind} coefficients from {len(args.data)} recording(s)")
+    model = _model(args, robot, progress)
+    if args.kind == "inertia":
+        assert stacked_inertia_columns(model.manifest) == list(required)
+    with progress.step("least squares"):
+        estimate = identify(model, signals, args.kind)
+    out = Path(args.output) if args.output else Path("out") / robot.name / f"identified_{args.kind}.yaml"
+    from .atomic import write_file
+
+    write_file(out, identified_yaml(robot.name, {args.kind: estimate}, [Path(p).name for p in args.data],
+                                    _conditioning_text(args)))
+    if not args.quiet:
+        print(f"{robot.name}: {len(estimate.names)} {args.kind} coefficients from {estimate.rows} equations; "
+              f"condition number {estimate.condition:.3g} (columns scaled {estimate.scaled_condition:.3g}); "
+              f"residual RMS {estimate.residual_rms:.4g}")
+        print("\n".join("  " + line for line in summary_table(args.kind, estimate).splitlines()))
+        for w in estimate.warnings():
+            print(f"  warning: {w}")
+        print(f"  written: {out}")
+    return 0
+
+
+def _inertia_names(robot):
+    n = robot.dof
+    return [f"M{j + 1}{k + 1}" for j in range(n) for k in range(j, n)]
+
+
+def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
+    parser = argparse.ArgumentParser(prog=prog, description=(
+        "Diagnose the gap between measured torques and the Newton-Euler model with given link parameters: "
+        "where the residual lies (per joint, per phase of the motion), which unmodelled effects explain it "
+        "(Coulomb, viscous and Stribeck friction, rotor inertia, sensor offset and gain, payload, tilted "
+        "base, time shift, coefficient errors; chosen by their gain on held-out data) and how far it shrinks. "
+        "Writes report.md, diagnosis.json, effects.yaml, torques.png, residuals.png and, for consistent "
+        "parameters, URDF and MJCF with the selected friction."))
+    _data_options(parser)
+    parser.add_argument("--params", required=True, metavar="P.yaml",
+                        help="link parameters: extraction output (links:), a solution file (solution:) or a robot "
+                             "YAML (parameters.nominal)")
+    parser.add_argument("--holdout", action="append", metavar="CSV",
+                        help="recording(s) held out from the fit to select and judge effects (default: every "
+                             "third block of 2 s of the --data recordings)")
+    parser.add_argument("--out", default=None, metavar="DIR", help="output folder (default out/<robot>/diagnosis)")
+    parser.add_argument("--effects", metavar="LIST",
+                        help="comma-separated effects to try (default all: offset, coulomb, viscous, stribeck, "
+                             "armature, gain, payload, tilt, time_shift, coefficients)")
+    parser.add_argument("--min-gain", type=float, default=None, metavar="G",
+                        help="least held-out gain to select an effect (default 0.05: 5%% of a joint's mean square)")
+    parser.add_argument("--sign-velocity", type=float, default=0.002, metavar="V",
+                        help="sign(qd) is smoothed as tanh(qd / V) (default 0.002 rad/s)")
+    args = parser.parse_args(argv)
+    from .description import load_robot
+    from .diagnosis import Options, diagnose
+    from .diagnosis.outputs import write_outputs
+    from .diagnosis.report import summary_lines
+    from .data.parameters_file import read_link_parameters
+
+    robot = load_robot(args.robot)
+    p = read_link_parameters(args.params, robot.dof)
+    progress = Progress(quiet=args.quiet)
+    start = time.perf_counter()
+    fit = _read(args.data, robot, args)  # bad input fails before anything is announced or written
+    held = _read(args.holdout, robot, args) if args.holdout else None
+    progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit and "
+                 f"{len(args.holdout or [])} held-out recording(s)")
+    model = _model(args, robot, progress)
+    options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
+                      sign_velocity=args.sign_velocity,
+                      **({"min_gain": args.min_gain} if args.min_gain is not None else {}))
+    with progress.step("residual, effects, selection on held-out data"):
+        try:
+            result = diagnose(robot, model, p, fit, held, options)
+        except ValueError as err:
+            raise InputError("--effects", "", str(err)) from None
+    out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
+    sources = {"params": Path(args.params).name, "fit": [Path(x).name for x in args.data],
+               "holdout": [Path(x).name for x in args.holdout or []], "conditioning": _conditioning_text(args)}
+    with progress.step("report, JSON, figures, updated model"):
+        paths = write_outputs(result, robot, p, out, sources, args.sign_velocity)
+    if not args.quiet:
+        print(f"{robot.name}: diagnosis in {time.perf_counter() - start:.1f} s ({result.split})")
+        print("\n".join(summary_lines(result)))
+        written = [str(v) for k, v in paths.items() if k != "export skipped"]
+        print(f"  written: {', '.join(written)}")
+        if "export skipped" in paths:
+            print(f"  URDF/MJCF not written: {paths['export skipped']}")
+    return 0

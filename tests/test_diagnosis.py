@@ -1,0 +1,238 @@
+"""Diagnosis on synthetic data with known, independently injected effects (tests/synthetic.py):
+it names the effect and joint, recovers the values, shrinks the held-out residual to the
+noise level, and claims nothing when there is nothing. Also the effect models' building blocks
+against oracles, the friction routine of the generated C, and the command line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import ROOT
+from oracles import pinocchio_arm
+from oracles.arm import Arm
+from oracles.random_params import random_parameters
+from synthetic import fourier, noisy, rigid_torques, signals
+
+from dyngen.description import load_robot
+from dyngen.diagnosis import diagnose
+from dyngen.diagnosis.effects import gravity_matrix
+from dyngen.runtime import load
+
+LWR = ROOT / "examples" / "lwr.yaml"
+NOISE = 0.02  # Nm, white
+
+
+@pytest.fixture(scope="module")
+def lwr():
+    model = load(ROOT / "generated" / "lwr")
+    arm = Arm.from_yaml(LWR)
+    p = random_parameters(7, seed=3)  # physically consistent, so the exports can be written
+    trajectories = {}
+    for name, seed in (("fit", 11), ("held", 12)):
+        t, at = fourier(7, seed, duration=10.0, rate=200.0)
+        q, qd, qdd = at(t)
+        trajectories[name] = (t, at, q, qd, qdd, rigid_torques(arm, p, q, qd, qdd))
+    return model, load_robot(LWR), arm, p, trajectories
+
+
+def run(lwr, extra, seed=0, **options):
+    """extra(name, t, at, q, qd, qdd, tau) -> measured torques before noise."""
+    model, robot, arm, p, trajectories = lwr
+    data = []
+    for k, name in enumerate(("fit", "held")):
+        t, at, q, qd, qdd, tau = trajectories[name]
+        measured = noisy(extra(name, t, at, q, qd, qdd, tau), NOISE, seed + k)
+        data.append(signals(name, t, q, qd, qdd, measured))
+    return diagnose(robot, model, p, [data[0]], [data[1]])
+
+
+def claims(d):
+    return sorted((e["effect"], tuple(e["joints"])) for e in d.selected)
+
+
+def value(d, effect, joint=None):
+    e = next(e for e in d.selected if e["effect"] == effect and (joint is None or e["joints"] == [joint]))
+    return e["values"], e["std"]
+
+
+def near_noise(d, factor=1.3):
+    return max(d.rms_after) < factor * NOISE
+
+
+def test_no_effect_claims_nothing(lwr):
+    for seed in (0, 10):
+        d = run(lwr, lambda name, t, at, q, qd, qdd, tau: tau, seed=seed)
+        assert d.selected == [], claims(d)
+        assert np.allclose(d.rms_before, d.rms_after) and max(d.rms_before) < 1.2 * NOISE
+
+
+def test_residual_is_measured_minus_independent_newton_euler(lwr):
+    """rms_before against Pinocchio's rnea on the same held-out samples (no dyngen code)."""
+    model, robot, arm, p, trajectories = lwr
+    d = run(lwr, lambda name, t, at, q, qd, qdd, tau: tau + 0.3)
+    t, at, q, qd, qdd, tau = trajectories["held"]
+    measured = noisy(tau + 0.3, NOISE, 1)
+    expected = np.sqrt(np.mean((measured - rigid_torques(arm, p, q, qd, qdd)) ** 2, axis=0))
+    assert np.allclose(d.rms_before, expected, rtol=1e-9)
+
+
+def test_friction_on_two_joints(lwr):
+    def friction(name, t, at, q, qd, qdd, tau):
+        out = tau.copy()
+        out[:, 1] += 1.0 * np.sign(qd[:, 1]) + 0.5 * qd[:, 1]
+        out[:, 5] += 0.6 * np.sign(qd[:, 5])
+        return out
+
+    d = run(lwr, friction)
+    assert claims(d) == [("coulomb", (2,)), ("coulomb", (6,)), ("viscous", (2,))]
+    assert value(d, "coulomb", 2)[0]["Fc"] == pytest.approx(1.0, rel=0.1)
+    assert value(d, "viscous", 2)[0]["Fv"] == pytest.approx(0.5, rel=0.1)
+    assert value(d, "coulomb", 6)[0]["Fc"] == pytest.approx(0.6, rel=0.1)
+    assert near_noise(d, 2.0) and d.rms_before[1] > 10 * NOISE
+    where = d.where[5]  # Coulomb friction shows around reversals, where its sign flips
+    assert where["phases"]["reversal"]["rms"] > where["phases"]["fast"]["rms"]
+
+
+def test_sensor_offsets(lwr):
+    def offsets(name, t, at, q, qd, qdd, tau):
+        return tau + np.array([0.8, 0, 0, 0, -0.5, 0, 0])
+
+    d = run(lwr, offsets)
+    assert claims(d) == [("offset", (1,)), ("offset", (5,))]
+    assert value(d, "offset", 1)[0]["b"] == pytest.approx(0.8, rel=0.05)
+    assert value(d, "offset", 5)[0]["b"] == pytest.approx(-0.5, rel=0.05)
+    assert near_noise(d)
+
+
+def test_tilted_base(lwr):
+    """Gravity turned by 2 degrees about the base x axis: Pinocchio with that gravity."""
+    model, robot, arm, p, trajectories = lwr
+    angle = np.radians(2.0)
+    tilted = Arm(arm.convention, arm.joints, np.array([0.0, 9.81 * np.sin(angle), -9.81 * np.cos(angle)]))
+
+    def tilt(name, t, at, q, qd, qdd, tau):
+        return rigid_torques(tilted, p, q, qd, qdd)
+
+    d = run(lwr, tilt)
+    assert [e["effect"] for e in d.selected] == ["tilt"]
+    angles = d.selected[0]["derived"]["tilt_deg"]
+    assert np.hypot(*angles) == pytest.approx(2.0, rel=0.1)
+    assert near_noise(d)
+
+
+def test_payload_on_last_link(lwr):
+    model, robot, arm, p, trajectories = lwr
+    payload = (1.5, [0.02, 0.0, 0.08], np.diag([0.004, 0.004, 0.002]))
+
+    def with_payload(name, t, at, q, qd, qdd, tau):
+        return rigid_torques(arm, p, q, qd, qdd, payload=payload)
+
+    d = run(lwr, with_payload)
+    assert [e["effect"] for e in d.selected] == ["payload"]
+    values = d.selected[0]["values"]
+    assert values["m"] == pytest.approx(1.5, rel=0.1)
+    assert values["mx"] == pytest.approx(1.5 * 0.02, rel=0.2)
+    assert near_noise(d)
+
+
+def test_time_shift(lwr):
+    """Torques recorded 8 ms late: the rigid-body torque of the trajectory at t - dt."""
+    model, robot, arm, p, trajectories = lwr
+    dt = 0.008
+
+    def late(name, t, at, q, qd, qdd, tau):
+        return rigid_torques(arm, p, *at(t - dt))
+
+    d = run(lwr, late)
+    assert [e["effect"] for e in d.selected] == ["time_shift"]
+    assert d.selected[0]["values"]["dt"] == pytest.approx(dt, rel=0.1)
+    assert near_noise(d)
+
+
+def test_rotor_inertia_and_gain(lwr):
+    def effects(name, t, at, q, qd, qdd, tau):
+        out = tau.copy()
+        out[:, 3] += 0.3 * qdd[:, 3]
+        out[:, 1] *= 1.05
+        return out
+
+    d = run(lwr, effects)
+    assert claims(d) == [("armature", (4,)), ("gain", (2,))]
+    assert value(d, "armature", 4)[0]["Ia"] == pytest.approx(0.3, rel=0.1)
+    assert value(d, "gain", 2)[0]["k-1"] == pytest.approx(0.05, rel=0.1)
+
+
+@pytest.mark.parametrize("name", ["lwr", "panda", "stanford"])
+def test_gravity_matrix_against_pinocchio(name):
+    """The tilt effect's G(q) (numpy forward kinematics) times gravity equals Pinocchio's g(q),
+    for standard and modified DH and a prismatic joint, with random consistent parameters."""
+    path = ROOT / "examples" / f"{name}.yaml"
+    robot, arm = load_robot(path), Arm.from_yaml(path)
+    p = random_parameters(robot.dof, seed=7)
+    q = np.random.default_rng(2).uniform(-1.5, 1.5, (10, robot.dof))
+    G = gravity_matrix(robot, p, q)
+    for gvec in (arm.gravity, np.array([1.0, -2.0, 0.5])):
+        oracle = Arm(arm.convention, arm.joints, gvec)
+        expected = np.array([pinocchio_arm.gravity(oracle, p, x) for x in q])
+        assert np.allclose(G @ gvec, expected, atol=1e-10 * max(1.0, np.abs(expected).max()))
+
+
+def test_generated_friction_routine_against_numpy():
+    model = load(ROOT / "generated" / "lwr")
+    rng = np.random.default_rng(4)
+    f = np.column_stack([rng.uniform(0, 2, 7), rng.uniform(0, 1, 7), rng.uniform(0, 1, 7),
+                         [0.1, 0.0, 0.2, 0.05, 0.1, 0.3, 0.0], [0.01, 0.0, 0.02, 0.0, 0.05, 0.01, 0.0]])
+    for qd in rng.normal(0, 0.5, (20, 7)):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sgn = np.where(f[:, 4] > 0, np.tanh(qd / np.where(f[:, 4] > 0, f[:, 4], 1.0)), np.sign(qd))
+            stribeck = np.where(f[:, 3] > 0, f[:, 2] * np.exp(-(qd / np.where(f[:, 3] > 0, f[:, 3], 1.0)) ** 2), 0.0)
+        expected = (f[:, 0] + stribeck) * sgn + f[:, 1] * qd
+        assert np.allclose(model("friction", qd, f.ravel()), expected, rtol=1e-13, atol=1e-15)
+
+
+def test_diagnose_cli_writes_report_json_figures_and_model(lwr, tmp_path):
+    model, robot, arm, p, trajectories = lwr
+    paths = []
+    for k, name in enumerate(("fit", "held")):
+        t, at, q, qd, qdd, tau = trajectories[name]
+        measured = noisy(tau + np.outer(np.sign(qd[:, 2]), [0, 0, 0.9, 0, 0, 0, 0]), NOISE, k)
+        header = ["t"] + [f"q{j}" for j in range(1, 8)] + [f"qd{j}" for j in range(1, 8)] + \
+                 [f"qdd{j}" for j in range(1, 8)] + [f"tau{j}" for j in range(1, 8)]
+        path = tmp_path / f"{name}.csv"
+        np.savetxt(path, np.column_stack([t, q, qd, qdd, measured]), delimiter=",", header=",".join(header),
+                   comments="", fmt="%.10g")
+        paths.append(path)
+    params = tmp_path / "params.yaml"
+    params.write_text("links:\n" + "".join(
+        f"  - {{m: {float(r[0])!r}, c: {list(map(float, r[1:4]))}, I: {list(map(float, r[4:]))}}}\n" for r in p.reshape(7, 10)))
+    out = tmp_path / "diag"
+    cmd = [sys.executable, "-m", "dyngen", "diagnose", LWR, "--params", params, "--data", paths[0], "--holdout",
+           paths[1], "--model", ROOT / "generated" / "lwr", "--out", out]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "coulomb" in r.stdout and "joints 3" in r.stdout
+    doc = json.loads((out / "diagnosis.json").read_text())
+    (effect,) = doc["selected"]
+    assert effect["effect"] == "coulomb" and effect["joints"] == [3]
+    assert effect["values"]["Fc"] == pytest.approx(0.9, rel=0.05) and effect["std"]["Fc"] > 0
+    assert len(effect["rms_before"]) == len(effect["rms_after"]) == 7
+    assert effect["rms_after"][2] < 0.2 * effect["rms_before"][2]
+    for name in ("report.md", "effects.yaml", "torques.png", "residuals.png", "lwr.urdf", "lwr.xml"):
+        assert (out / name).stat().st_size > 0, name
+    assert 'friction="0.9' in (out / "lwr.urdf").read_text() or 'friction="0.8' in (out / "lwr.urdf").read_text()
+    assert "frictionloss" in (out / "lwr.xml").read_text()
+    # bad input: one line naming file, line and column; nothing written
+    bad = tmp_path / "bad.csv"
+    lines = paths[0].read_text().splitlines()
+    cells = lines[9].split(",")
+    cells[4] = "nan"  # column q4 of file line 10
+    lines[9] = ",".join(cells)
+    bad.write_text("\n".join(lines) + "\n")
+    r = subprocess.run(cmd[:8] + [bad] + cmd[9:-1] + [tmp_path / "none"], capture_output=True, text=True)
+    assert r.returncode != 0 and r.stderr.strip().count("\n") == 0, r.stderr
+    assert "bad.csv: line 10, column q4: nan (NaN or infinite value)" in r.stderr
+    assert not (tmp_path / "none").exists()
