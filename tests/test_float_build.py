@@ -59,6 +59,10 @@ def test_float_build_agrees_with_double(built, tmp_path_factory):
             compare("regressor_gravity", q, *g)
             compare("regressor_inertia", q)
             compare("regressor", q, qd, qdd, *g)
+            # friction: per joint Fc, Fv, Fs, vs, eps (templates/friction.c.j2)
+            (f,) = float_inputs(np.column_stack([rng.uniform(0, 2, n), rng.uniform(0, 1, n), rng.uniform(0, 1, n),
+                                                 rng.uniform(0.01, 0.5, n), rng.uniform(1e-3, 0.05, n)]).ravel())
+            compare("friction", qd, f)
     assert len(worst) == len(double.functions)  # every generated function was compared
     assert max(worst.values()) < TOL, {k: f"{v:.1e}" for k, v in worst.items()}
     assert min(worst.values()) > 0  # the float build really computed in float

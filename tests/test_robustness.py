@@ -107,6 +107,21 @@ static void parameters(long k, real *p)
     }
 }
 
+/* Friction parameters (Fc, Fv, Fs, vs, eps per joint, templates/friction.c.j2): up to 1e3, with
+ * every 4th set using the plain sign and no Stribeck term (vs = eps = 0), and the next one
+ * velocities of 1e-300 (their quotients overflow to infinity inside exp and tanh, which must
+ * still give finite torques). */
+static void friction_parameters(long k, real *f)
+{
+    for (int i = 0; i < 5 * %(dof)d; ++i) {
+        int field = i %% 5;
+        double v = field < 3 ? uniform(0, 1e3) : uniform(0, 10);
+        if (field >= 3 && k %% 4 == 1) v = 0;
+        if (field >= 3 && k %% 4 == 2) v = 1e-300;
+        f[i] = (real)v;
+    }
+}
+
 static int finite_all(const real *x, int n)
 {
     for (int k = 0; k < n; ++k)
@@ -121,18 +136,20 @@ int main(int argc, char **argv)
     real *q = block(%(dof)d), *qd = block(%(dof)d), *qdd = block(%(dof)d);
     real *p = block(%(n_parameters)d), *s = block(%(n_parameters)d);
     real *gravity = block(%(n_gravity_alloc)d);
+    real *f = block(5 * %(dof)d);
 %(outputs)s
     long calls = 0;
     int failed = 0;
     for (long k = 0; k < n_states && !failed; ++k) {
         joints(k, q, qd, qdd);
         if (k %% 16 == 0) parameters(k / 16, p);
+        if (k %% 16 == 0) friction_parameters(k / 16, f);
         fill(gravity, %(n_gravity_alloc)d, -1e3, 1e3);
         if (inject && k == 3) qd[0] = (real)INFINITY;
 %(calls)s
     }
     if (!failed) printf("%%ld states, %%ld calls, every output finite\n", n_states, calls);
-    free(q); free(qd); free(qdd); free(p); free(s); free(gravity);
+    free(q); free(qd); free(qdd); free(p); free(s); free(gravity); free(f);
 %(frees)s
     return failed;
 }
