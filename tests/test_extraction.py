@@ -121,8 +121,11 @@ def consistent_inside_bounds(robot, seed):
     return p
 
 
-@pytest.mark.parametrize("arm", ["lwr", "panda"])
+@pytest.mark.parametrize("arm", ["lwr", "panda", "puma560"])
 def test_exact_consistent_solution_is_found(arm, tmp_path):
+    """Coefficients of known consistent parameters: the best restart reproduces them to 1e-9,
+    at least 95% of the restarts end consistent and most of them exact. (Before the local
+    refinement moved to the standard parameters, 0 of 16 PUMA 560 restarts were exact.)"""
     base = build_arm(ROOT / "examples" / f"{arm}.yaml", tmp_path / "base")
     p_true = consistent_inside_bounds(base.robot, seed=3)
     path = synthetic_yaml(base, p_true, tmp_path)
@@ -133,7 +136,11 @@ def test_exact_consistent_solution_is_found(arm, tmp_path):
         got = base.c(f"pi_{kind}", ex.p)
         assert np.linalg.norm(got - want) <= 1e-9 * np.linalg.norm(want), kind
     assert all(physically_consistent(row) for row in ex.p.reshape(-1, 10))
-    assert ex.stages[-1].consistent >= 0.95 * ex.stages[-1].restarts
+    stage = ex.stages[-1]
+    assert stage.consistent >= 0.95 * stage.restarts
+    norm = np.sqrt(sum(np.sum(t.v ** 2) for t in ex.targets.values()))
+    exact = (stage.restart_violations <= 1e-10) & (np.sqrt(stage.restart_costs) <= 1e-9 * norm)
+    assert exact.mean() >= 0.75, f"{exact.sum()} of {exact.size} restarts exact"
 
 
 def test_conflicting_bounds_are_named(lwr, tmp_path):

@@ -21,7 +21,8 @@ from conftest import ROOT
 from dyngen.runtime import library_sources
 
 FOLDER = ROOT / "generated" / "lwr"
-LIBM = {"sin", "cos", "sinf", "cosf", "sincos", "sincosf"}
+LIBM = {"sin", "cos", "sinf", "cosf", "sincos", "sincosf",
+        "exp", "expf", "tanh", "tanhf"}  # exp and tanh: the optional friction routine (Stribeck term, smooth sign)
 COMPILER_SUPPORT = {"memset", "memcpy", "memmove"}  # GCC's freestanding requirements (gcc docs, "Standards")
 HELPER = re.compile(r"__aeabi_\w+")
 STRICT = ["-std=c99", "-ffreestanding", "-Wall", "-Wextra", "-Werror", "-pedantic"]
