@@ -13,8 +13,10 @@ ALPHAS = ("pi/2", "0", "-pi/2", "pi/2", "-pi/2", "0")
 
 
 def prismatic_index(n: int) -> int:
-    """0-based index of the one prismatic joint: the third joint (the second on a 2-joint arm)."""
-    return min(2, n - 1)
+    """0-based index of the one prismatic joint: the third joint; on a 2-joint arm the first
+    (a prismatic second joint would move along the horizontal z1, and an arm whose gravity
+    vector is identically zero is not what this benchmark is about)."""
+    return 2 if n > 2 else 0
 
 
 def synthetic_arm_yaml(n: int) -> str:
