@@ -382,8 +382,8 @@ def build(arms: list, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path,
 
 # --- measurements -------------------------------------------------------------------------
 
-def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> tuple[dict, dict, float]:
-    """(times, agreement errors, peak RSS of the timing run in MiB)."""
+def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> tuple[dict, dict, tuple]:
+    """(times, agreement errors, (peak RSS of the timing run, the launcher's floor) in MiB)."""
     res = run_measured([exe, "time", models, states, batches, warmup])
     times, errors = {}, {}
     for line in res.stdout.splitlines():
@@ -394,7 +394,7 @@ def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> t
             errors[(tok[1], tok[2])] = float(tok[3])
     if res.returncode != 0:
         raise SystemExit(f"benchmark run failed ({res.returncode}):\n{res.stdout}{res.stderr}")
-    return times, errors, res.max_rss_mib
+    return times, errors, (res.max_rss_mib, res.floor_kib / 1024)
 
 
 def callgrind_ir(exe: Path, models: Path, states: int, arm: str, function: str, side: str, calls: int,
@@ -461,10 +461,11 @@ def table(arms: list, times: dict, irs: dict | None) -> list:
     return rows
 
 
-def write_json(path: Path, arms: list, times: dict, irs: dict | None, errors: dict, peak_mib: float,
+def write_json(path: Path, arms: list, times: dict, irs: dict | None, errors: dict, peak: tuple,
                args) -> None:
     """The same numbers, machine-readable (bench/run_all.py reads them for its summary)."""
-    doc = {"callgrind": bool(irs), "flags": args.flags, "peak_rss_mib": peak_mib, "arms": {}}
+    doc = {"callgrind": bool(irs), "flags": args.flags, "peak_rss_mib": peak[0], "peak_rss_floor_mib": peak[1],
+           "arms": {}}
     for a in arms:
         doc["arms"][a["name"]] = {
             "dof": a["n"],
@@ -550,7 +551,7 @@ def bench(args, work: Path) -> int:
             pin_proc.wait()
 
     log(f"verifying and timing ({args.states} states x {args.batches} batches per function and side) ...")
-    times, errors, peak_mib = timing(exe, work / "models", args.states, args.batches, args.warmup)
+    times, errors, (peak_mib, floor_mib) = timing(exe, work / "models", args.states, args.batches, args.warmup)
     irs = None
     if args.callgrind:
         log(f"callgrind ({args.calls} calls per function and side, minus a 0-call baseline) ...")
@@ -594,7 +595,9 @@ def bench(args, work: Path) -> int:
         "|dyngen - Pinocchio| / max(1, |Pinocchio|)): " + "; ".join(
             f"{a['name']} " + ", ".join(f"{f} {errors[(a['name'], f)]:.1e}"
                                         for f in (*FUNCTIONS, "pinocchio_regressor")) for a in arms),
-        f"- peak memory of the timing run (all arms, one process): {peak_mib:.1f} MiB",
+        f"- peak memory of the timing run (all arms, one process): {peak_mib:.1f} MiB"
+        + (f" (at the measurement floor {floor_mib:.1f} MiB: the process itself needs at most that)"
+           if peak_mib <= floor_mib + 0.5 else ""),
     ]
     if irs:
         info.append(f"- Ir/call: callgrind instructions of a run with {args.calls} calls of one function minus "
@@ -612,7 +615,7 @@ def bench(args, work: Path) -> int:
                        + "\n".join(info) + "\n\n" + markdown(rows) + "\n\n"
                        "ratio = Pinocchio ns/call / dyngen ns/call (above 1: the generated C is faster).\n")
         log(f"wrote {out}")
-        write_json(out.with_suffix(".json"), arms, times, irs, errors, peak_mib, args)
+        write_json(out.with_suffix(".json"), arms, times, irs, errors, (peak_mib, floor_mib), args)
     log(f"done in {time.perf_counter() - start:.0f} s")
     return 0
 

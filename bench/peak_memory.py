@@ -31,7 +31,7 @@ pid = os.posix_spawnp(sys.argv[2], sys.argv[2:], os.environ)
 _, status, usage = os.wait4(pid, 0)
 with open(sys.argv[1], "w") as f:
     json.dump({"returncode": os.waitstatus_to_exitcode(status), "max_rss_kib": usage.ru_maxrss,
-               "floor_kib": floor}, f)
+               "floor_kib": floor, "cpu_seconds": usage.ru_utime + usage.ru_stime}, f)
 """
 
 
@@ -41,6 +41,7 @@ class Measured:
     seconds: float
     max_rss_kib: int  # ru_maxrss is in KiB on Linux
     floor_kib: int  # the launcher's own RSS: a measurement at this value means "at most this"
+    cpu_seconds: float  # user + system CPU time of the command and its waited-for descendants
     stdout: str
     stderr: str
 
@@ -64,7 +65,8 @@ def run_measured(cmd, cwd=None, env=None) -> Measured:
         if not text:
             raise OSError(f"could not run {cmd[0]}: {err.read().strip()}")
         got = json.loads(text)
-        return Measured(got["returncode"], seconds, got["max_rss_kib"], got["floor_kib"], out.read(), err.read())
+        return Measured(got["returncode"], seconds, got["max_rss_kib"], got["floor_kib"], got["cpu_seconds"],
+                        out.read(), err.read())
 
 
 def main(argv=None) -> int:
