@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The whole benchmark suite in one command; writes BENCHMARKS.md at the top level.
 
-    python bench/run_all.py                         # everything, full size (about 15 minutes)
+    python bench/run_all.py                         # everything, full size (6-15 minutes)
     python bench/run_all.py --quick                 # smaller runs of everything (a few minutes)
     python bench/run_all.py --parts dynamics scaling --arms lwr panda
 
@@ -83,6 +83,9 @@ def part_command(part: str, args) -> list | None:
         return [*py, BENCH / "bench_opcounts.py", *arms]
     if part == "dynamics":
         quick = ["--batches", "30"] if args.quick else ["--callgrind"]
+        if not args.quick and not shutil.which("valgrind"):
+            log("warning: valgrind is not installed (DYNGEN_BENCH=1 bash scripts/setup.sh): no instruction counts")
+            quick = []
         return [*py, BENCH / "bench_dynamics.py", *(arms or (["--arms", "lwr", "stanford"] if args.quick else [])),
                 *quick]
     if part == "scaling":
@@ -101,7 +104,7 @@ def run_part(part: str, args) -> Outcome:
     cmd = part_command(part, args)
     out = Outcome(part)
     if cmd is None:
-        out.note = (f"not available: {DIAGNOSIS_SCRIPT.relative_to(ROOT)} does not exist on this branch "
+        out.note = (f"Not available: {DIAGNOSIS_SCRIPT.relative_to(ROOT)} does not exist on this branch "
                     "(`dyngen diagnose` is being written on another branch)")
         log(f"== {part}: {out.note}")
         return out

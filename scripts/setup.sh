@@ -12,6 +12,8 @@ command -v cmake >/dev/null 2>&1 || need_apt+=(cmake)
 [ -f /usr/include/nlopt.h ] || need_apt+=(libnlopt-dev)
 [ -d /usr/include/eigen3 ] || need_apt+=(libeigen3-dev)
 command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
+# The benchmarks (bench/run_all.py) also count instructions with valgrind: DYNGEN_BENCH=1 adds it.
+if [ "${DYNGEN_BENCH:-0}" = 1 ]; then command -v valgrind >/dev/null 2>&1 || need_apt+=(valgrind); fi
 
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "setup: installing system packages: ${need_apt[*]}"
