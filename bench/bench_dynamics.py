@@ -8,9 +8,12 @@ bench/pinocchio_side.cpp) with the same compiler family and the same flags on bo
 check that both sides agree on every state (relative 1e-9), then time, on the same random
 states:
 
-    <name>_rnea         vs pinocchio::rnea
-    <name>_gravity      vs pinocchio::computeGeneralizedGravity
-    <name>_mass_matrix  vs pinocchio::crba (upper triangle only, as crba fills it)
+    <name>_rnea                                 vs pinocchio::rnea
+    <name>_gravity                              vs pinocchio::computeGeneralizedGravity
+    <name>_regressor_gravity, then Y_g pi_g     vs pinocchio::computeGeneralizedGravity
+    <name>_mass_matrix                          vs pinocchio::crba (upper triangle, as crba fills it)
+    <name>_regressor_inertia, then Y_m pi_m     vs pinocchio::crba (Y_m pi_m is the stacked upper triangle)
+    <name>_regressor (n x base coefficients)    vs pinocchio::computeJointTorqueRegressor (n x 10n)
 
 Reported: the median over batches of the per-batch ns/call, the ratio pinocchio/dyngen and
 dyngen's operation counts (manifest.json). --callgrind adds instructions per call measured
@@ -47,9 +50,23 @@ import yaml
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
 sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(BENCH))
 
-FUNCTIONS = ("rnea", "gravity", "mass_matrix")
-PIN_NAMES = {"rnea": "pinocchio::rnea", "gravity": "computeGeneralizedGravity", "mass_matrix": "pinocchio::crba"}
+from peak_memory import run_measured  # noqa: E402
+
+# The compared pairs, in harness.cpp's order: id -> (what dyngen computes, Pinocchio's function).
+PAIRS = {
+    "rnea": ("rnea", "rnea"),
+    "gravity": ("gravity g(q)", "computeGeneralizedGravity"),
+    "yg_pig": ("Y_g(q) pi_g", "computeGeneralizedGravity"),
+    "mass_matrix": ("mass_matrix M(q)", "crba"),
+    "ym_pim": ("Y_m(q) pi_m", "crba"),
+    "regressor": ("base regressor Y(q, qd, qdd)", "computeJointTorqueRegressor"),
+}
+FUNCTIONS = tuple(PAIRS)
+# A pair that multiplies a generated regressor by its coefficients: (regressor function,
+# coefficients). Its operation count adds the dense product, rows x cols multiplications.
+PRODUCTS = {"yg_pig": ("regressor_gravity", "pi_gravity"), "ym_pim": ("regressor_inertia", "pi_inertia")}
 DEFAULT_FLAGS = "-O2 -DNDEBUG"
 
 
@@ -246,8 +263,9 @@ def prepare_arm(yaml_path: Path, gen_root: Path, model_dir: Path) -> dict:
     model, _ = pinocchio_arm.build(Arm.from_yaml(yaml_path), p)
     write_model(model_dir / f"{name}.model", model)
     ops = {f["name"][len(name) + 1:]: f["ops"] for f in manifest["functions"]}
+    shapes = {f["name"][len(name) + 1:]: f["output"]["shape"] for f in manifest["functions"]}
     lo, hi = joint_ranges(yaml_path)
-    return {"name": name, "n": n, "folder": folder, "p": p, "p_source": p_source, "ops": ops,
+    return {"name": name, "n": n, "folder": folder, "p": p, "p_source": p_source, "ops": ops, "shapes": shapes,
             "qlo": lo, "qhi": hi, "joint_types": "".join("R" if t == "revolute" else "P"
                                                          for t in manifest["joint_types"])}
 
@@ -270,6 +288,18 @@ def arms_inc(arms: list) -> str:
             "  }",
             f"  static void gravity(const double *q, const double *s, double *g) {{ {name}_gravity(q, s, g); }}",
             f"  static void mass_matrix(const double *q, const double *s, double *M) {{ {name}_mass_matrix(q, s, M); }}",
+            f"  static constexpr int n_stacked = {a['shapes']['regressor_inertia'][0]};",
+            f"  static constexpr int n_pi_gravity = {a['shapes']['pi_gravity'][0]};",
+            f"  static constexpr int n_pi_inertia = {a['shapes']['pi_inertia'][0]};",
+            f"  static constexpr int n_pi_full = {a['shapes']['pi_full'][0]};",
+            f"  static void pi_gravity(const double *p, double *pi) {{ {name}_pi_gravity(p, pi); }}",
+            f"  static void pi_inertia(const double *p, double *pi) {{ {name}_pi_inertia(p, pi); }}",
+            f"  static void pi_full(const double *p, double *pi) {{ {name}_pi_full(p, pi); }}",
+            f"  static void regressor_gravity(const double *q, double *Y) {{ {name}_regressor_gravity(q, Y); }}",
+            f"  static void regressor_inertia(const double *q, double *Y) {{ {name}_regressor_inertia(q, Y); }}",
+            "  static void regressor(const double *q, const double *qd, const double *qdd, double *Y) {",
+            f"    {name}_regressor(q, qd, qdd, Y);",
+            "  }",
             "};",
             f"const double Arm_{name}::p[{10 * n}] = {{{', '.join(repr(float(x)) for x in a['p'])}}};",
             f"const double Arm_{name}::qlo[{n}] = {{{', '.join(repr(float(x)) for x in a['qlo'])}}};",
@@ -336,7 +366,7 @@ def finish_pinocchio_object(proc) -> None:
 def build(arms: list, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path, pin_proc, libs: list) -> Path:
     objs = []
     for a in arms:
-        for src in (f"{a['name']}_dynamics.c", f"{a['name']}_parameters.c"):
+        for src in (f"{a['name']}_dynamics.c", f"{a['name']}_parameters.c", f"{a['name']}_regressors.c"):
             obj = work / "obj" / (src[:-2] + ".o")
             run([cc, "-std=c99", *flags, "-c", str(a["folder"] / src), "-o", str(obj)])
             objs.append(obj)
@@ -352,9 +382,9 @@ def build(arms: list, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path,
 
 # --- measurements -------------------------------------------------------------------------
 
-def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> tuple[dict, dict]:
-    res = subprocess.run([str(exe), "time", str(models), str(states), str(batches), str(warmup)],
-                         capture_output=True, text=True)
+def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> tuple[dict, dict, tuple]:
+    """(times, agreement errors, (peak RSS of the timing run, the launcher's floor) in MiB)."""
+    res = run_measured([exe, "time", models, states, batches, warmup])
     times, errors = {}, {}
     for line in res.stdout.splitlines():
         tok = line.split()
@@ -364,7 +394,7 @@ def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> t
             errors[(tok[1], tok[2])] = float(tok[3])
     if res.returncode != 0:
         raise SystemExit(f"benchmark run failed ({res.returncode}):\n{res.stdout}{res.stderr}")
-    return times, errors
+    return times, errors, (res.max_rss_mib, res.floor_kib / 1024)
 
 
 def callgrind_ir(exe: Path, models: Path, states: int, arm: str, function: str, side: str, calls: int,
@@ -399,8 +429,21 @@ def callgrind_all(exe: Path, models: Path, states: int, arms: list, calls: int, 
 
 # --- report -------------------------------------------------------------------------------
 
+def pair_ops(arm: dict, pair: str) -> dict:
+    """dyngen's operation counts of a pair's timed work: the generated function's (manifest),
+    plus, for Y pi, the dense product (rows x cols multiplications, rows x (cols - 1) additions)."""
+    if pair not in PRODUCTS:
+        return dict(arm["ops"][pair])
+    regressor, _ = PRODUCTS[pair]
+    rows, cols = arm["shapes"][regressor]
+    ops = dict(arm["ops"][regressor])
+    ops["mul"] += rows * cols
+    ops["add"] += rows * (cols - 1)
+    return ops
+
+
 def table(arms: list, times: dict, irs: dict | None) -> list:
-    head = ["arm", "function", "dyngen ns/call", "Pinocchio ns/call", "ratio (Pin/dyngen)",
+    head = ["arm", "dyngen", "Pinocchio", "dyngen ns/call", "Pinocchio ns/call", "ratio (Pin/dyngen)",
             "dyngen mul", "dyngen add"]
     if irs:
         head += ["dyngen Ir/call", "Pinocchio Ir/call", "Ir ratio"]
@@ -408,8 +451,8 @@ def table(arms: list, times: dict, irs: dict | None) -> list:
     for a in arms:
         for f in FUNCTIONS:
             d, p = times[(a["name"], f)]
-            ops = a["ops"][f]
-            row = [a["name"], f, f"{d:.1f}", f"{p:.1f}", f"{p / d:.2f}x",
+            ops = pair_ops(a, f)
+            row = [a["name"], PAIRS[f][0], PAIRS[f][1], f"{d:.1f}", f"{p:.1f}", f"{p / d:.2f}x",
                    str(ops["mul"]), str(ops["add"])]
             if irs:
                 di, pi = irs[(a["name"], f)]
@@ -418,8 +461,26 @@ def table(arms: list, times: dict, irs: dict | None) -> list:
     return rows
 
 
+def write_json(path: Path, arms: list, times: dict, irs: dict | None, errors: dict, peak: tuple,
+               args) -> None:
+    """The same numbers, machine-readable (bench/run_all.py reads them for its summary)."""
+    doc = {"callgrind": bool(irs), "flags": args.flags, "peak_rss_mib": peak[0], "peak_rss_floor_mib": peak[1],
+           "arms": {}}
+    for a in arms:
+        doc["arms"][a["name"]] = {
+            "dof": a["n"],
+            "regressor_shape": {"dyngen": a["shapes"]["regressor"], "pinocchio": [a["n"], 10 * a["n"]]},
+            "pairs": {f: {"dyngen_ns": times[(a["name"], f)][0], "pinocchio_ns": times[(a["name"], f)][1],
+                          "dyngen_ir": irs[(a["name"], f)][0] if irs else None,
+                          "pinocchio_ir": irs[(a["name"], f)][1] if irs else None,
+                          "max_rel_error": errors[(a["name"], f)], "ops": pair_ops(a, f)}
+                      for f in FUNCTIONS},
+        }
+    path.write_text(json.dumps(doc, indent=1) + "\n")
+
+
 def markdown(rows: list) -> str:
-    right = [False, False] + [True] * (len(rows[0]) - 2)
+    right = [False, False, False] + [True] * (len(rows[0]) - 3)
     lines = ["| " + " | ".join(rows[0]) + " |",
              "|" + "|".join("---:" if r else "---" for r in right) + "|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows[1:]]
@@ -428,7 +489,7 @@ def markdown(rows: list) -> str:
 
 def plain(rows: list) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    return "\n".join("  ".join(c.ljust(w) if i < 2 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths)))
+    return "\n".join("  ".join(c.ljust(w) if i < 3 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths)))
                      for r in rows)
 
 
@@ -490,7 +551,7 @@ def bench(args, work: Path) -> int:
             pin_proc.wait()
 
     log(f"verifying and timing ({args.states} states x {args.batches} batches per function and side) ...")
-    times, errors = timing(exe, work / "models", args.states, args.batches, args.warmup)
+    times, errors, (peak_mib, floor_mib) = timing(exe, work / "models", args.states, args.batches, args.warmup)
     irs = None
     if args.callgrind:
         log(f"callgrind ({args.calls} calls per function and side, minus a 0-call baseline) ...")
@@ -502,8 +563,8 @@ def bench(args, work: Path) -> int:
         f"- machine: {machine()}",
         f"- C compiler: `{cc}` ({cc_v}), `-std=c99 {args.flags}` (generated C)",
         f"- C++ compiler: `{cxx}` ({cxx_v}), `-std=c++17 {args.flags}` (harness and Pinocchio)",
-        (f"- Pinocchio {tool['version']} (pip wheel `pin`), PRECOMPILED: rnea, crba, computeGeneralizedGravity "
-         f"run from the wheel's {pinocchio_library(tool) / 'libpinocchio_default.so'} (built by "
+        (f"- Pinocchio {tool['version']} (pip wheel `pin`), PRECOMPILED: the algorithms "
+         f"that have explicit instantiations run from the wheel's {pinocchio_library(tool) / 'libpinocchio_default.so'} (built by "
          f"{wheel_compiler(tool)} with the wheel's flags, NOT the flags above); definitions "
          f"{' '.join('-D' + d for d in tool['defines'])} -DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION"
          if args.pinocchio_lib else
@@ -515,12 +576,28 @@ def bench(args, work: Path) -> int:
         f"the same for both sides; {args.batches} timed batches per function and side after {args.warmup} "
         "warm-up batches, interleaved; ns/call = median over batches of (batch time / states)",
         "- every call is an out-of-line call into another translation unit on both sides; the outputs are "
-        "summed into a volatile sink (for the inertia matrix: the upper triangle on both sides)",
+        "summed into a volatile sink (for the inertia matrix: the upper triangle on both sides; for the "
+        "regressors only their first and last entries, since summing hundreds of entries would cost more "
+        "than the generated regressor itself)",
         "- crba fills only the upper triangle of M; the generated mass matrix writes the full matrix",
+        "- Y_g pi_g and Y_m pi_m: the generated regressor, then a plain dense matrix-vector product with the "
+        "base coefficients (computed once from p by the generated pi functions), both inside the timed call; "
+        "their mul/add columns include the product (rows x cols multiplications). Y_m pi_m is the stacked "
+        "upper triangle of M (M11, M12, ..., MNN), compared with crba's upper triangle",
+        "- the regressors are different matrices: dyngen's is the BASE regressor, n x (number of base "
+        "coefficients), Pinocchio's computeJointTorqueRegressor is n x 10n (all standard parameters, "
+        "structurally rank deficient): " + "; ".join(
+            f"{a['name']} {a['n']} x {a['shapes']['regressor'][1]} vs {a['n']} x {10 * a['n']}" for a in arms)
+        + ". Checked through what they are for: dyngen's Y pi_full and Pinocchio's regressor times its "
+        "dynamic parameters, both against pinocchio::rnea",
         "- parameters: " + "; ".join(f"{a['name']} {a['p_source']}" for a in arms),
         "- agreement checked before timing, on every state (max relative error "
         "|dyngen - Pinocchio| / max(1, |Pinocchio|)): " + "; ".join(
-            f"{a['name']} " + ", ".join(f"{f} {errors[(a['name'], f)]:.1e}" for f in FUNCTIONS) for a in arms),
+            f"{a['name']} " + ", ".join(f"{f} {errors[(a['name'], f)]:.1e}"
+                                        for f in (*FUNCTIONS, "pinocchio_regressor")) for a in arms),
+        f"- peak memory of the timing run (all arms, one process): {peak_mib:.1f} MiB"
+        + (f" (at the measurement floor {floor_mib:.1f} MiB: the process itself needs at most that)"
+           if peak_mib <= floor_mib + 0.5 else ""),
     ]
     if irs:
         info.append(f"- Ir/call: callgrind instructions of a run with {args.calls} calls of one function minus "
@@ -538,6 +615,7 @@ def bench(args, work: Path) -> int:
                        + "\n".join(info) + "\n\n" + markdown(rows) + "\n\n"
                        "ratio = Pinocchio ns/call / dyngen ns/call (above 1: the generated C is faster).\n")
         log(f"wrote {out}")
+        write_json(out.with_suffix(".json"), arms, times, irs, errors, (peak_mib, floor_mib), args)
     log(f"done in {time.perf_counter() - start:.0f} s")
     return 0
 

@@ -48,7 +48,8 @@ def worker(yaml_path: str, out_dir: str) -> None:
     from dyngen.progress import Progress
 
     class Recorder(Progress):
-        """Progress that records how long each of build()'s steps takes, silently."""
+        """Progress that records how long each of build()'s steps takes (wall and CPU
+        seconds of this process; CPU time is what other processes' load changes least)."""
 
         def __init__(self):
             super().__init__(quiet=True)
@@ -56,24 +57,25 @@ def worker(yaml_path: str, out_dir: str) -> None:
 
         @contextmanager
         def step(self, what: str):
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             yield
-            self.steps.append((what, time.perf_counter() - start))
+            self.steps.append((what, time.perf_counter() - start, time.process_time() - cpu))
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     robot = load_robot(yaml_path)
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     recorder = Recorder()
     _, emitted = build(robot, recorder)
-    t2 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.process_time()
     folder = Path(out_dir) / robot.name
     write_folder(folder, emitted.files)
-    times = {"load": t1 - t0, "build": t2 - t1}
-    for what, seconds in recorder.steps:
+    times, cpu_times = {"load": t1 - t0, "build": t2 - t1}, {"load": c1 - c0, "build": c2 - c1}
+    for what, seconds, cpu_seconds in recorder.steps:
         key = what.split()[0]  # "derive regressors ...", "reduce to ...", "emit C"
         times[key] = times.get(key, 0.0) + seconds
+        cpu_times[key] = cpu_times.get(key, 0.0) + cpu_seconds
     print(json.dumps({"name": robot.name, "dof": robot.dof, "folder": str(folder), "times": times,
-                      "steps": recorder.steps}))
+                      "cpu_times": cpu_times, "steps": recorder.steps}))
 
 
 def generate_once(yaml_path: Path, out_dir: Path) -> dict:

@@ -2,7 +2,7 @@
 // model, the same random states, the same compiler and flags.
 //
 // "arms.inc" is written by bench_dynamics.py: one struct per arm wrapping the generated
-// functions (direct calls), its nominal dynamic parameters p and joint ranges, and
+// functions (direct calls), its sizes, nominal dynamic parameters p and joint ranges, and
 // BENCH_ARMS(X) listing the structs.
 //
 //   harness time      MODELS_DIR STATES BATCHES WARMUP
@@ -11,6 +11,16 @@
 //   harness callgrind MODELS_DIR STATES ARM FUNCTION SIDE CALLS
 //       the same set-up (model, states, a short verification that calls every function),
 //       then CALLS calls of one function on one side (CALLS = 0: the baseline run).
+//
+// The compared pairs (FUNCTION):
+//   rnea         <arm>_rnea                                vs pinocchio::rnea
+//   gravity      <arm>_gravity                             vs computeGeneralizedGravity
+//   yg_pig       <arm>_regressor_gravity, then Y_g pi_g    vs computeGeneralizedGravity
+//   mass_matrix  <arm>_mass_matrix                         vs crba
+//   ym_pim       <arm>_regressor_inertia, then Y_m pi_m    vs crba
+//   regressor    <arm>_regressor (n x base coefficients)   vs computeJointTorqueRegressor (n x 10n)
+// pi_g and pi_m are computed once from p (<arm>_pi_gravity / _pi_inertia): they are constants
+// of the robot; the matrix-vector product is part of the timed work.
 #include "pinocchio_side.hpp"
 
 #include <algorithm>
@@ -27,9 +37,18 @@
 
 namespace {
 
-volatile double g_sink;  // every output is summed into this, so no call can be dropped
+volatile double g_sink;  // every call's result feeds this, so no call can be dropped
 
 const double kTolerance = 1e-9;  // |dyngen - pinocchio| / max(1, |pinocchio|)
+
+enum Fn { RNEA, GRAVITY, YG_PIG, MASS_MATRIX, YM_PIM, REGRESSOR, N_FN };
+const char *const kFnNames[N_FN] = {"rnea", "gravity", "yg_pig", "mass_matrix", "ym_pim", "regressor"};
+
+int fn_from_name(const std::string &name) {
+  for (int f = 0; f < N_FN; ++f)
+    if (name == kFnNames[f]) return f;
+  return -1;
+}
 
 struct Config {
   bool timing = true;
@@ -37,15 +56,17 @@ struct Config {
   int states = 1000;
   int batches = 200;
   int warmup = 10;
-  std::string arm, function, side;
+  std::string arm, side;
+  int function = -1;
   long calls = 0;
 };
 
 template <class A>
 struct Setup {
   PinArm *pin = nullptr;
-  std::vector<double> s, q, qd, qdd;
-  std::vector<double> out;  // dyngen output buffer (n x n, the largest)
+  std::vector<double> s, pi_g, pi_m, pi_f, pin_params, q, qd, qdd;
+  std::vector<double> out;  // dyngen outputs: n x n (the largest vector-like output)
+  std::vector<double> Y;    // dyngen regressors: the largest of Y_g, Y_m, Y
   int count = 0;
   const double *Q(int k) const { return q.data() + (size_t)k * A::n; }
   const double *QD(int k) const { return qd.data() + (size_t)k * A::n; }
@@ -64,6 +85,14 @@ bool make_setup(const Config &cfg, Setup<A> &S) {
   }
   S.s.assign(10 * n, 0.0);
   A::std_from_dyn(A::p, S.s.data());
+  S.pi_g.assign(A::n_pi_gravity, 0.0);
+  S.pi_m.assign(A::n_pi_inertia, 0.0);
+  S.pi_f.assign(A::n_pi_full, 0.0);
+  A::pi_gravity(A::p, S.pi_g.data());
+  A::pi_inertia(A::p, S.pi_m.data());
+  A::pi_full(A::p, S.pi_f.data());
+  S.pin_params.assign(10 * n, 0.0);
+  pin_parameters(S.pin, S.pin_params.data());
   S.count = cfg.states;
   std::mt19937_64 rng(20240611u);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -77,85 +106,131 @@ bool make_setup(const Config &cfg, Setup<A> &S) {
       S.qdd[(size_t)k * n + i] = -5.0 + 10.0 * unit(rng);
     }
   S.out.assign((size_t)n * n, 0.0);
+  const size_t ny = std::max({(size_t)n * A::n_pi_gravity, (size_t)A::n_stacked * A::n_pi_inertia,
+                              (size_t)n * A::n_pi_full});
+  S.Y.assign(ny, 0.0);
   return true;
 }
 
-// One evaluation of each function on each side; returns the sum of the outputs
-// (for the inertia matrix: the upper triangle, which is all crba fills).
-template <class A>
-inline double dyn_rnea(Setup<A> &S, int k) {
-  A::rnea(S.Q(k), S.QD(k), S.QDD(k), S.s.data(), S.out.data());
+// y = A x, A rows x cols row-major: the plain product a user of the regressors writes.
+inline void matvec(const double *A, const double *x, int rows, int cols, double *y) {
+  for (int r = 0; r < rows; ++r) {
+    double acc = 0.0;
+    for (int c = 0; c < cols; ++c) acc += A[(size_t)r * cols + c] * x[c];
+    y[r] = acc;
+  }
+}
+
+// The timed work of one function on one side for state k; writes the comparable output
+// (tau, g, the upper triangle of M, or the regressor) and returns a value that depends on
+// it. Vector outputs are summed (n to n(n+1)/2 entries, as before). The regressors have
+// hundreds to thousands of entries: summing them all would cost more than the dyngen call
+// itself, so only their first and last entries feed the sink; the calls are out of line
+// (other translation units, no LTO), so they cannot be dropped either way.
+template <class A, int F>
+inline double dyngen_call(Setup<A> &S, int k) {
+  const int n = A::n;
   double acc = 0.0;
-  for (int i = 0; i < A::n; ++i) acc += S.out[i];
+  if constexpr (F == RNEA) {
+    A::rnea(S.Q(k), S.QD(k), S.QDD(k), S.s.data(), S.out.data());
+    for (int i = 0; i < n; ++i) acc += S.out[i];
+  } else if constexpr (F == GRAVITY) {
+    A::gravity(S.Q(k), S.s.data(), S.out.data());
+    for (int i = 0; i < n; ++i) acc += S.out[i];
+  } else if constexpr (F == YG_PIG) {
+    A::regressor_gravity(S.Q(k), S.Y.data());
+    matvec(S.Y.data(), S.pi_g.data(), n, A::n_pi_gravity, S.out.data());
+    for (int i = 0; i < n; ++i) acc += S.out[i];
+  } else if constexpr (F == MASS_MATRIX) {
+    A::mass_matrix(S.Q(k), S.s.data(), S.out.data());  // row-major, full
+    for (int i = 0; i < n; ++i)
+      for (int j = i; j < n; ++j) acc += S.out[(size_t)i * n + j];
+  } else if constexpr (F == YM_PIM) {
+    A::regressor_inertia(S.Q(k), S.Y.data());  // stacked upper triangle, row by row
+    matvec(S.Y.data(), S.pi_m.data(), A::n_stacked, A::n_pi_inertia, S.out.data());
+    for (int i = 0; i < A::n_stacked; ++i) acc += S.out[i];
+  } else {
+    A::regressor(S.Q(k), S.QD(k), S.QDD(k), S.Y.data());  // n x n_pi_full, row-major
+    acc = S.Y[0] + S.Y[(size_t)n * A::n_pi_full - 1];
+  }
   return acc;
 }
-template <class A>
-inline double pin_rnea_(Setup<A> &S, int k) {
-  const double *t = pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k));
+
+template <class A, int F>
+inline double pinocchio_call(Setup<A> &S, int k) {
+  const int n = A::n;
   double acc = 0.0;
-  for (int i = 0; i < A::n; ++i) acc += t[i];
-  return acc;
-}
-template <class A>
-inline double dyn_gravity(Setup<A> &S, int k) {
-  A::gravity(S.Q(k), S.s.data(), S.out.data());
-  double acc = 0.0;
-  for (int i = 0; i < A::n; ++i) acc += S.out[i];
-  return acc;
-}
-template <class A>
-inline double pin_gravity_(Setup<A> &S, int k) {
-  const double *g = pin_gravity(S.pin, S.Q(k));
-  double acc = 0.0;
-  for (int i = 0; i < A::n; ++i) acc += g[i];
-  return acc;
-}
-template <class A>
-inline double dyn_mass(Setup<A> &S, int k) {
-  A::mass_matrix(S.Q(k), S.s.data(), S.out.data());  // row-major, full
-  double acc = 0.0;
-  for (int i = 0; i < A::n; ++i)
-    for (int j = i; j < A::n; ++j) acc += S.out[(size_t)i * A::n + j];
-  return acc;
-}
-template <class A>
-inline double pin_mass(Setup<A> &S, int k) {
-  const double *M = pin_crba(S.pin, S.Q(k));  // column-major, upper triangle
-  double acc = 0.0;
-  for (int i = 0; i < A::n; ++i)
-    for (int j = i; j < A::n; ++j) acc += M[i + (size_t)j * A::n];
+  if constexpr (F == RNEA) {
+    const double *t = pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k));
+    for (int i = 0; i < n; ++i) acc += t[i];
+  } else if constexpr (F == GRAVITY || F == YG_PIG) {
+    const double *g = pin_gravity(S.pin, S.Q(k));
+    for (int i = 0; i < n; ++i) acc += g[i];
+  } else if constexpr (F == MASS_MATRIX || F == YM_PIM) {
+    const double *M = pin_crba(S.pin, S.Q(k));  // column-major, upper triangle
+    for (int i = 0; i < n; ++i)
+      for (int j = i; j < n; ++j) acc += M[i + (size_t)j * n];
+  } else {
+    const double *Y = pin_regressor(S.pin, S.Q(k), S.QD(k), S.QDD(k));  // n x 10n, column-major
+    acc = Y[0] + Y[(size_t)n * 10 * n - 1];
+  }
   return acc;
 }
 
 double rel_err(double a, double b) { return std::fabs(a - b) / std::max(1.0, std::fabs(b)); }
 
-// Compares all three functions on the first `count` states; prints VERIFY lines.
+// Compares every pair on the first `count` states; prints VERIFY lines. For the regressors:
+// dyngen's Y pi_full and Pinocchio's regressor times its own parameters, both against
+// pinocchio::rnea (the two regressors have different columns, so they are compared through
+// what they are for).
 template <class A>
 bool verify(Setup<A> &S, int count, bool print) {
   const int n = A::n;
-  double e_rnea = 0.0, e_grav = 0.0, e_mass = 0.0;
-  std::vector<double> M((size_t)n * n);
+  double err[N_FN + 1] = {0.0};  // the last: Pinocchio's regressor times its parameters vs rnea
+  std::vector<double> v((size_t)n * n), tau(n);
+  auto upper = [&](const double *M_colmajor, int i, int j) { return M_colmajor[i + (size_t)j * n]; };
   for (int k = 0; k < count; ++k) {
-    A::rnea(S.Q(k), S.QD(k), S.QDD(k), S.s.data(), S.out.data());
     const double *t = pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k));
-    for (int i = 0; i < n; ++i) e_rnea = std::max(e_rnea, rel_err(S.out[i], t[i]));
-    A::gravity(S.Q(k), S.s.data(), S.out.data());
+    std::copy(t, t + n, tau.begin());
+    A::rnea(S.Q(k), S.QD(k), S.QDD(k), S.s.data(), v.data());
+    for (int i = 0; i < n; ++i) err[RNEA] = std::max(err[RNEA], rel_err(v[i], tau[i]));
+    A::regressor(S.Q(k), S.QD(k), S.QDD(k), S.Y.data());
+    matvec(S.Y.data(), S.pi_f.data(), n, A::n_pi_full, v.data());
+    for (int i = 0; i < n; ++i) err[REGRESSOR] = std::max(err[REGRESSOR], rel_err(v[i], tau[i]));
+    const double *Yp = pin_regressor(S.pin, S.Q(k), S.QD(k), S.QDD(k));
+    for (int i = 0; i < n; ++i) {
+      double acc = 0.0;
+      for (int c = 0; c < 10 * n; ++c) acc += Yp[i + (size_t)c * n] * S.pin_params[c];
+      err[N_FN] = std::max(err[N_FN], rel_err(acc, tau[i]));
+    }
+
     const double *g = pin_gravity(S.pin, S.Q(k));
-    for (int i = 0; i < n; ++i) e_grav = std::max(e_grav, rel_err(S.out[i], g[i]));
-    A::mass_matrix(S.Q(k), S.s.data(), M.data());
-    const double *P = pin_crba(S.pin, S.Q(k));
+    A::gravity(S.Q(k), S.s.data(), v.data());
+    for (int i = 0; i < n; ++i) err[GRAVITY] = std::max(err[GRAVITY], rel_err(v[i], g[i]));
+    A::regressor_gravity(S.Q(k), S.Y.data());
+    matvec(S.Y.data(), S.pi_g.data(), n, A::n_pi_gravity, v.data());
+    for (int i = 0; i < n; ++i) err[YG_PIG] = std::max(err[YG_PIG], rel_err(v[i], g[i]));
+
+    const double *M = pin_crba(S.pin, S.Q(k));
+    A::mass_matrix(S.Q(k), S.s.data(), v.data());
     for (int i = 0; i < n; ++i)
-      for (int j = i; j < n; ++j) e_mass = std::max(e_mass, rel_err(M[(size_t)i * n + j], P[i + (size_t)j * n]));
+      for (int j = i; j < n; ++j)
+        err[MASS_MATRIX] = std::max(err[MASS_MATRIX], rel_err(v[(size_t)i * n + j], upper(M, i, j)));
+    A::regressor_inertia(S.Q(k), S.Y.data());
+    matvec(S.Y.data(), S.pi_m.data(), A::n_stacked, A::n_pi_inertia, v.data());
+    for (int i = 0, r = 0; i < n; ++i)
+      for (int j = i; j < n; ++j, ++r) err[YM_PIM] = std::max(err[YM_PIM], rel_err(v[r], upper(M, i, j)));
   }
-  if (print) {
-    std::printf("VERIFY %s rnea %.3e\n", A::name, e_rnea);
-    std::printf("VERIFY %s gravity %.3e\n", A::name, e_grav);
-    std::printf("VERIFY %s mass_matrix %.3e\n", A::name, e_mass);
+  bool ok = true;
+  for (int f = 0; f <= N_FN; ++f) {
+    const char *what = f < N_FN ? kFnNames[f] : "pinocchio_regressor";
+    if (print) std::printf("VERIFY %s %s %.3e\n", A::name, what, err[f]);
+    if (!(err[f] <= kTolerance)) {
+      std::fprintf(stderr, "%s: %s disagrees (max relative error %.3e > %.0e)\n", A::name, what, err[f],
+                   kTolerance);
+      ok = false;
+    }
   }
-  const bool ok = e_rnea <= kTolerance && e_grav <= kTolerance && e_mass <= kTolerance;
-  if (!ok)
-    std::fprintf(stderr, "%s: dyngen and Pinocchio disagree (max relative error rnea %.3e, gravity %.3e, "
-                 "mass matrix %.3e > %.0e)\n", A::name, e_rnea, e_grav, e_mass, kTolerance);
   return ok;
 }
 
@@ -178,25 +253,37 @@ double median(std::vector<double> v) {
 }
 
 // Interleaved batches (the order alternates), medians of the per-batch ns/call.
-template <class FD, class FP>
-void time_pair(const Config &cfg, const char *arm, const char *function, int count, FD dyn, FP pin) {
+template <class A, int F>
+void time_pair(const Config &cfg, Setup<A> &S) {
+  auto dyn = [&](int k) { return dyngen_call<A, F>(S, k); };
+  auto pin = [&](int k) { return pinocchio_call<A, F>(S, k); };
   std::vector<double> td, tp;
   for (int b = 0; b < cfg.warmup + cfg.batches; ++b) {
     double d, p;
     if (b % 2 == 0) {
-      d = batch_ns(dyn, count);
-      p = batch_ns(pin, count);
+      d = batch_ns(dyn, S.count);
+      p = batch_ns(pin, S.count);
     } else {
-      p = batch_ns(pin, count);
-      d = batch_ns(dyn, count);
+      p = batch_ns(pin, S.count);
+      d = batch_ns(dyn, S.count);
     }
     if (b >= cfg.warmup) {
       td.push_back(d);
       tp.push_back(p);
     }
   }
-  std::printf("TIME %s %s %.3f %.3f\n", arm, function, median(td), median(tp));
+  std::printf("TIME %s %s %.3f %.3f\n", A::name, kFnNames[F], median(td), median(tp));
   std::fflush(stdout);
+}
+
+template <class A, int F>
+double call_many(Setup<A> &S, bool dyngen, long calls) {
+  double acc = 0.0;
+  for (long c = 0; c < calls; ++c) {
+    const int k = (int)(c % S.count);
+    acc += dyngen ? dyngen_call<A, F>(S, k) : pinocchio_call<A, F>(S, k);
+  }
+  return acc;
 }
 
 template <class A>
@@ -206,25 +293,22 @@ int run(const Config &cfg) {
   if (!make_setup(cfg, S)) return 2;
   if (!verify(S, cfg.timing ? S.count : std::min(S.count, 10), cfg.timing)) return 3;
   if (cfg.timing) {
-    time_pair(cfg, A::name, "rnea", S.count, [&](int k) { return dyn_rnea(S, k); },
-              [&](int k) { return pin_rnea_(S, k); });
-    time_pair(cfg, A::name, "gravity", S.count, [&](int k) { return dyn_gravity(S, k); },
-              [&](int k) { return pin_gravity_(S, k); });
-    time_pair(cfg, A::name, "mass_matrix", S.count, [&](int k) { return dyn_mass(S, k); },
-              [&](int k) { return pin_mass(S, k); });
+    time_pair<A, RNEA>(cfg, S);
+    time_pair<A, GRAVITY>(cfg, S);
+    time_pair<A, YG_PIG>(cfg, S);
+    time_pair<A, MASS_MATRIX>(cfg, S);
+    time_pair<A, YM_PIM>(cfg, S);
+    time_pair<A, REGRESSOR>(cfg, S);
   } else {
     const bool dyn = cfg.side == "dyngen";
-    double acc = 0.0;
-    for (long c = 0; c < cfg.calls; ++c) {
-      const int k = (int)(c % S.count);
-      if (cfg.function == "rnea")
-        acc += dyn ? dyn_rnea(S, k) : pin_rnea_(S, k);
-      else if (cfg.function == "gravity")
-        acc += dyn ? dyn_gravity(S, k) : pin_gravity_(S, k);
-      else
-        acc += dyn ? dyn_mass(S, k) : pin_mass(S, k);
+    switch (cfg.function) {
+      case RNEA: g_sink = call_many<A, RNEA>(S, dyn, cfg.calls); break;
+      case GRAVITY: g_sink = call_many<A, GRAVITY>(S, dyn, cfg.calls); break;
+      case YG_PIG: g_sink = call_many<A, YG_PIG>(S, dyn, cfg.calls); break;
+      case MASS_MATRIX: g_sink = call_many<A, MASS_MATRIX>(S, dyn, cfg.calls); break;
+      case YM_PIM: g_sink = call_many<A, YM_PIM>(S, dyn, cfg.calls); break;
+      default: g_sink = call_many<A, REGRESSOR>(S, dyn, cfg.calls); break;
     }
-    g_sink = acc;
   }
   pin_free(S.pin);
   return 0;
@@ -233,7 +317,8 @@ int run(const Config &cfg) {
 int usage() {
   std::fprintf(stderr,
                "usage: harness time MODELS_DIR STATES BATCHES WARMUP\n"
-               "       harness callgrind MODELS_DIR STATES ARM {rnea|gravity|mass_matrix} {dyngen|pinocchio} CALLS\n");
+               "       harness callgrind MODELS_DIR STATES ARM "
+               "{rnea|gravity|yg_pig|mass_matrix|ym_pim|regressor} {dyngen|pinocchio} CALLS\n");
   return 1;
 }
 
@@ -251,10 +336,10 @@ int main(int argc, char **argv) {
     cfg.models = argv[2];
     cfg.states = std::atoi(argv[3]);
     cfg.arm = argv[4];
-    cfg.function = argv[5];
+    cfg.function = fn_from_name(argv[5]);
     cfg.side = argv[6];
     cfg.calls = std::atol(argv[7]);
-    if (cfg.function != "rnea" && cfg.function != "gravity" && cfg.function != "mass_matrix") return usage();
+    if (cfg.function < 0) return usage();
     if (cfg.side != "dyngen" && cfg.side != "pinocchio") return usage();
   } else {
     return usage();

@@ -5,6 +5,7 @@
 #include "pinocchio_side.hpp"
 
 #include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/regressor.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 
 #include <cstdio>
@@ -90,4 +91,17 @@ const double *pin_gravity(PinArm *arm, const double *q) {
 const double *pin_crba(PinArm *arm, const double *q) {
   Eigen::Map<const Eigen::VectorXd> qm(q, arm->nv);
   return pinocchio::crba(arm->model, arm->data, qm).data();
+}
+
+const double *pin_regressor(PinArm *arm, const double *q, const double *qd, const double *qdd) {
+  const int n = arm->nv;
+  Eigen::Map<const Eigen::VectorXd> qm(q, n), vm(qd, n), am(qdd, n);
+  return pinocchio::computeJointTorqueRegressor(arm->model, arm->data, qm, vm, am).data();
+}
+
+void pin_parameters(const PinArm *arm, double *out) {
+  for (int j = 1; j < arm->model.njoints; ++j) {
+    const Eigen::Matrix<double, 10, 1> v = arm->model.inertias[j].toDynamicParameters();
+    for (int k = 0; k < 10; ++k) out[10 * (j - 1) + k] = v[k];
+  }
 }

@@ -19,3 +19,9 @@ const double *pin_gravity(PinArm *arm, const double *q);
 // pinocchio::crba (default convention); returns data.M, column-major nv x nv, of which
 // crba fills only the upper triangle (M(i, j), i <= j, at [i + j * nv]).
 const double *pin_crba(PinArm *arm, const double *q);
+// pinocchio::computeJointTorqueRegressor; returns data.jointTorqueRegressor, column-major
+// nv x 10 nv, its columns Pinocchio's dynamic parameters per body (see pin_parameters).
+const double *pin_regressor(PinArm *arm, const double *q, const double *qd, const double *qdd);
+// Pinocchio's dynamic parameters (10 nv): per body inertia.toDynamicParameters(), the
+// vector its regressor multiplies.
+void pin_parameters(const PinArm *arm, double *out);

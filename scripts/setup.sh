@@ -15,6 +15,8 @@ command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
 # Firmware checks: the ARM cross compiler and newlib's headers and libm (tests/test_firmware.py)
 command -v arm-none-eabi-gcc >/dev/null 2>&1 || need_apt+=(gcc-arm-none-eabi)
 [ -f /usr/include/newlib/math.h ] || need_apt+=(libnewlib-arm-none-eabi)
+# The benchmarks (bench/run_all.py) also count instructions with valgrind: DYNGEN_BENCH=1 adds it.
+if [ "${DYNGEN_BENCH:-0}" = 1 ]; then command -v valgrind >/dev/null 2>&1 || need_apt+=(valgrind); fi
 
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "setup: installing system packages: ${need_apt[*]}"
