@@ -181,16 +181,16 @@ def verdict_text(d: dict) -> str:
         name, v = e["effect"], e["values"]
         if name in PER_JOINT:
             key = PER_JOINT[name][1]
-            parts.append(f"{name} j{e['joints'][0]} {key} {v[key]:.3g}")
+            parts.append(f"{name} j{e['joints'][0]} {key} {v[key]:#.4g}")
         elif name == "stribeck":
-            parts.append(f"stribeck j{e['joints'][0]} Fs {v['Fs']:.3g} at vs {e['variant']['vs']:.3g}")
+            parts.append(f"stribeck j{e['joints'][0]} Fs {v['Fs']:#.4g} at vs {e['variant']['vs']:#.3g}")
         elif name == "payload":
-            parts.append(f"payload m {v['m']:.3g}, mc ({', '.join(f'{v[k]:.3g}' for k in ('mx', 'my', 'mz'))})")
+            parts.append(f"payload m {v['m']:#.4g}, mc ({', '.join(f'{v[k]:#.3g}' for k in ('mx', 'my', 'mz'))})")
         elif name == "tilt":
             change = fitted_gravity_change(v, np.array([0.0, 0.0, -1.0]))
-            parts.append(f"tilt {e['derived']['tilt_total_deg']:.3g} deg, dg ({', '.join(f'{x:.3f}' for x in change)})")
+            parts.append(f"tilt {e['derived']['tilt_total_deg']:#.3g} deg, dg ({', '.join(f'{x:.3f}' for x in change)})")
         elif name == "time_shift":
-            parts.append(f"time shift {1e3 * v['dt']:.3g} ms")
+            parts.append(f"time shift {1e3 * v['dt']:#.3g} ms")
         elif name == "coefficients":
             known = [k for k, x in v.items() if x is not None]
             big = sorted(known, key=lambda k: -abs(v[k] / e["std"][k]) if e["std"][k] else 0)[:2]

@@ -4,12 +4,17 @@
     gain:        (k - 1) * tau_model                per joint [1]: the sensor reads k times the torque
     time shift:  tau(t - dt) - tau(t)               whole arm [s]: torques lag positions by dt
 
-The time shift is selected to first order, -dt * d tau_model / dt, which holds only where
-tau_model is smooth over dt: where it jumps (an acceleration step), the measured torque keeps
-the value before the jump for dt, and the derivative cannot say so. Once selected, the shift
-is refined (refine.py) with the exact form at a shift dt0, (tau_model(t - dt0) - tau_model(t))
-/ dt0, tau_model interpolated linearly between samples, so that the fitted dt equals dt0 when
-the model holds.
+The time shift is linear in dt only to first order, -dt * d tau_model / dt, which fails
+wherever tau_model jumps (an acceleration step): the measured torque keeps the value before
+the jump for dt, while the sampled derivative puts a spike of jump * dt / (2 h) on the two
+samples around it (h the sample period; 5 times the jump for 10 ms at 1 kHz). So its column
+is the exact form at a shift dt0,
+
+    (tau_model(t - dt0) - tau_model(t)) / dt0       (tau_model interpolated linearly in time)
+
+whose fitted value dt equals dt0 when the model holds. Selection tries a few variants of dt0
+(TIME_SHIFTS in effects/__init__.py); once selected, dt0 is refined by fixed-point iteration
+dt0 <- dt (refine.py), which also reaches negative shifts (torques leading the positions).
 """
 
 from __future__ import annotations
@@ -40,16 +45,14 @@ class TimeShift(Effect):
     name, scope, parameters, units = "time_shift", "arm", ("dt",), ("s",)
     refinable = True
 
-    def __init__(self, shift: float = 0.0):
-        self.shift = float(shift)  # dt0 [s]; 0: first order
-        self.label = f"dt0={self.shift:.6g}" if self.shift else ""
+    def __init__(self, shift: float):
+        self.shift = float(shift)  # dt0 [s], not 0
+        self.label = f"dt0={self.shift:.6g}"
 
     def fixed(self):
-        return {"dt0": self.shift} if self.shift else {}
+        return {"dt0": self.shift}
 
     def columns(self, context, signals, tau_model):
-        if not self.shift:
-            return -np.gradient(tau_model, signals.t, axis=0)[:, :, None]
         # Before the first sample the torque is held at its first value (np.interp's ends).
         shifted = np.column_stack([np.interp(signals.t - self.shift, signals.t, tau) for tau in tau_model.T])
         return ((shifted - tau_model) / self.shift)[:, :, None]
