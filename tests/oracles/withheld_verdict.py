@@ -167,7 +167,8 @@ def truth_text(truth: list[dict]) -> str:
         elif name == "payload":
             parts.append(f"payload m {v['s'][0]:g}, mc ({', '.join(f'{x:.3g}' for x in v['s'][1:4])})")
         elif name == "tilt":
-            parts.append(f"tilt {v['angle_deg']:g} deg, dg ({', '.join(f'{x:.3f}' for x in np.asarray(v['gravity']) - nominal_gravity(v))})")
+            change = np.asarray(v["gravity"]) - nominal_gravity(v)
+            parts.append(f"tilt {v['angle_deg']:g} deg, dg ({', '.join(f'{x:.3f}' for x in change)})")
         elif name == "time_shift":
             parts.append(f"time shift {1e3 * v['dt']:g} ms")
         elif name == "coefficients":
@@ -188,7 +189,8 @@ def verdict_text(d: dict) -> str:
             parts.append(f"payload m {v['m']:#.4g}, mc ({', '.join(f'{v[k]:#.3g}' for k in ('mx', 'my', 'mz'))})")
         elif name == "tilt":
             change = fitted_gravity_change(v, np.array([0.0, 0.0, -1.0]))
-            parts.append(f"tilt {e['derived']['tilt_total_deg']:#.3g} deg, dg ({', '.join(f'{x:.3f}' for x in change)})")
+            angle = e["derived"]["tilt_total_deg"]
+            parts.append(f"tilt {angle:#.3g} deg, dg ({', '.join(f'{x:.3f}' for x in change)})")
         elif name == "time_shift":
             parts.append(f"time shift {1e3 * v['dt']:#.3g} ms")
         elif name == "coefficients":
