@@ -94,6 +94,14 @@ CASES = [
     Case("gain_viscous", Effects(gain={2: 0.05}, viscous={6: 0.5})),
 ]
 
+# Settings between the diagnosis's variants (Stribeck vs 0.03/0.1/0.3 rad/s, time shifts
+# 1/4/16/64 ms), and a torque leading the positions: does its refinement find them?
+OFF_GRID_CASES = [
+    Case("stribeck_off_grid", Effects(coulomb={2: 0.6}, stribeck={2: (0.9, 0.05)})),
+    Case("time_shift_off_grid", Effects(time_shift=0.007)),
+    Case("time_lead", Effects(time_shift=-0.005)),
+]
+
 
 # ------------------------------------------------------------------ the nominal model
 

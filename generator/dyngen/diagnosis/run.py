@@ -1,4 +1,5 @@
-"""The diagnosis: residual, forward selection of effects on held-out data, final fit.
+"""The diagnosis: residual, forward selection of effects on held-out data, refinement of
+their nonlinear settings, final fit.
 
     result = diagnose(robot, model, p, fit_signals, holdout_signals)   # or holdout None: blocks
 """
@@ -13,6 +14,7 @@ from . import design as dz
 from . import phases
 from .correlation import integrated_time
 from .effects import Context, library
+from .refine import refine
 from .selection import ALPHA, MIN_GAIN, forward, heldout_gain, prune, solve
 
 
@@ -143,8 +145,10 @@ def diagnose(robot, model, p, fit_signals, holdout_signals=None, options: Option
 
     selection = forward(design, options.min_gain, options.alpha)
     chosen, tau_corr, dropped = prune(design, selection.chosen, correlation, options.alpha)
+    design, chosen = refine(context, segments, design, chosen)  # Stribeck velocity, exact time shift
     final = solve(design, chosen)
-    correlation(chosen, final)  # leaves each segment's correction at the final fit
+    if chosen:  # also leaves each segment's correction at the final fit
+        tau_corr = correlation(chosen, final)
     before = np.sqrt(design.held.c / max(design.held.count, 1))
     after = np.sqrt(design.held.mse(final.slots, final.x)) if chosen else before.copy()
     held_before = np.vstack([seg.residual[seg.held] for seg in segments])

@@ -6,7 +6,8 @@ r = tau_measured - tau_model that is linear in its fitted values:
 An effect acts either on one joint at a time (scope "joint": friction, rotor inertia, sensor
 offset and gain; one candidate per joint) or on the whole arm with shared values (scope
 "arm": payload, tilted base, time shift, errors in the model's coefficients). Nonlinear
-parameters (the Stribeck velocity) are handled as a few fixed variants of one effect.
+parameters (the Stribeck velocity, the time shift of the exact form) are handled as a few
+fixed variants of one effect, refined once the effect is selected (diagnosis/refine.py).
 """
 
 from __future__ import annotations
@@ -18,12 +19,13 @@ from .sensor import Gain, Offset, TimeShift
 from .tilt import Tilt, gravity_matrix
 
 STRIBECK_VELOCITIES = (0.03, 0.1, 0.3)  # rad/s (m/s): the variants tried (well above Context.sign_velocity)
+TIME_SHIFTS = (0.001, 0.004, 0.016, 0.064)  # s: the variants tried (factors of 4; refined once selected)
 
 
 def library(names=None) -> list[Effect]:
     """Every candidate effect (or those whose name is in `names`)."""
     effects = [Offset(), Coulomb(), Viscous(), *[Stribeck(v) for v in STRIBECK_VELOCITIES], Armature(), Gain(),
-               Payload(), Tilt(), TimeShift(), Coefficients()]
+               Payload(), Tilt(), *[TimeShift(dt) for dt in TIME_SHIFTS], Coefficients()]
     if names is None:
         return effects
     known = {e.name for e in effects}
@@ -34,4 +36,4 @@ def library(names=None) -> list[Effect]:
 
 
 __all__ = ["Armature", "Coefficients", "Context", "Coulomb", "Effect", "Gain", "Offset", "Payload", "Stribeck",
-           "Tilt", "TimeShift", "Viscous", "gravity_matrix", "library", "STRIBECK_VELOCITIES"]
+           "Tilt", "TimeShift", "Viscous", "gravity_matrix", "library", "STRIBECK_VELOCITIES", "TIME_SHIFTS"]

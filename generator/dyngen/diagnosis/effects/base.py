@@ -31,6 +31,7 @@ class Effect:
     parameters: tuple = ()
     units: tuple = ()
     label = ""  # a variant's setting, e.g. "vs = 0.1 rad/s"
+    refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
 
     def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the
@@ -40,6 +41,22 @@ class Effect:
     def plausible(self, values: np.ndarray) -> bool:
         """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
         return True
+
+    setting: float = 0.0  # refinable effects: the current nonlinear setting
+
+    def implied_setting(self, values: np.ndarray) -> float | None:
+        """Refinable effects whose fitted values imply their setting (refined by fixed-point
+        iteration): that setting; others None."""
+        return None
+
+    def search_interval(self, values: np.ndarray) -> tuple[float, float] | None:
+        """Refinable effects whose setting is independent of their values: where to search
+        it (refined by scalar search); others None."""
+        return None
+
+    def at(self, setting: float) -> "Effect":
+        """Refinable effects: the same effect at another setting."""
+        raise NotImplementedError
 
     def fixed(self) -> dict:
         """Settings of a variant that are not fitted (e.g. the Stribeck velocity)."""

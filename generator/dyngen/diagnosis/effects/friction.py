@@ -2,7 +2,7 @@
 
     Coulomb:   Fc * sign(qd)                      [Nm]
     viscous:   Fv * qd                            [Nm s/rad]
-    Stribeck:  Fs * sign(qd) * exp(-(qd/vs)^2)    [Nm] at a fixed vs (variants)
+    Stribeck:  Fs * sign(qd) * exp(-(qd/vs)^2)    [Nm] at a fixed vs (variants; vs refined once selected)
     armature:  Ia * qdd                           [kg m^2] (reflected rotor inertia)
 
 sign(qd) is smoothed (Context.sign) so that standstill noise does not flip it.
@@ -39,6 +39,7 @@ class Viscous(_Dissipative):
 
 class Stribeck(_Dissipative):
     name, parameters, units = "stribeck", ("Fs",), ("Nm",)
+    refinable = True
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)
@@ -46,6 +47,16 @@ class Stribeck(_Dissipative):
 
     def fixed(self):
         return {"vs": self.velocity}
+
+    @property
+    def setting(self):
+        return self.velocity
+
+    def search_interval(self, values):
+        return self.velocity / 3, self.velocity * 3  # reaches the neighbouring variants
+
+    def at(self, setting):
+        return Stribeck(setting)
 
     def columns(self, context, signals, tau_model):
         qd = signals.qd

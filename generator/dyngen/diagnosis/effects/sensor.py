@@ -2,7 +2,19 @@
 
     offset:      b                                  per joint [Nm]: torque-sensor zero offset
     gain:        (k - 1) * tau_model                per joint [1]: the sensor reads k times the torque
-    time shift:  tau(t - dt) - tau(t) ~ -dt * d tau_model / dt   whole arm [s]: torques lag positions by dt
+    time shift:  tau(t - dt) - tau(t)               whole arm [s]: torques lag positions by dt
+
+The time shift is linear in dt only to first order, -dt * d tau_model / dt, which fails
+wherever tau_model jumps (an acceleration step): the measured torque keeps the value before
+the jump for dt, while the sampled derivative puts a spike of jump * dt / (2 h) on the two
+samples around it (h the sample period; 5 times the jump for 10 ms at 1 kHz). So its column
+is the exact form at a shift dt0,
+
+    (tau_model(t - dt0) - tau_model(t)) / dt0       (tau_model interpolated linearly in time)
+
+whose fitted value dt equals dt0 when the model holds. Selection tries a few variants of dt0
+(TIME_SHIFTS in effects/__init__.py); once selected, dt0 is refined by fixed-point iteration
+dt0 <- dt (refine.py), which also reaches negative shifts (torques leading the positions).
 """
 
 from __future__ import annotations
@@ -31,8 +43,26 @@ class Gain(Effect):
 
 class TimeShift(Effect):
     name, scope, parameters, units = "time_shift", "arm", ("dt",), ("s",)
+    refinable = True
+
+    def __init__(self, shift: float):
+        self.shift = float(shift)  # dt0 [s], not 0
+        self.label = f"dt0={self.shift:.6g}"
+
+    def fixed(self):
+        return {"dt0": self.shift}
 
     def columns(self, context, signals, tau_model):
-        # First order in dt: a delay of dt of the torque signal. Good for dt well below the
-        # time scale of the motion (a few samples).
-        return -np.gradient(tau_model, signals.t, axis=0)[:, :, None]
+        # Before the first sample the torque is held at its first value (np.interp's ends).
+        shifted = np.column_stack([np.interp(signals.t - self.shift, signals.t, tau) for tau in tau_model.T])
+        return ((shifted - tau_model) / self.shift)[:, :, None]
+
+    @property
+    def setting(self):
+        return self.shift
+
+    def implied_setting(self, values):
+        return float(values[0]) or None
+
+    def at(self, setting):
+        return TimeShift(setting)

@@ -35,7 +35,7 @@ class Tilt(Effect):
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors perpendicular to the model's gravity (the base x or y axis made
-    perpendicular; for gravity along -z they are x and y)."""
+    perpendicular; for gravity along -z they are x and -y)."""
     g = np.array([float(x) for x in robot.gravity])
     n = g / np.linalg.norm(g)
     seed = np.eye(3)[int(np.argmin(np.abs(n)))]

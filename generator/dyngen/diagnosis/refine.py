@@ -1,0 +1,131 @@
+"""Nonlinear settings of selected effects, refined after the selection.
+
+Some effects are linear in their values only once a setting is fixed: the Stribeck velocity
+vs, and the time shift, whose exact form tau_model(t - dt) - tau_model(t) is linear in nothing.
+Selection works with a few variants of vs and with the time shift to first order (the
+derivative of tau_model), which is wrong wherever tau_model jumps (acceleration steps, e.g.
+rest-to-rest trajectories). Once such an effect is selected, its setting is refined on the
+fit samples, every other selected effect refitted each time (held-out data stay unused):
+
+  - a setting the fitted values imply (Effect.implied_setting: the time shift, whose exact
+    column at dt0 gives the fitted value dt = dt0 when the model holds) by fixed-point
+    iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE;
+  - a setting independent of the values (Effect.search_interval: the Stribeck velocity) by a
+    bounded scalar search for the smallest weighted fit residual.
+
+    design, chosen = refine(context, segments, design, chosen)
+
+returns a design holding only the chosen candidates (slots renumbered), weighted as the
+selection's, and the chosen candidates with their refined effects.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from . import design as dz
+from .selection import solve
+
+REFINE_TOLERANCE = 1e-3  # relative (fixed point) or of the search interval's width
+MAX_ITERATIONS = 30
+
+
+def refine(context, segments, design, chosen):
+    if not any(c.effect.refinable for c in chosen):
+        return design, chosen
+    state = _State(context, segments, design, _renumbered(chosen))
+    for index, cand in enumerate(state.chosen):
+        if cand.effect.refinable:
+            _refine_one(state, index)
+    return state.design, state.chosen
+
+
+class _State:
+    """The chosen candidates, their columns per segment and their restricted design."""
+
+    def __init__(self, context, segments, design, chosen):
+        self.context, self.segments, self.weights = context, segments, design.weights
+        self.template = design
+        effects = list({c.effect.key: c.effect for c in chosen}.values())
+        self.columns = [dz.effect_columns(effects, context, seg) for seg in segments]
+        self.chosen = chosen
+        self.design = self.restricted(chosen, self.columns)
+
+    def values(self, index, design=None, chosen=None) -> np.ndarray:
+        design, chosen = design or self.design, chosen or self.chosen
+        fit = solve(design, chosen)
+        offset = sum(c.size for c in chosen[:index])
+        return fit.x[offset: offset + chosen[index].size]
+
+    def trial(self, index, setting):
+        """(chosen, columns, design) with candidate `index` at another setting."""
+        old = self.chosen[index]
+        effect = old.effect.at(setting)
+        chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
+        columns = [{**cols, effect.key: np.asarray(effect.columns(self.context, seg.signals, seg.tau_model), float)}
+                   for cols, seg in zip(self.columns, self.segments)]
+        return chosen, columns, self.restricted(chosen, columns)
+
+    def accept(self, trial):
+        self.chosen, self.columns, self.design = trial
+
+    def restricted(self, chosen, columns):
+        """Moments of the chosen candidates only, weighted as the selection's design."""
+        n = self.weights.size
+        size = sum(c.size for c in chosen)
+        fit, held = dz.empty(n, size), dz.empty(n, size)
+        for seg, cols in zip(self.segments, columns):
+            for j in range(n):
+                acting = [c for c in chosen if c.joint is None or c.joint == j]
+                if acting:
+                    A, slots = dz.joint_matrix(acting, cols, j)
+                else:
+                    A, slots = np.zeros((seg.residual.shape[0], 0)), np.zeros(0, dtype=int)
+                for moments, mask in ((fit, seg.fit), (held, seg.held)):
+                    if mask.any():
+                        dz.accumulate(moments, A[mask], slots, seg.residual[mask, j], j)
+            fit.count += int(seg.fit.sum())
+            held.count += int(seg.held.sum())
+        return type(self.template)(chosen, fit, held, self.weights)
+
+
+def _refine_one(state, index) -> None:
+    effect = state.chosen[index].effect
+    if effect.implied_setting(state.values(index)) is not None:
+        for _ in range(MAX_ITERATIONS):
+            current = state.chosen[index].effect
+            setting = current.implied_setting(state.values(index))
+            if setting is None:
+                return
+            state.accept(state.trial(index, setting))
+            if abs(setting - current.setting) <= REFINE_TOLERANCE * abs(setting):
+                return
+        return
+    interval = effect.search_interval(state.values(index))
+    if interval is None:
+        return
+
+    def cost(setting):
+        chosen, _, design = state.trial(index, setting)
+        return _weighted_sse(design, solve(design, chosen))
+
+    lo, hi = interval
+    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"xatol": REFINE_TOLERANCE * (hi - lo)})
+    state.accept(state.trial(index, float(best.x)))
+
+
+def _renumbered(chosen) -> list:
+    """The chosen candidates with consecutive slots (a design of these alone)."""
+    out, start = [], 0
+    for c in chosen:
+        out.append(dz.Candidate(c.effect, c.joint, start, c.size))
+        start += c.size
+    return out
+
+
+def _weighted_sse(design, fit) -> float:
+    m = design.fit
+    G = m.G[:, fit.slots][:, :, fit.slots]
+    sse = m.c - 2 * m.b[:, fit.slots] @ fit.x + np.einsum("k,jkl,l->j", fit.x, G, fit.x)
+    return float(design.weights ** 2 @ np.maximum(sse, 0.0))
