@@ -62,6 +62,19 @@ def test_bad_input_one_line_error_nothing_written(case, tmp_path):
     assert not out.exists()
 
 
+def test_arm_without_gravity_coefficients_is_one_line(tmp_path):
+    """A horizontal SCARA: gravity never acts on its joints, so there is no gravity coefficient."""
+    (tmp_path / "scara.yaml").write_text(
+        "name: scara\ndh: standard\ngravity: [0, 0, -9.81]\njoints:\n"
+        "  - {type: revolute, a: 0.4, alpha: 0, d: 0.3, theta: 0}\n"
+        "  - {type: revolute, a: 0.3, alpha: 0, d: 0, theta: 0}\n")
+    result = dyngen("generate", tmp_path / "scara.yaml", "-o", tmp_path / "out", "-q")
+    assert result.returncode != 0
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "scara.yaml: gravity: no joint of this arm moves against gravity" in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
 def test_missing_file_is_one_line():
     result = dyngen("no/such/robot.yaml")
     assert result.returncode != 0 and len(result.stderr.strip().splitlines()) == 1

@@ -10,6 +10,7 @@ from .derivation.models import Derivation
 from .description import Robot, load_robot
 from .emission.render import Emitted, emit
 from .progress import Progress
+from .errors import InputError
 from .reduction.base import BaseSet, reduce_model
 
 KINDS = ("gravity", "inertia", "full")
@@ -32,6 +33,10 @@ def build(robot: Robot, progress: Progress | None = None) -> tuple[dict, Emitted
         models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix()}
     with progress.step("reduce to base coefficients (exact rank)"):
         bases: dict[str, BaseSet] = {kind: reduce_model(regressors[kind]) for kind in KINDS}
+        if bases["gravity"].rank == 0:  # C has no zero-length arrays for pi_gravity and Y_g
+            raise InputError(robot.source, "gravity", "no joint of this arm moves against gravity (the gravity "
+                             "vector is identically zero, e.g. a horizontal SCARA); dyngen needs at least one "
+                             "gravity coefficient: tilt the base slightly or give gravity a symbol")
     with progress.step("emit C"):
         emitted = emit(robot, derivation, regressors, bases, models)
     return bases, emitted

@@ -33,7 +33,7 @@ class BaseSet:
 
     def appearing(self) -> list[int]:
         """Indices of standard parameters that appear in some coefficient."""
-        return [j for j in range(len(self.K[0])) if any(row[j] != 0 for row in self.K)]
+        return sorted({j for row in self.K for j, k in enumerate(row) if k != 0})
 
 
 class SampledRegressor:
