@@ -667,10 +667,9 @@ Outcome run_restart(const Problem &P, int restart) {
 // Among solutions with cost <= cap, the one closest to the reference parameters.
 Outcome prefer_reference(const Problem &P, const Outcome &best) {
     Context c{&P};
-    // Slack: a relative coefficient error of 1e-10 (far below what identification resolves) lets
-    // an exact fit move toward the reference; without it the two-stage procedure kept an
-    // arbitrary exact gravity solution, from which the inertia stage reached only 1e-2.
-    c.cost_cap = best.cost / P.cost_scale * (1 + 1e-6) + 1e-20;
+    // Almost no slack: the cost is relative to all blocks together, so a looser cap would let a
+    // small block (the gravity coefficients beside larger inertia ones) lose its exact fit.
+    c.cost_cap = best.cost / P.cost_scale * (1 + 1e-6) + 1e-30;
     std::vector<EqualityData> eq;
     for (const auto &poly : P.equalities) eq.push_back({&c, &poly});
     nlopt_opt opt = make(NLOPT_LD_SLSQP, P);
