@@ -32,7 +32,6 @@ import argparse
 import hashlib
 import json
 import os
-import platform
 import re
 import shlex
 import shutil
@@ -49,6 +48,7 @@ import yaml
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
+from common import arm_yaml, compiler_version, example_arms, log, machine  # noqa: E402
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(BENCH))
 
@@ -68,10 +68,6 @@ FUNCTIONS = tuple(PAIRS)
 # coefficients). Its operation count adds the dense product, rows x cols multiplications.
 PRODUCTS = {"yg_pig": ("regressor_gravity", "pi_gravity"), "ym_pim": ("regressor_inertia", "pi_inertia")}
 DEFAULT_FLAGS = "-O2 -DNDEBUG"
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
 
 
 def run(cmd, **kw) -> subprocess.CompletedProcess:
@@ -154,48 +150,7 @@ def header_version(path: Path, macros) -> str:
     return ".".join(parts)
 
 
-def compiler_version(cc: str) -> str:
-    return run([cc, "--version"]).stdout.splitlines()[0].strip()
-
-
-def machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.machine()}"
-
-
 # --- per arm: generated C, the Pinocchio model file, parameters and joint ranges ----------
-
-def arm_yaml(name: str) -> Path:
-    path = Path(name)
-    if path.suffix in (".yaml", ".yml") and path.is_file():
-        return path.resolve()
-    path = ROOT / "examples" / f"{name}.yaml"
-    if not path.is_file():
-        raise SystemExit(f"no such arm: {name} (looked for {path})")
-    return path
-
-
-def example_arms() -> list:
-    """examples/*.yaml that are robot descriptions (dyngen loads them); others are skipped."""
-    from dyngen.description import load_robot
-
-    names = []
-    for path in sorted((ROOT / "examples").glob("*.yaml")):
-        try:
-            load_robot(path)
-        except Exception as err:  # noqa: BLE001 - any failure: not an arm for this benchmark
-            log(f"skipping examples/{path.name}: not loadable as a robot description ({err})")
-            continue
-        names.append(path.stem)
-    return names
-
 
 def dynamic_parameters(yaml_path: Path, n: int) -> tuple[np.ndarray, str]:
     from oracles.arm import nominal_parameters

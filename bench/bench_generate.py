@@ -32,11 +32,9 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
+sys.path.insert(0, str(BENCH))
+from common import arm_yaml, compiler_version, example_arms, log, machine  # noqa: E402
 STAGES = ("load", "derive", "reduce", "emit")
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
 
 
 # --- worker: one generation in this (fresh) process ------------------------------------
@@ -97,47 +95,6 @@ def compile_once(cc: str, flags: list, folder: Path) -> tuple[float, dict]:
         if res.returncode != 0:
             raise SystemExit(f"{cc} failed on {src}:\n{res.stderr}")
     return sum(per_file.values()), per_file
-
-
-def example_arms() -> list:
-    from dyngen.description import load_robot
-
-    names = []
-    for path in sorted((ROOT / "examples").glob("*.yaml")):
-        try:
-            load_robot(path)
-        except Exception as err:  # noqa: BLE001 - not a robot description: skip it
-            log(f"skipping examples/{path.name}: not loadable as a robot description ({err})")
-            continue
-        names.append(path.stem)
-    return names
-
-
-def arm_yaml(name: str) -> Path:
-    path = Path(name)
-    if path.suffix in (".yaml", ".yml") and path.is_file():
-        return path.resolve()
-    path = ROOT / "examples" / f"{name}.yaml"
-    if not path.is_file():
-        raise SystemExit(f"no such arm: {name} (looked for {path})")
-    return path
-
-
-def compiler_version(cc: str) -> str:
-    res = subprocess.run([cc, "--version"], capture_output=True, text=True)
-    return res.stdout.splitlines()[0].strip() if res.returncode == 0 else cc
-
-
-def machine() -> str:
-    model = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores, {model}, {platform.system()} {platform.machine()}"
 
 
 def main(argv=None) -> int:

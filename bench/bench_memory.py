@@ -27,13 +27,10 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
+from common import log  # noqa: E402
 sys.path.insert(0, str(BENCH))
 
 from peak_memory import run_measured  # noqa: E402
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
 
 
 def checked(res, what: str):

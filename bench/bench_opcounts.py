@@ -18,11 +18,8 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
+from common import log  # noqa: E402
 sys.path.insert(0, str(BENCH))
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
 
 
 def arm_counts(yaml_path: Path, tmp: Path) -> dict:
@@ -35,7 +32,9 @@ def arm_counts(yaml_path: Path, tmp: Path) -> dict:
             "functions": {f["name"][len(prefix):]: f["ops"] for f in manifest["functions"]}}
 
 
-def cell(ops: dict) -> str:
+def cell(ops: dict | None) -> str:
+    if ops is None:  # the friction routine: a loop with branches, no straight-line count
+        return "loop, not counted"
     text = f"{ops['mul']} / {ops['add']} / {ops['sin_cos']}"
     return text + (f" (+{ops['div']} div)" if ops["div"] else "")
 
@@ -53,7 +52,7 @@ def table(arms: list) -> str:
 
 
 def main(argv=None) -> int:
-    from bench_dynamics import arm_yaml, example_arms
+    from common import arm_yaml, example_arms
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--arms", nargs="+", help="example names or YAML paths; default: all examples")

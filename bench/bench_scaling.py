@@ -33,6 +33,7 @@ import numpy as np
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
+from common import log  # noqa: E402
 sys.path.insert(0, str(BENCH))
 
 from peak_memory import run_measured  # noqa: E402
@@ -46,10 +47,6 @@ STEPS = ("derive", "reduce", "emit")
 TRACKED = ("rnea", "regressor", "mass_matrix", "regressor_inertia")
 TARGET_SECONDS = 60.0
 TARGET_EXPONENT = 2.0
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
 
 
 def fit_exponent(ns, values) -> float:

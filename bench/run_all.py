@@ -39,6 +39,8 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
+sys.path.insert(0, str(BENCH))
+from common import cpu_model, log  # noqa: E402
 RESULTS = BENCH / "results"
 PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory")
 TITLES = {
@@ -58,10 +60,6 @@ NOTES = {
                    "the time per restart by max(success rate, 1e-9): where dyngen's success rate is 0%, its 'time "
                    "to a success' (about 3e8 s) and the ratio mean that none of the restarts succeeded."),
 }
-
-
-def log(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
 
 
 @dataclass
@@ -146,12 +144,7 @@ def package_version(name: str) -> str:
 
 
 def environment() -> list:
-    cpu = platform.processor() or platform.machine()
-    try:
-        cpu = next(line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
-                   if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
+    cpu = cpu_model()
     try:
         mem = next(line.split()[1] for line in Path("/proc/meminfo").read_text().splitlines()
                    if line.startswith("MemTotal"))

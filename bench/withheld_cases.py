@@ -78,7 +78,7 @@ def main(argv=None) -> int:
                     f"{held.max() / args.noise:.1f} | {fit.max() / args.noise:.1f} |")
         print(rows[-1])
     table = "\n".join([
-        f"# Withheld-effect cases: residual of the nominal model\n",
+        "# Withheld-effect cases: residual of the nominal model\n",
         f"`python bench/withheld_cases.py --out DIR --rate {args.rate:g} --noise {args.noise:g} --seed {args.seed}`: "
         f"{len(doc['cases'])} cases, fit = Fourier excitation ({doc['trajectories']['fit']['seconds']:g} s), "
         f"held-out = Table V (28 s), {args.rate:g} Hz, noise sigma {args.noise:g} Nm; written in {seconds:.1f} s, "
