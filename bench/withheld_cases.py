@@ -28,7 +28,7 @@ from oracles.mujoco_measurements import read_csv  # noqa: E402
 from oracles.withheld_cases import write_cases  # noqa: E402
 
 from dyngen.atomic import write_file  # noqa: E402
-from dyngen.extraction.report import read_solution  # noqa: E402
+from dyngen.data.parameters_file import read_link_parameters  # noqa: E402
 from dyngen.runtime import load  # noqa: E402
 
 
@@ -69,7 +69,7 @@ def main(argv=None) -> int:
     size = sum(f.stat().st_size for f in args.out.iterdir())
     print(f"wrote {len(doc['cases'])} cases to {args.out} in {seconds:.1f} s ({size / 1e6:.0f} MB)")
 
-    s = model("standard_from_dynamic", read_solution(args.out / doc["params"]))
+    s = model("standard_from_dynamic", read_link_parameters(args.out / doc["params"], model.manifest["dof"]))
     rows = []
     for case in doc["cases"]:
         fit, held = (residual_rms(model, s, args.out / case[k]) for k in ("fit", "holdout"))

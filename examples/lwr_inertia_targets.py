@@ -10,7 +10,7 @@ from pathlib import Path
 
 from dyngen.description import load_robot
 from dyngen.emission.coefficients import grouped_text
-from dyngen.extraction.report import read_solution
+from dyngen.data.parameters_file import read_link_parameters
 from dyngen.generate import build
 from dyngen.parameters import PER_LINK, standard_from_dynamic, standard_name
 
@@ -22,7 +22,7 @@ def main():
     robot = load_robot(HERE / "lwr.yaml")
     bases, _ = build(robot)
     base = bases["inertia"]
-    s = standard_from_dynamic(read_solution(HERE / "lwr_paper_solution.yaml"))
+    s = standard_from_dynamic(read_link_parameters(HERE / "lwr_paper_solution.yaml", robot.dof))
     names = [standard_name(i + 1, k) for i in range(robot.dof) for k in range(PER_LINK)]
     lines = [BEGIN, "  # The paper does not print pi_hat_m: these are pi_inertia(p) of the paper's own final solution\n  # (examples/lwr_paper_solution.yaml: Tables II, IV, eq. 20, eq. 15), by examples/lwr_inertia_targets.py.\n  inertia:\n"]
     for row in base.K:

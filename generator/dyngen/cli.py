@@ -128,6 +128,7 @@ def _extract(args, robot, bases, folder) -> None:
     from pathlib import Path
 
     from .atomic import write_file
+    from .data.parameters_file import read_link_parameters
     from .extraction import report
     from .extraction.run import extract
 
@@ -148,7 +149,7 @@ def _extract(args, robot, bases, folder) -> None:
     compare = args.compare or robot.extraction.get("compare")
     if compare:
         path = Path(compare) if args.compare else Path(args.robot).parent / compare
-        columns = {path.name: report.read_solution(path), **columns}
+        columns = {path.name: read_link_parameters(path, robot.dof), **columns}
     residual_rows = report.residual_comparison(robot, extraction, columns, folder)
     table = report.consistency_table(columns)
     write_file(out / "consistency.md", table + "\n")

@@ -8,14 +8,6 @@ from ..parameters import PER_LINK
 from .problem import consistency_margin
 
 
-def read_solution(path) -> np.ndarray:
-    """A parameter set written as `solution:` links in the `parameters.nominal` format -> p (10N)."""
-    import yaml
-
-    links = yaml.safe_load(open(path).read())["solution"]
-    return np.array([v for link in links for v in (link["m"], *link["c"], *link["I"])], dtype=float)
-
-
 def links_yaml(p) -> str:
     """The parameters in the `parameters.nominal` format of docs/conventions.md."""
     lines = []
