@@ -25,7 +25,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "generator"))
 
-import dyngen  # noqa: E402,F401  (first: it sets one BLAS thread before numpy loads; see dyngen/__init__.py)
+from dyngen import blas  # noqa: E402
+
+blas.use_one_thread()  # as the dyngen command does, before numpy loads
+
 import numpy as np  # noqa: E402
 
 from dyngen.data import Conditioning, condition, read_recording  # noqa: E402

@@ -28,7 +28,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "generator"))
 
-import dyngen  # noqa: E402,F401  (first: one BLAS thread, see bench/README.md)
 from oracles.withheld_cases import CASES, OFF_GRID_CASES, write_cases  # noqa: E402
 from oracles.withheld_verdict import NOISE_FACTOR, TOLERANCE, problems, truth_text, verdict_text  # noqa: E402
 

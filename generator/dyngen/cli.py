@@ -6,11 +6,14 @@ import argparse
 import sys
 import time
 
-from . import __version__
-from .errors import InputError
-from .extraction.driver import DriverError
-from .extraction.problem import Infeasible
-from .progress import Progress
+from . import __version__, blas
+
+blas.use_one_thread()  # before numpy loads: the imports below load it
+
+from .errors import InputError  # noqa: E402
+from .extraction.driver import DriverError  # noqa: E402
+from .extraction.problem import Infeasible  # noqa: E402
+from .progress import Progress  # noqa: E402
 
 MAIN_HELP = """\
 dyngen: robot dynamic models as exact, standalone C from a DH table.
