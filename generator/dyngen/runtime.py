@@ -38,10 +38,14 @@ class Compiled:
         self.ffi.cdef("\n".join(_batch_prototype(f, real) + ";" for f in self.manifest["functions"]))
         self.lib = self.ffi.dlopen(str(library))
 
-    def __call__(self, name: str, *arrays) -> np.ndarray:
+    def _spec(self, name: str, arrays) -> dict:
         spec = self.functions[f"{self.prefix}_{name}"]
         if len(arrays) != len(spec["inputs"]):
             raise TypeError(f"{name} takes {[i['name'] for i in spec['inputs']]}")
+        return spec
+
+    def __call__(self, name: str, *arrays) -> np.ndarray:
+        spec = self._spec(name, arrays)
         keep, args = [], []
         for array, inp in zip(arrays, spec["inputs"]):
             a = np.ascontiguousarray(array, dtype=self.dtype).ravel()
@@ -56,9 +60,7 @@ class Compiled:
     def batch(self, name: str, *arrays) -> np.ndarray:
         """The function at T samples: each input is (T, length) or (length,) (the same for
         every sample); returns (T, *output shape)."""
-        spec = self.functions[f"{self.prefix}_{name}"]
-        if len(arrays) != len(spec["inputs"]):
-            raise TypeError(f"{name} takes {[i['name'] for i in spec['inputs']]}")
+        spec = self._spec(name, arrays)
         shaped = [np.ascontiguousarray(a, dtype=self.dtype) for a in arrays]
         counts = {a.shape[0] for a, inp in zip(shaped, spec["inputs"]) if a.ndim == 2}
         if len(counts) > 1:
