@@ -255,6 +255,15 @@ Eigen::Matrix3d density_matrix(const Eigen::VectorXd &p, int link) {
     return 0.5 * inertia.trace() * Eigen::Matrix3d::Identity() - inertia;
 }
 
+// d lambda_min / d I = v^T (dSigma/dI) v for xx, xy, xz, yy, yz, zz; v: the eigenvector of lambda_min.
+Eigen::Matrix<double, 6, 1> lambda_min_gradient(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> &eig) {
+    const Eigen::Vector3d v = eig.eigenvectors().col(0);
+    Eigen::Matrix<double, 6, 1> d;
+    d << 0.5 - v[0] * v[0], -2 * v[0] * v[1], -2 * v[0] * v[2], 0.5 - v[1] * v[1], -2 * v[1] * v[2],
+        0.5 - v[2] * v[2];
+    return d;
+}
+
 // m constraints: margin - lambda_min(tr(I)/2 E - I) <= 0, one per link.
 void consistency(unsigned m, double *result, unsigned n, const double *x, double *grad, void *data) {
     const Context &c = *static_cast<Context *>(data);
@@ -264,10 +273,7 @@ void consistency(unsigned m, double *result, unsigned n, const double *x, double
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(density_matrix(p, link));
         result[link] = c.P->margin - eig.eigenvalues()[0];
         if (!grad) continue;
-        const Eigen::Vector3d v = eig.eigenvectors().col(0);
-        // d lambda_min / d I = v^T (dSigma/dI) v, for xx, xy, xz, yy, yz, zz
-        const double d[6] = {0.5 - v[0] * v[0], -2 * v[0] * v[1], -2 * v[0] * v[2],
-                             0.5 - v[1] * v[1], -2 * v[1] * v[2], 0.5 - v[2] * v[2]};
+        const Eigen::Matrix<double, 6, 1> d = lambda_min_gradient(eig);
         for (unsigned k = 0; k < n; ++k) {
             const int j = c.P->free[k];
             if (j / 10 == link && j % 10 >= 4) grad[link * n + k] = -d[j % 10 - 4];
@@ -298,22 +304,29 @@ struct EqualityData {
     const std::vector<Term> *poly;
 };
 
-double equality(unsigned n, const double *x, double *grad, void *data) {
-    const EqualityData &e = *static_cast<EqualityData *>(data);
-    const Eigen::VectorXd p = e.context->full(x);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(kParameters);
+// h(p) of a polynomial identity, and dh/dp when asked.
+double polynomial(const std::vector<Term> &poly, const Eigen::VectorXd &p, Eigen::VectorXd *gradient) {
+    if (gradient) gradient->setZero(kParameters);
     double h = 0;
-    for (const Term &t : *e.poly) {
+    for (const Term &t : poly) {
         double product = t.coefficient;
         for (int i : t.index) product *= p[i];
         h += product;
+        if (!gradient) continue;
         for (size_t a = 0; a < t.index.size(); ++a) {  // d/dp of the product, factor a removed
             double rest = t.coefficient;
             for (size_t b = 0; b < t.index.size(); ++b)
                 if (b != a) rest *= p[t.index[b]];
-            g[t.index[a]] += rest;
+            (*gradient)[t.index[a]] += rest;
         }
     }
+    return h;
+}
+
+double equality(unsigned n, const double *x, double *grad, void *data) {
+    const EqualityData &e = *static_cast<EqualityData *>(data);
+    Eigen::VectorXd g;
+    const double h = polynomial(*e.poly, e.context->full(x), grad ? &g : nullptr);
     for (unsigned k = 0; grad && k < n; ++k) grad[k] = g[e.context->P->free[k]] * e.context->span(k);
     return h;
 }
@@ -328,12 +341,7 @@ double violation(const Problem &P, const Eigen::VectorXd &p) {
         worst = std::max(worst, P.margin - eig.eigenvalues()[0]);
     }
     if (P.has_total_mass) worst = std::max({worst, total_mass(p) - P.mass_hi, P.mass_lo - total_mass(p)});
-    Context c{&P};
-    for (const auto &poly : P.equalities) {
-        std::vector<double> x = c.unit(p);
-        EqualityData e{&c, &poly};
-        worst = std::max(worst, std::fabs(equality(static_cast<unsigned>(x.size()), x.data(), nullptr, &e)));
-    }
+    for (const auto &poly : P.equalities) worst = std::max(worst, std::fabs(polynomial(poly, p, nullptr)));
     return worst;
 }
 
@@ -516,9 +524,7 @@ void standard_constraints(unsigned m, double *result, unsigned n, const double *
         if (!grad) continue;
         const double *J = dpdy.data() + 100 * link;  // dp/dy of this link
         auto row = [&](int r) { return grad + static_cast<size_t>(first + r) * n + o; };
-        const Eigen::Vector3d v = eig.eigenvectors().col(0);
-        const double dl[6] = {0.5 - v[0] * v[0], -2 * v[0] * v[1], -2 * v[0] * v[2],
-                              0.5 - v[1] * v[1], -2 * v[1] * v[2], 0.5 - v[2] * v[2]};
+        const Eigen::Matrix<double, 6, 1> dl = lambda_min_gradient(eig);
         for (int a = 0; a < 10; ++a) {
             double sum = 0;
             for (int e = 0; e < 6; ++e) sum += dl[e] * J[10 * (4 + e) + a];
@@ -550,25 +556,13 @@ struct StandardEquality {
     const StandardContext *context;
     const std::vector<Term> *poly;
 };
-double standard_equality(unsigned n, const double *y, double *grad, void *data) {
+double standard_equality(unsigned, const double *y, double *grad, void *data) {
     const StandardEquality &e = *static_cast<StandardEquality *>(data);
     std::vector<double> dpdy;
     const Eigen::VectorXd p = e.context->p_of(y, grad ? &dpdy : nullptr);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(kParameters);
-    double h = 0;
-    for (const Term &t : *e.poly) {
-        double product = t.coefficient;
-        for (int i : t.index) product *= p[i];
-        h += product;
-        for (size_t a = 0; a < t.index.size(); ++a) {
-            double rest = t.coefficient;
-            for (size_t b = 0; b < t.index.size(); ++b)
-                if (b != a) rest *= p[t.index[b]];
-            g[t.index[a]] += rest;
-        }
-    }
+    Eigen::VectorXd g;
+    const double h = polynomial(*e.poly, p, grad ? &g : nullptr);
     if (grad) e.context->chain(g, dpdy, grad);
-    (void)n;
     return h;
 }
 
