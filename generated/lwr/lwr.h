@@ -27,7 +27,7 @@
  *   lwr_pi_full                  138 mul, 106 add, 0 div, 0 sin/cos
  *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
  *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 12 sin/cos
- *   lwr_regressor_inertia        2022 mul, 906 add, 0 div, 12 sin/cos
+ *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 12 sin/cos
  *   lwr_regressor                696 mul, 420 add, 0 div, 12 sin/cos
  *   lwr_rnea                     375 mul, 368 add, 0 div, 12 sin/cos
  *   lwr_gravity                  108 mul, 72 add, 0 div, 12 sin/cos
@@ -126,7 +126,7 @@ void lwr_regressor_gravity(const lwr_real *q, lwr_real *Y);
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   q        [7]  joint positions [rad or m]
  *   Y        [28 x 39]  row-major (written)
- * 2022 mul, 906 add, 0 div, 12 sin/cos
+ * 1383 mul, 757 add, 0 div, 12 sin/cos
  */
 void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y);
 

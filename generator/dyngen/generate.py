@@ -29,10 +29,14 @@ def build(robot: Robot, progress: Progress | None = None) -> tuple[dict, Emitted
     progress = progress or Progress(quiet=True)
     derivation = Derivation(robot)
     with progress.step("derive regressors (symbolic Newton-Euler)"):
-        regressors = {kind: derivation.regressor(kind) for kind in KINDS}
-        models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix()}
+        # The inertia matrix's base set comes from the full regressor without gravity (O(n^2) code)
+        # rather than from Y_m (O(n^3)): reduction/base.py says why they agree.
+        regressors = {kind: derivation.regressor(kind) for kind in ("gravity", "full")}
+        reduced = {**regressors, "inertia": derivation.regressor("full_without_gravity")}
+        models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix(),
+                  "unit_accelerations": derivation.unit_accelerations()}
     with progress.step("reduce to base coefficients (exact rank)"):
-        bases: dict[str, BaseSet] = {kind: reduce_model(regressors[kind]) for kind in KINDS}
+        bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
         if bases["gravity"].rank == 0:  # C has no zero-length arrays for pi_gravity and Y_g
             raise InputError(robot.source, "gravity", "no joint of this arm moves against gravity (the gravity "
                              "vector is identically zero, e.g. a horizontal SCARA); dyngen needs at least one "

@@ -104,27 +104,35 @@ class Derivation:
     # ---- regressors (all 10N columns) ---------------------------------------------------
 
     def regressor(self, kind: str) -> Model:
-        """kind: 'gravity' (N x 10N), 'inertia' (N(N+1)/2 x 10N, stacked upper M), 'full' (N x 10N)."""
+        """kind: 'gravity' (N x 10N), 'full' (N x 10N) or 'full_without_gravity' (N x 10N, the full
+        regressor with gravity zero: its base set is the inertia matrix's, see reduction/base.py)."""
         program, sym, chain = self._start()
         zero = [0] * self.n
         if kind == "full":
             rows = chain.regressor_columns(chain.forward(sym.qd, sym.qdd, self.robot.gravity))
             inputs = self._joint_inputs(sym, "q", "qd", "qdd") + self._gravity_inputs()
+        elif kind == "full_without_gravity":
+            rows = chain.regressor_columns(chain.forward(sym.qd, sym.qdd, [0, 0, 0]))
+            inputs = self._joint_inputs(sym, "q", "qd", "qdd")
         elif kind == "gravity":
             rows = chain.regressor_columns(chain.forward(zero, zero, self.robot.gravity))
             inputs = self._joint_inputs(sym, "q") + self._gravity_inputs()
-        elif kind == "inertia":
-            columns = []
-            for k in range(self.n):
-                unit = [int(j == k) for j in range(self.n)]
-                columns.append(chain.regressor_columns(chain.forward(zero, unit, [0, 0, 0])))
-            rows = [columns[k][j] for j in range(self.n) for k in range(j, self.n)]  # M[j][k], j <= k
-            inputs = self._joint_inputs(sym, "q")
         else:
             raise ValueError(kind)
         shape = (len(rows), PER_LINK * self.n)
         return Model(f"regressor_{kind}", inputs, [x for row in rows for x in row], shape,
                      f"{kind} regressor over all standard parameters", program, sym.trig)
+
+    def unit_accelerations(self) -> Model:
+        """The motions S_j^i = (wd, a) of link i under a unit acceleration of joint j <= i (zero
+        velocity, no gravity), link-major (derivation/inertia.py): the inertia regressor's
+        factors. Shape n(n+1)/2 x 6."""
+        program, sym, chain = self._start()
+        outputs = [x for per_link in chain.unit_accelerations() for motion in per_link
+                   for x in (*motion.wd, *motion.a)]
+        return Model("unit_accelerations", self._joint_inputs(sym, "q"), outputs, (len(outputs) // 6, 6),
+                     "angular and linear acceleration of each link under a unit acceleration of each joint",
+                     program, sym.trig)
 
     # ---- parameters ---------------------------------------------------------------------
 

@@ -77,32 +77,47 @@ class Chain:
     # ---- forward ---------------------------------------------------------------------
 
     def forward(self, qd, qdd, gravity) -> list[Motion]:
-        let, lets = self.program.let, self.program.let_vector
-        w, wd, a = ZERO, ZERO, lets([-g for g in gravity])
-        U_prev = sp.zeros(3, 3)
+        base = Motion(ZERO, ZERO, self.program.let_vector([-g for g in gravity]), sp.zeros(3, 3), {})
         motions = []
-        for i, (joint, geo) in enumerate(zip(self.robot.joints, self.geometry)):
+        for i in range(len(self.geometry)):
             self.program.section = f"link {i + 1}: velocities and accelerations"
-            if not self.standard:  # modified DH: O_i is fixed in link i-1
-                a = add(a, mat_vec(U_prev, geo.offset))
-            w_in, wd_in, a_in = lets(mat_t_vec(geo.R, w)), lets(mat_t_vec(geo.R, wd)), lets(mat_t_vec(geo.R, a))
-            if joint.revolute:
-                spin = scale(qd[i], geo.axis)
-                w = lets(add(w_in, spin))
-                wd = lets(add(wd_in, scale(qdd[i], geo.axis), cross(w_in, spin)))
-            else:
-                w, wd = w_in, wd_in
-            ww = {(r, c): let(w[r] * w[c]) for r in range(3) for c in range(r, 3)}
-            U = _u_matrix(let, ww, wd)
-            if self.standard:  # O_(i-1) lies on joint i's axis, fixed in link i
-                a_in = add(a_in, mat_vec(U, geo.offset))
-            if not joint.revolute:
-                slide = scale(qd[i], geo.axis)
-                a_in = add(a_in, scale(qdd[i], geo.axis), scale(2, cross(w, slide)))
-            a = lets(a_in)
-            motions.append(Motion(w, wd, a, U, ww))
-            U_prev = U
+            motions.append(self.step(i, motions[-1] if motions else base, qd[i], qdd[i]))
         return motions
+
+    def unit_accelerations(self) -> list[list[Motion]]:
+        """motions[i][j] (j <= i): link i's motion when joint j accelerates at 1, nothing moves
+        and there is no gravity, i.e. forward(0, unit_j, 0)[i]. Its (wd, a) is column j of link
+        i's Jacobian at O_i in frame i. Built link by link (all joints at once) so that the
+        emitted code reads per link; links before joint j do not move, so O(n^2) motions."""
+        rest = Motion(ZERO, ZERO, ZERO, sp.zeros(3, 3), {})
+        motions: list[list[Motion]] = []
+        for i in range(len(self.geometry)):
+            self.program.section = f"link {i + 1}: unit accelerations"
+            motions.append([self.step(i, motions[i - 1][j] if j < i else rest, 0, int(i == j)) for j in range(i + 1)])
+        return motions
+
+    def step(self, i, parent: Motion, qd_i, qdd_i) -> Motion:
+        """Link i's motion from its parent's (link i-1's, or the base's) and joint i's rate and acceleration."""
+        let, lets = self.program.let, self.program.let_vector
+        joint, geo = self.robot.joints[i], self.geometry[i]
+        a = parent.a
+        if not self.standard:  # modified DH: O_i is fixed in link i-1
+            a = add(a, mat_vec(parent.U, geo.offset))
+        w_in, wd_in, a_in = lets(mat_t_vec(geo.R, parent.w)), lets(mat_t_vec(geo.R, parent.wd)), lets(mat_t_vec(geo.R, a))
+        if joint.revolute:
+            spin = scale(qd_i, geo.axis)
+            w = lets(add(w_in, spin))
+            wd = lets(add(wd_in, scale(qdd_i, geo.axis), cross(w_in, spin)))
+        else:
+            w, wd = w_in, wd_in
+        ww = {(r, c): let(w[r] * w[c]) for r in range(3) for c in range(r, 3)}
+        U = _u_matrix(let, ww, wd)
+        if self.standard:  # O_(i-1) lies on joint i's axis, fixed in link i
+            a_in = add(a_in, mat_vec(U, geo.offset))
+        if not joint.revolute:
+            slide = scale(qd_i, geo.axis)
+            a_in = add(a_in, scale(qdd_i, geo.axis), scale(2, cross(w, slide)))
+        return Motion(w, wd, lets(a_in), U, ww)
 
     # ---- backward --------------------------------------------------------------------
 

@@ -86,8 +86,18 @@ def input_names(model) -> dict:
     return {sym: f"{inp.name}[{k}]" for inp in model.inputs for k, sym in enumerate(inp.symbols)}
 
 
-def render_function(prefix: str, joints, name: str, model, outputs, output, doc: str) -> CFunction:
-    """outputs: flat expressions written to output[0] (argument name, shape, meaning)."""
+@dataclass
+class StraightLine:
+    """The C statements of a program's assignments that some outputs need."""
+
+    body: list[str]  # the joint angles' sin/cos, then per-section const declarations
+    printer: Printer  # prints expressions over the declared names and the inputs
+    ops: OpCount  # of the statements in body
+    used: set  # input arguments the statements or outputs read
+
+
+def straight_line(prefix: str, joints, model, outputs) -> StraightLine:
+    """Declarations of everything `outputs` (expressions of the model's program) need."""
     pruned = model.program.pruned(outputs)
     names = input_names(model)
     names.update({a.symbol: f"x{k}" for k, a in enumerate(pruned)})  # dense numbering: stable diffs
@@ -112,18 +122,24 @@ def render_function(prefix: str, joints, name: str, model, outputs, output, doc:
             section = a.section
             body.append(f"/* {section} */")
         body.append(f"const {real} {names[a.symbol]} = {printer.doprint(a.expr)};")
-    body.append(f"/* {output[0]} */")
+    ops = count_all([a.expr for a in pruned]) + OpCount(trig=len(trig_used))
+    free = set().union(*(a.expr.free_symbols for a in pruned), *(sp.sympify(o).free_symbols for o in outputs))
+    used = {inp.name for inp in model.inputs if free & set(inp.symbols)}
+    if trig_used:
+        used.add("q")
+    return StraightLine(body, printer, ops, used)
+
+
+def render_function(prefix: str, joints, name: str, model, outputs, output, doc: str) -> CFunction:
+    """outputs: flat expressions written to output[0] (argument name, shape, meaning)."""
+    code = straight_line(prefix, joints, model, outputs)
+    body = code.body + [f"/* {output[0]} */"]
     flat = [sp.sympify(o) for o in outputs]
     zeros = sum(1 for o in flat if o == 0)
     if zeros > 8:
         body.append(f"for (int k = 0; k < {len(flat)}; ++k) {output[0]}[k] = 0;")
     for k, o in enumerate(flat):
         if o != 0 or zeros <= 8:
-            body.append(f"{output[0]}[{k}] = {printer.doprint(o)};")
-    ops = count_all([a.expr for a in pruned] + flat) + OpCount(trig=len(trig_used))
+            body.append(f"{output[0]}[{k}] = {code.printer.doprint(o)};")
     ins = [(inp.name, len(inp.symbols), inp.doc) for inp in model.inputs]
-    free = set().union(*(a.expr.free_symbols for a in pruned), *(o.free_symbols for o in flat))
-    used = {inp.name for inp in model.inputs if free & set(inp.symbols)}
-    if trig_used:
-        used.add("q")
-    return CFunction(f"{prefix}_{name}", doc, ins, output, body, ops, used)
+    return CFunction(f"{prefix}_{name}", doc, ins, output, body, code.ops + count_all(flat), code.used)

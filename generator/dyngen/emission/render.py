@@ -15,6 +15,7 @@ from ..reduction.identifiability import classify
 from .c_code import render_function
 from .coefficients import dynamic_names_text, grouped_text
 from .eigen import eigen_interface
+from .inertia_regressor import render_inertia_regressor
 from .selftest import N_STATES, TOLERANCE, c_numbers, selftest_data
 
 TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
@@ -39,7 +40,8 @@ def environment() -> jinja2.Environment:
 
 
 def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emitted:
-    """regressors: kind -> full regressor Model; bases: kind -> BaseSet; models: rnea, gravity, mass_matrix."""
+    """regressors: "gravity" and "full" -> full regressor Model; bases: kind -> BaseSet; models: rnea,
+    gravity, mass_matrix and unit_accelerations (the factors of the inertia regressor)."""
     P, n = robot.name, robot.dof
     joints = robot.joints
     n_stacked = n * (n + 1) // 2
@@ -53,19 +55,22 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
                      ("s", (PER_LINK * n,), "standard parameters"), "Standard parameters s from dynamic parameters p.")]
     regressor_fns = []
     kinds = []
-    out_rows = {"gravity": n, "inertia": n_stacked, "full": n}
+    out_rows = {"gravity": n, "full": n}
     for kind in ("gravity", "inertia", "full"):
-        base, reg = bases[kind], regressors[kind]
+        base = bases[kind]
         cm = coefficient_model(derivation, base, kind)
         parameters.append(fn(f"pi_{kind}", cm, cm.outputs, ("pi", (base.rank,), f"pi_{kind}"),
                              f"Base coefficients pi_{kind}(p) of the {KIND_LABELS[kind]}."))
         jm = coefficient_jacobian_model(derivation, base, kind)
         parameters.append(fn(f"pi_{kind}_jacobian", jm, jm.outputs, ("J", (base.rank, PER_LINK * n), "row-major"),
                              f"Jacobian d pi_{kind} / d p (for gradient-based extraction)."))
-        name = {"gravity": "regressor_gravity", "inertia": "regressor_inertia", "full": "regressor"}[kind]
-        regressor_fns.append(fn(name, reg, base_regressor_outputs(reg, base),
-                                ("Y", (out_rows[kind], base.rank), "row-major"),
-                                f"Base regressor of the {KIND_LABELS[kind]}."))
+        doc = f"Base regressor of the {KIND_LABELS[kind]}."
+        if kind == "inertia":  # factored: O(n^2) code for its O(n^3) entries
+            regressor_fns.append(render_inertia_regressor(P, joints, models["unit_accelerations"], base, doc))
+        else:
+            name = {"gravity": "regressor_gravity", "full": "regressor"}[kind]
+            regressor_fns.append(fn(name, regressors[kind], base_regressor_outputs(regressors[kind], base),
+                                    ("Y", (out_rows[kind], base.rank), "row-major"), doc))
         standard, dynamic = classify(base, n)
         coefficients = []
         for k, row in enumerate(base.K):

@@ -79,8 +79,14 @@ def _check(kind, sampled, pivots, K):
                 raise AssertionError(f"{kind}: regrouping check failed at column {j}")
 
 
-def reduce_model(model) -> BaseSet:
-    """Reduce a full regressor model (derivation.models.Derivation.regressor)."""
+def reduce_model(model, kind: str | None = None) -> BaseSet:
+    """Reduce a full regressor model (derivation.models.Derivation.regressor); kind names the
+    BaseSet (default: from the model's name).
+
+    The inertia matrix's base set comes from the full regressor with gravity zero, not from
+    Y_m: Y_m(q) s = 0 for all q iff Y(q, qd, qdd; g = 0) s = 0 for all states (M(q) s
+    determines the Coriolis terms), so both have the same row space, hence the same pivots and
+    K. That regressor has n rows per state and O(n^2) code; Y_m has n(n+1)/2 and O(n^3)."""
     trig = model.trig
     angle_of = {}
     for symbol, (joint, fn) in trig.items():
@@ -100,4 +106,4 @@ def reduce_model(model) -> BaseSet:
     rows, cols = model.shape
     per_state = [model.outputs[r * cols:(r + 1) * cols] for r in range(rows)]
     sampled = SampledRegressor(model.assignments, per_state, cols, sample_env)
-    return reduce(model.name.replace("regressor_", ""), sampled)
+    return reduce(kind or model.name.replace("regressor_", ""), sampled)

@@ -1,0 +1,78 @@
+"""C of the base inertia regressor Y_m(q): O(n^2) code for an output with O(n^3) entries.
+
+Straight-line code computes the motions S_j^i of every link under a unit acceleration of
+every joint (derivation/inertia.py) into a local array, link by link; a short loop then
+fills Y_m, driven by two small tables (local, not static: the library has no static
+data at all, tests/test_cli.py) that give each base column's link and parameter kind:
+entry (M[j][k], column c) is phi_kind(S_j, S_k) of link(c) for j <= k <= link(c), else 0.
+Printing every entry of Y_m instead made its code, and every step that touched it
+(derivation, reduction, printing, compiling), grow like n^3.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..derivation.inertia import KIND_NAMES, column_links_and_kinds, pairs, phi
+from .c_code import CFunction, straight_line
+from .opcount import OpCount, count, count_all
+
+MOTION_ARGS = (sp.symbols("a0:6", real=True), sp.symbols("b0:6", real=True))  # S_j and S_k in the loop
+
+
+def render_inertia_regressor(prefix: str, joints, motions, base, doc: str) -> CFunction:
+    """motions: the unit_accelerations Model (Derivation.unit_accelerations); base: the
+    inertia BaseSet (its pivots are the columns of Y_m kept)."""
+    n = len(joints)
+    n_stacked, rank = n * (n + 1) // 2, base.rank
+    real = f"{prefix}_real"
+    code = straight_line(prefix, joints, motions, motions.outputs)
+    body = code.body + [
+        f"/* S[i(i+1)/2 + j]: angular and linear acceleration of link i+1 (frame i+1, at its origin)",
+        " * when joint j+1 accelerates at 1 and nothing else moves (no gravity) */",
+        f"const {real} S[{len(motions.outputs) // 6}][6] = {{"]
+    for i in range(n):
+        body.append(f"    /* link {i + 1} */")
+        for j in range(i + 1):
+            start = 6 * (i * (i + 1) // 2 + j)
+            entries = ", ".join(code.printer.doprint(x) for x in motions.outputs[start:start + 6])
+            body.append(f"    {{{entries}}},")
+    body.append("};")
+    links, kinds = column_links_and_kinds(base.pivots)
+    body += [
+        f"/* Y: entry (M[j][k], column c) is phi over S_j, S_k of link column_link[c] for",
+        " * j <= k <= column_link[c], else 0; phi by the column's standard parameter (derivation/inertia.py) */",
+        f"const unsigned char column_link[{rank}] = {{{', '.join(map(str, links))}}};",
+        f"const unsigned char column_kind[{rank}] = {{{', '.join(map(str, kinds))}}};"
+        f"  /* {', '.join(f'{k} {name}' for k, name in enumerate(KIND_NAMES))} */",
+        f"for (int e = 0; e < {n_stacked * rank}; ++e) Y[e] = 0;",
+        f"for (int c = 0; c < {rank}; ++c) {{",
+        "    const int i = column_link[c];",
+        f"    const {real} (*link)[6] = S + i * (i + 1) / 2;",
+        "    int row = 0;  /* row of M[j][j] in the stacked upper triangle */",
+        f"    for (int j = 0; j <= i; row += {n} - j, ++j) {{",
+        "        for (int k = j; k <= i; ++k) {",
+        f"            const {real} *a = link[j], *b = link[k];",
+        f"            {real} y = 0;",
+        "            switch (column_kind[c]) {",
+    ]
+    names = {s: f"{v}[{k}]" for v, group in zip("ab", MOTION_ARGS) for k, s in enumerate(group)}
+    printer = type(code.printer)(prefix, names)
+    for kind in sorted(set(kinds)):
+        body.append(f"            case {kind}: y = {printer.doprint(phi(kind, *MOTION_ARGS))}; break;"
+                    f"  /* {KIND_NAMES[kind]} */")
+    body += [
+        "            }",
+        f"            Y[(row + k - j) * {rank} + c] = y;",
+        "        }",
+        "    }",
+        "}",
+    ]
+    loop = OpCount()
+    for link, kind in zip(links, kinds):  # trip count times the body's floating-point operations
+        trips = pairs(link)
+        body_ops = count(phi(kind, *MOTION_ARGS))
+        loop = loop + OpCount(trips * body_ops.mul, trips * body_ops.add, trips * body_ops.div)
+    ops = code.ops + count_all(motions.outputs) + loop
+    return CFunction(f"{prefix}_regressor_inertia", doc, [("q", n, motions.inputs[0].doc)],
+                     ("Y", (n_stacked, rank), "row-major"), body, ops, code.used)
