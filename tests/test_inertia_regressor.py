@@ -97,3 +97,38 @@ def test_layout_helpers():
     rows = [stacked_row(j, k, n) for j in range(n) for k in range(j, n)]
     assert rows == list(range(n * (n + 1) // 2))
     assert [motion_index(i, j) for i in range(n) for j in range(i + 1)] == list(range(n * (n + 1) // 2))
+
+
+class Counter:
+    """A number that only counts the multiplications and additions made with it."""
+
+    mul = add = 0
+
+    def __mul__(self, other):
+        Counter.mul += 1
+        return Counter()
+
+    def __add__(self, other):
+        Counter.add += 1
+        return Counter()
+
+    __sub__ = __add__
+
+
+def test_operation_count_is_the_loop_trips_times_the_body_plus_the_motions():
+    """The header's count of Y_m equals the motions' straight-line count plus the products and
+    sums that evaluating every filled entry with phi makes (counted by brute force here)."""
+    from dyngen.emission.c_code import straight_line
+    from dyngen.emission.opcount import count_all
+    from dyngen.generate import build
+
+    robot = load_robot(ARMS["lwr"])
+    bases, emitted = build(robot)
+    motions = Derivation(robot).unit_accelerations()
+    straight = straight_line(robot.name, robot.joints, motions, motions.outputs).ops + count_all(motions.outputs)
+    n = robot.dof
+    Counter.mul = Counter.add = 0
+    stacked_regressor([[Counter() for _ in range(6)] for _ in range(n * (n + 1) // 2)], bases["inertia"].pivots, n)
+    reported = next(f.ops for f in emitted.functions if f.name == "lwr_regressor_inertia")
+    assert (reported.mul, reported.add) == (straight.mul + Counter.mul, straight.add + Counter.add)
+    assert Counter.mul > 1000  # the loop is most of it: O(n^3) products for an O(n^3) output

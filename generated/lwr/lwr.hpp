@@ -218,7 +218,7 @@ inline RegressorGravity regressor_gravity(const Eigen::MatrixBase<A0> &q)
     return Y;
 }
 
-/* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
+/* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body).
  * lwr_regressor_inertia(q: Joints, Y: RegressorInertia written) */
 template <typename A0, typename Out>
 inline void regressor_inertia(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &Y)

@@ -164,7 +164,7 @@ void lwr_regressor_gravity(const lwr_real *q, lwr_real *Y)
     Y[83] = -x10;
 }
 
-/* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. */
+/* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body). */
 void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
 {
     /* joint angles */
@@ -297,25 +297,54 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
     for (int e = 0; e < 1092; ++e) Y[e] = 0;
     for (int c = 0; c < 39; ++c) {
         const int i = column_link[c];
-        const lwr_real (*link)[6] = S + i * (i + 1) / 2;
-        int row = 0;  /* row of M[j][j] in the stacked upper triangle */
-        for (int j = 0; j <= i; row += 7 - j, ++j) {
-            for (int k = j; k <= i; ++k) {
-                const lwr_real *a = link[j], *b = link[k];
-                lwr_real y = 0;
-                switch (column_kind[c]) {
-                case 1: y = -a[1]*b[5] + a[2]*b[4] + a[4]*b[2] - a[5]*b[1]; break;  /* mx */
-                case 2: y = a[0]*b[5] - a[2]*b[3] - a[3]*b[2] + a[5]*b[0]; break;  /* my */
-                case 3: y = -a[0]*b[4] + a[1]*b[3] + a[3]*b[1] - a[4]*b[0]; break;  /* mz */
-                case 4: y = a[0]*b[0]; break;  /* XX */
-                case 5: y = a[0]*b[1] + a[1]*b[0]; break;  /* XY */
-                case 6: y = a[0]*b[2] + a[2]*b[0]; break;  /* XZ */
-                case 7: y = a[1]*b[1]; break;  /* YY */
-                case 8: y = a[1]*b[2] + a[2]*b[1]; break;  /* YZ */
-                case 9: y = a[2]*b[2]; break;  /* ZZ */
-                }
-                Y[(row + k - j) * 39 + c] = y;
-            }
+        const lwr_real (*link)[6] = S + i * (i + 1) / 2;  /* S_0 .. S_i of that link */
+        lwr_real *y = Y + c;  /* column c: row r is y[r * 39] */
+        switch (column_kind[c]) {  /* outside the loops: each loop body is branch-free */
+        case 1:  /* mx */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = -link[j][1]*link[k][5] + link[j][2]*link[k][4] + link[j][4]*link[k][2] - link[j][5]*link[k][1];
+            break;
+        case 2:  /* my */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][0]*link[k][5] - link[j][2]*link[k][3] - link[j][3]*link[k][2] + link[j][5]*link[k][0];
+            break;
+        case 3:  /* mz */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = -link[j][0]*link[k][4] + link[j][1]*link[k][3] + link[j][3]*link[k][1] - link[j][4]*link[k][0];
+            break;
+        case 4:  /* XX */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][0]*link[k][0];
+            break;
+        case 5:  /* XY */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][0]*link[k][1] + link[j][1]*link[k][0];
+            break;
+        case 6:  /* XZ */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][0]*link[k][2] + link[j][2]*link[k][0];
+            break;
+        case 7:  /* YY */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][1]*link[k][1];
+            break;
+        case 8:  /* YZ */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][1]*link[k][2] + link[j][2]*link[k][1];
+            break;
+        case 9:  /* ZZ */
+            for (int j = 0, row = 0; j <= i; row += 7 - j, ++j)  /* row: M[j][j]'s */
+                for (int k = j; k <= i; ++k)
+                    y[(row + k - j) * 39] = link[j][2]*link[k][2];
+            break;
         }
     }
 }
