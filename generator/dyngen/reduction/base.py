@@ -52,18 +52,19 @@ class SampledRegressor:
         return rows
 
 
+QUIET_STATES = 3  # fresh states in a row that must add nothing before the rank is taken as found
+
+
 def reduce(kind: str, sampled: SampledRegressor) -> BaseSet:
-    """Exact rank and regrouping; keeps sampling until fresh states add nothing."""
-    n = sampled.n_cols
-    rows_per_state = len(sampled.outputs)
-    states = n // rows_per_state + 2
-    rows = sampled.rows(states)
-    while True:
-        pivots, reduced = exact.rref(rows, n)
-        fresh = sampled.rows(3)
-        if exact.rref(reduced + fresh, n)[0] == pivots:
-            break
-        rows = reduced + fresh  # a fresh state raised the rank: keep it and go on
+    """Exact rank and regrouping; samples one state at a time until QUIET_STATES fresh
+    states in a row add nothing (each would, with probability ~1 - 1e-30, if the row space
+    were not complete)."""
+    echelon = exact.Echelon(sampled.n_cols)
+    quiet = 0
+    while quiet < QUIET_STATES:
+        grew = [echelon.add(row) for row in sampled.rows(1)]
+        quiet = 0 if any(grew) else quiet + 1
+    pivots, reduced = echelon.pivots, echelon.rows
     K = tuple(tuple(exact.rational(v) for v in row) for row in reduced)
     _check(kind, sampled, pivots, K)
     return BaseSet(kind, tuple(pivots), K)

@@ -9,6 +9,7 @@ rank over the rationals. No floating point tolerance is involved.
 
 from __future__ import annotations
 
+import bisect
 import random
 
 import sympy as sp
@@ -79,24 +80,38 @@ def rational(x: int) -> sp.Rational:
     return sp.Rational(r1, s1)
 
 
-def rref(rows: list[list[int]], n_cols: int):
-    """Reduced row echelon form over GF(P): (pivot columns, reduced rows)."""
-    rows = [list(r) for r in rows]
-    pivots = []
-    top = 0
-    for col in range(n_cols):
-        hit = next((r for r in range(top, len(rows)) if rows[r][col] % P), None)
-        if hit is None:
-            continue
-        rows[top], rows[hit] = rows[hit], rows[top]
-        inv = inverse(rows[top][col])
-        rows[top] = [(v * inv) % P for v in rows[top]]
-        for r in range(len(rows)):
-            if r != top and rows[r][col]:
-                k = rows[r][col]
-                rows[r] = [(v - k * w) % P for v, w in zip(rows[r], rows[top])]
-        pivots.append(col)
-        top += 1
-        if top == len(rows):
-            break
-    return pivots, rows[: len(pivots)]
+class Echelon:
+    """A reduced row echelon basis over GF(P), grown one row at a time.
+
+    Each basis row has a leading 1 in its pivot column and zeros in every other pivot
+    column. A new row is reduced against the basis (dropped when nothing is left) and the
+    basis against it: O(rank x columns) per row, so only the rows sampled are eliminated,
+    not a tall matrix again and again. The result is the unique reduced form of the row space.
+    """
+
+    def __init__(self, n_cols: int):
+        self.n_cols = n_cols
+        self.pivots: list[int] = []  # increasing
+        self.rows: list[list[int]] = []  # rows[r] belongs to pivots[r]
+
+    def add(self, row) -> bool:
+        """Adds row's new direction, if any; True when the rank grew."""
+        row = [v % P for v in row]
+        for pivot, basis in zip(self.pivots, self.rows):
+            k = row[pivot]
+            if k:
+                row = [(v - k * w) % P for v, w in zip(row, basis)]
+        col = next((c for c, v in enumerate(row) if v), None)
+        if col is None:
+            return False
+        inv = inverse(row[col])
+        row = [(v * inv) % P for v in row]
+        for r, basis in enumerate(self.rows):
+            k = basis[col]
+            if k:
+                self.rows[r] = [(v - k * w) % P for v, w in zip(basis, row)]
+        at = bisect.bisect(self.pivots, col)
+        self.pivots.insert(at, col)
+        self.rows.insert(at, row)
+        return True
+
