@@ -99,17 +99,17 @@ class Echelon:
         row = [v % P for v in row]
         for pivot, basis in zip(self.pivots, self.rows):
             k = row[pivot]
-            if k:
-                row = [(v - k * w) % P for v, w in zip(row, basis)]
+            if k:  # a basis row is zero left of its pivot: only the columns from there on change
+                row[pivot:] = [(v - k * w) % P for v, w in zip(row[pivot:], basis[pivot:])]
         col = next((c for c, v in enumerate(row) if v), None)
         if col is None:
             return False
         inv = inverse(row[col])
-        row = [(v * inv) % P for v in row]
+        row[col:] = [(v * inv) % P for v in row[col:]]
         for r, basis in enumerate(self.rows):
             k = basis[col]
             if k:
-                self.rows[r] = [(v - k * w) % P for v, w in zip(basis, row)]
+                basis[col:] = [(v - k * w) % P for v, w in zip(basis[col:], row[col:])]
         at = bisect.bisect(self.pivots, col)
         self.pivots.insert(at, col)
         self.rows.insert(at, row)
