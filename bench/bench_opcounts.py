@@ -68,7 +68,11 @@ def main(argv=None) -> int:
     text = ("# Operation counts of the generated functions\n\n"
             "Written by `python bench/bench_opcounts.py`. Each cell: multiplications / additions (subtractions "
             "included) / sin and cos calls, counted in the emitted C (divisions noted where there are any); "
-            "the column head gives the number of joints.\n\n" + table(arms) + "\n")
+            "the column head gives the number of joints. Straight-line code is counted as printed; "
+            "`<arm>_regressor_inertia` (Y_m) is straight-line link motions plus a loop over its base columns, "
+            "counted as the motions' operations plus each column's loop trips times its loop body "
+            "(generator/dyngen/emission/inertia_regressor.py; index arithmetic not counted).\n\n"
+            + table(arms) + "\n")
     print(text)
     if args.output:
         out = Path(args.output)
