@@ -2,7 +2,8 @@
 
 A `Model` is the math of one emitted C function: its inputs (name, symbols, meaning),
 its pruned assignments and its flat outputs. Regressors come full (all 10N standard
-parameters); reduction picks their base columns.
+parameters); reduction picks their base columns. The inertia regressor Y_m is not one of
+them: it is emitted from its factors, `unit_accelerations` (derivation/inertia.py).
 """
 
 from __future__ import annotations
