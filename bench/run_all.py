@@ -205,7 +205,7 @@ def summary() -> list:
         lines.append(f"- Scaling: the {last['n']}-joint synthetic arm generates in {last['generate_s']:.1f} s wall "
                      f"(target < 60 s) and its C compiles in {last['compile_s']:.1f} s wall; growth exponents of cost "
                      f"(target <= 2): generation CPU time {k['generate s']:.2f}, cc CPU time {k['compile s']:.2f}, "
-                     f"C size {k['C bytes']:.2f}; of run-time multiplications (bound by output size): rnea "
+                     f"C size {k['C lines']:.2f} in lines, {k['C bytes']:.2f} in bytes; of run-time multiplications (bound by output size): rnea "
                      f"{k['rnea mul']:.2f}, Y {k['regressor mul']:.2f}, M {k['mass_matrix mul']:.2f}, Y_m "
                      f"{k['regressor_inertia mul']:.2f} (its output has O(n^3) entries).")
     return lines
