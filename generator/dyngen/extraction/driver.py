@@ -70,6 +70,7 @@ def problem_text(problem: Problem, stage: Stage, options: Options) -> str:
     lines = ["dyngen-extraction 1", f"parameters {problem.lower.size}",
              f"lower {vec(problem.lower)}", f"upper {vec(problem.upper)}", f"value {vec(stage.value)}",
              f"reference {vec(problem.reference)}", f"weight {vec(problem.weight)}",
+             f"center {vec(problem.center)}",
              "free " + " ".join(str(int(f)) for f in stage.free)]
     lo, hi = problem.total_mass if problem.total_mass else (0.0, 0.0)
     lines.append(f"total_mass {int(problem.total_mass is not None)} {lo!r} {hi!r}")
