@@ -45,6 +45,9 @@ class Stage:
     blocks: list[Target]
     free: np.ndarray  # bool (10N,)
     value: np.ndarray  # values of the fixed parameters (and the reference start)
+    # the next stage's targets: among this stage's best fits, the driver returns the one that fits
+    # these best (the next stage keeps part of it fixed)
+    next_blocks: list[Target] = field(default_factory=list)
 
 
 @dataclass
