@@ -149,7 +149,7 @@ def consistent_inside_bounds(robot, seed):
 @pytest.mark.parametrize("arm", ["lwr", "panda", "puma560"])
 def test_exact_consistent_solution_is_found(arm, tmp_path):
     """Coefficients of known consistent parameters: the best restart reproduces them to 1e-9,
-    at least 95% of the restarts end consistent and most of them exact. (Before the local
+    at least 95% of the restarts end consistent and 85% exact. (Before the local
     refinement moved to the standard parameters, 0 of 16 PUMA 560 restarts were exact.)"""
     base = build_arm(ROOT / "examples" / f"{arm}.yaml", tmp_path / "base")
     p_true = consistent_inside_bounds(base.robot, seed=3)
@@ -165,7 +165,22 @@ def test_exact_consistent_solution_is_found(arm, tmp_path):
     assert stage.consistent >= 0.95 * stage.restarts
     norm = np.sqrt(sum(np.sum(t.v ** 2) for t in ex.targets.values()))
     exact = (stage.restart_violations <= 1e-10) & (np.sqrt(stage.restart_costs) <= 1e-9 * norm)
-    assert exact.mean() >= 0.75, f"{exact.sum()} of {exact.size} restarts exact"
+    assert exact.mean() >= 0.85, f"{exact.sum()} of {exact.size} restarts exact"
+
+
+def test_two_stage_reaches_known_parameters_coefficients(tmp_path):
+    """Coefficients of known consistent parameters (PUMA 560): both stages fit exactly. The gravity
+    stage must hand over, among its infinitely many exact fits, one from which the inertia stage can
+    fit too (an arbitrary one left the inertia stage at a relative error of 3e-4 to 1e-3)."""
+    base = build_arm(ROOT / "examples" / "puma560.yaml", tmp_path / "base")
+    p_true = consistent_inside_bounds(base.robot, seed=3)
+    robot = load_robot(synthetic_yaml(base, p_true, tmp_path))
+    ex = extract(robot, base.bases, base.c.folder, Options(restarts=8, procedure="two-stage"))
+    for kind in ("gravity", "inertia"):
+        want, got = base.c(f"pi_{kind}", p_true), base.c(f"pi_{kind}", ex.p)
+        assert np.linalg.norm(got - want) <= 1e-9 * np.linalg.norm(want), kind
+    assert all(physically_consistent(row) for row in ex.p.reshape(-1, 10))
+    assert all(stage.consistent == stage.restarts for stage in ex.stages)
 
 
 def test_conflicting_bounds_are_named(lwr, tmp_path):
