@@ -183,6 +183,22 @@ def test_two_stage_reaches_known_parameters_coefficients(tmp_path):
     assert all(stage.consistent == stage.restarts for stage in ex.stages)
 
 
+@pytest.mark.parametrize("arm", ["lwr", "panda", "puma560", "ur5", "stanford"])
+def test_barrier_start_is_strictly_inside(arm):
+    """The driver's barrier method starts from the problem's centre: strictly inside every bound,
+    every link strictly consistent (eigenvalues of I checked here, not through dyngen's margin)."""
+    from dyngen.extraction.problem import build_problem
+
+    robot = load_robot(ROOT / "examples" / f"{arm}.yaml")
+    problem = build_problem(robot, Options())
+    center = problem.center
+    assert np.all(problem.lower < center) and np.all(center < problem.upper)
+    for row in center.reshape(-1, 10):
+        xx, xy, xz, yy, yz, zz = row[4:10]
+        eig = np.linalg.eigvalsh(np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+        assert eig.min() > 0 and eig[0] + eig[1] > eig[2] + 2 * Options().margin
+
+
 def test_conflicting_bounds_are_named(lwr, tmp_path):
     text = lwr.yaml.read_text()
     # link 3: Izz >= 0.04 while Ixx + Iyy <= 0.02 breaks the triangle inequality
