@@ -139,7 +139,7 @@ def table(rows, restarts, scipy_restarts, problems) -> str:
     lines = ["# Extraction: dyngen (NLopt driver) vs SciPy (dual_annealing + SLSQP)", "",
              f"Per arm, {problems} synthetic problems: coefficients from known consistent parameters inside the",
              "YAML's bounds (an exact consistent solution exists). dyngen: "
-             f"{restarts} restarts per problem (ISRES, then SLSQP), all cores;",
+             f"{restarts} restarts per problem (ISRES, then a barrier Newton method in the standard parameters), all cores;",
              f"SciPy: {scipy_restarts} restarts per problem (dual_annealing on a penalised cost, then SLSQP with the",
              "constraints and the same compiled gradients). *consistent*: every constraint holds (physical",
              "consistency, bounds, total mass); *exact*: consistent and relative coefficient error <= 1e-9.",

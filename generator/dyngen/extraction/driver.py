@@ -70,15 +70,17 @@ def problem_text(problem: Problem, stage: Stage, options: Options) -> str:
     lines = ["dyngen-extraction 1", f"parameters {problem.lower.size}",
              f"lower {vec(problem.lower)}", f"upper {vec(problem.upper)}", f"value {vec(stage.value)}",
              f"reference {vec(problem.reference)}", f"weight {vec(problem.weight)}",
+             f"center {vec(problem.center)}",
              "free " + " ".join(str(int(f)) for f in stage.free)]
     lo, hi = problem.total_mass if problem.total_mass else (0.0, 0.0)
     lines.append(f"total_mass {int(problem.total_mass is not None)} {lo!r} {hi!r}")
     lines.append(f"margin {options.margin!r}")
-    lines.append(f"blocks {len(stage.blocks)}")
-    for block in stage.blocks:
-        lines.append(f"{block.kind} {block.W.shape[0]}")
-        lines.extend(vec(row) for row in block.W)
-        lines.append(vec(block.v))
+    for key, blocks in (("blocks", stage.blocks), ("next_blocks", stage.next_blocks)):
+        lines.append(f"{key} {len(blocks)}")
+        for block in blocks:
+            lines.append(f"{block.kind} {block.W.shape[0]}")
+            lines.extend(vec(row) for row in block.W)
+            lines.append(vec(block.v))
     lines.append(f"equalities {len(problem.equalities)}")
     for terms in problem.equalities:
         lines.append(str(len(terms)) + " " + " ".join(

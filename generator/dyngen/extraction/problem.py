@@ -45,6 +45,9 @@ class Stage:
     blocks: list[Target]
     free: np.ndarray  # bool (10N,)
     value: np.ndarray  # values of the fixed parameters (and the reference start)
+    # the next stage's targets: among this stage's best fits, the driver returns the one that fits
+    # these best (the next stage keeps part of it fixed)
+    next_blocks: list[Target] = field(default_factory=list)
 
 
 @dataclass
@@ -56,6 +59,7 @@ class Problem:
     weight: np.ndarray
     total_mass: tuple | None
     equalities: list = field(default_factory=list)  # [[(coefficient, [indices])]]
+    center: np.ndarray | None = None  # strictly inside the bounds and consistency (see strict_center)
 
 
 def bounds(robot, options: Options) -> tuple[np.ndarray, np.ndarray]:
@@ -78,6 +82,7 @@ def build_problem(robot, options: Options) -> Problem:
     problem = Problem(robot.dof, lower, upper, reference, 1.0 / span**2, robot.total_mass)
     problem.equalities = [identity_terms(text, robot) for text in options.identities]
     check_feasible(problem, options, robot.source)
+    problem.center = strict_center(problem, options)
     return problem
 
 
@@ -120,6 +125,11 @@ def check_feasible(problem: Problem, options: Options, source: str) -> None:
 def best_inertia_margin(lower, upper, link: int) -> float:
     """max over the box of lambda_min(tr(I)/2 E - I), with the diagonal chosen by a small LP and
     the products of inertia as close to zero as their bounds allow (a lower bound of the maximum)."""
+    return most_consistent_inertia(lower, upper, link)[1]
+
+
+def most_consistent_inertia(lower, upper, link: int) -> tuple[np.ndarray, float]:
+    """(xx, xy, xz, yy, yz, zz) of best_inertia_margin's inertia, and its margin (-inf: none)."""
     base = PER_LINK * link + 4
     lo, hi = lower[base: base + 6], upper[base: base + 6]
     diag = [0, 3, 5]  # xx, yy, zz
@@ -133,11 +143,40 @@ def best_inertia_margin(lower, upper, link: int) -> float:
     result = linprog(c=[0, 0, 0, -1], A_ub=A, b_ub=b,
                      bounds=[(lo[d], hi[d]) for d in diag] + [(None, None)], method="highs")
     if not result.success:
-        return -np.inf
+        return 0.5 * (lo + hi), -np.inf
     xx, yy, zz = result.x[:3]
     xy, xz, yz = (float(np.clip(0.0, lo[k], hi[k])) for k in (1, 2, 4))
+    entries = np.array([xx, xy, xz, yy, yz, zz])
+    return entries, inertia_margin(entries)
+
+
+def inertia_margin(entries) -> float:
+    """lambda_min(tr(I)/2 E - I) of I given as (xx, xy, xz, yy, yz, zz)."""
+    xx, xy, xz, yy, yz, zz = entries
     inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     return float(np.linalg.eigvalsh(0.5 * np.trace(inertia) * np.eye(3) - inertia).min())
+
+
+def strict_center(problem: Problem, options: Options) -> np.ndarray:
+    """Parameters strictly inside every bound and strictly consistent where the bounds allow: the
+    driver's barrier method starts from points pulled towards it. Masses and centres of mass at the
+    middle of their bounds (the driver moves the masses into the total-mass window); per link the
+    inertia at the middle of its box if that is consistent with room to spare, else the mix of the
+    middle with the most consistent inertia (consistency is concave in I, so the mix keeps part of
+    its margin while leaving the box's faces)."""
+    center = 0.5 * (problem.lower + problem.upper)
+    for link in range(problem.n_links):
+        base = PER_LINK * link + 4
+        best, best_margin = most_consistent_inertia(problem.lower, problem.upper, link)
+        middle = center[base: base + 6].copy()
+        for t in (1.0, 0.5, 0.25, 0.1, 0.01):
+            mix = t * middle + (1 - t) * best
+            if inertia_margin(mix) > options.margin + 0.5 * max(best_margin - options.margin, 0.0):
+                center[base: base + 6] = mix
+                break
+        else:
+            center[base: base + 6] = best
+    return center
 
 
 def is_consistent(p: np.ndarray, margin: float = 0.0) -> np.ndarray:
@@ -149,6 +188,4 @@ def is_consistent(p: np.ndarray, margin: float = 0.0) -> np.ndarray:
 
 
 def consistency_margin(link10) -> float:
-    xx, xy, xz, yy, yz, zz = link10[4:10]
-    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-    return float(np.linalg.eigvalsh(0.5 * np.trace(inertia) * np.eye(3) - inertia).min())
+    return inertia_margin(link10[4:10])

@@ -45,6 +45,7 @@ def plan(robot, bases, targets: dict, problem: Problem, options: Options) -> lis
         in_gravity = set(dynamic.alone) | set(dynamic.grouped)
         free = np.array([dynamic_name(j // PER_LINK + 1, j % PER_LINK) not in in_gravity for j in range(n)])
         stages.append(Stage("inertia", rest, free, problem.reference.copy()))
+        stages[0].next_blocks = rest
     return stages
 
 
