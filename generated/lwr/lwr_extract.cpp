@@ -32,7 +32,6 @@
 #include <iostream>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
