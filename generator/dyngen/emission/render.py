@@ -18,7 +18,7 @@ from .eigen import eigen_interface
 from .inertia_regressor import render_inertia_regressor
 from .selftest import N_STATES, TOLERANCE, c_numbers, selftest_data
 
-TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
+TEMPLATES = Path(__file__).resolve().parents[1] / "templates"  # a link to the top-level templates/, shipped in the wheel
 FRICTION_PER_JOINT = 5  # Fc, Fv, Fs, vs, eps (templates/friction.c.j2)
 KIND_LABELS = {"gravity": "gravity vector g(q) = Y_g(q) pi_gravity",
                "inertia": "stacked inertia matrix m~(q) = Y_m(q) pi_inertia",
