@@ -106,7 +106,7 @@ class Echelon:
             return False
         inv = inverse(row[col])
         row[col:] = [(v * inv) % P for v in row[col:]]
-        for r, basis in enumerate(self.rows):
+        for basis in self.rows:
             k = basis[col]
             if k:
                 basis[col:] = [(v - k * w) % P for v, w in zip(basis[col:], row[col:])]
