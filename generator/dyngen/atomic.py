@@ -37,12 +37,23 @@ def write_folder(target: Path, files: dict[str, str]) -> None:
 
 
 def write_file(target: Path, text: str) -> None:
+    _replace(target, "w", lambda f: f.write(text))
+
+
+def write_figure(target: Path, fig, dpi: int) -> Path:
+    """A matplotlib figure as PNG; returns the path."""
+    _replace(target, "wb", lambda f: fig.savefig(f, format="png", dpi=dpi))
+    return Path(target)
+
+
+def _replace(target: Path, mode: str, write) -> None:
+    """write(file) into a temporary file beside target, then rename it over target."""
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent)
     try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
+        with os.fdopen(fd, mode) as f:
+            write(f)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes it private; the output file is not
         os.replace(tmp, target)
     except BaseException:

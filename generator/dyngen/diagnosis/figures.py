@@ -12,6 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..atomic import write_figure  # noqa: E402
+
 from . import phases  # noqa: E402
 
 DPI = 110
@@ -41,9 +43,7 @@ def _grid(n):
 def _save(fig, path, title) -> Path:
     fig.suptitle(title, fontsize=12)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)
+    path = write_figure(path, fig, DPI)
     plt.close(fig)
     return path
 

@@ -11,6 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..atomic import write_figure  # noqa: E402
+
 DPI = 120
 
 
@@ -66,9 +68,7 @@ def trajectory_figure(t, q, qd, qdd, path, knot_times=None, title="Joint traject
     fig.legend(handles, labels, loc="upper center", ncol=len(handles), frameon=False, bbox_to_anchor=(0.5, 0.955))
     fig.suptitle(title, fontsize=12, y=0.99)
     fig.tight_layout(rect=(0, 0, 1, 0.93))
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)
+    path = write_figure(path, fig, DPI)
     plt.close(fig)
     return path
 
@@ -113,8 +113,6 @@ def torque_comparison_figure(t, tau_ne, tau_coeff, path, knot_times=None,
     fig.tight_layout(rect=(0, 0, 1, 0.94))
     for ax in axes[:n + 1]:
         ax.set_xlim(t[0], t[-1])
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI)
+    path = write_figure(path, fig, DPI)
     plt.close(fig)
     return path
