@@ -67,7 +67,13 @@ def candidates_of(effects, n_joints: int, sizes: dict) -> list[Candidate]:
 
 def effect_columns(effects, context, segment) -> dict:
     """effect key -> (T, N, k) columns on one segment."""
-    return {e.key: np.asarray(e.columns(context, segment.signals, segment.tau_model), dtype=float) for e in effects}
+    return {e.key: columns_of(e, context, segment) for e in effects}
+
+
+def columns_of(effect, context, segment) -> np.ndarray:
+    """An effect's columns passed through the recording's filter, like the torque they explain
+    (a filtered step of friction is then compared with a filtered step, not a sharp one)."""
+    return segment.signals.filtered(np.asarray(effect.columns(context, segment.signals, segment.tau_model), float))
 
 
 def joint_matrix(candidates, columns: dict, joint: int) -> tuple[np.ndarray, np.ndarray]:

@@ -5,7 +5,7 @@ vs, and the time shift, whose exact form tau_model(t - dt) - tau_model(t) is lin
 Selection works with a few variants of vs and with the time shift to first order (the
 derivative of tau_model), which is wrong wherever tau_model jumps (acceleration steps, e.g.
 rest-to-rest trajectories). Once such an effect is selected, its setting is refined on the
-fit samples, every other selected effect refitted each time (held-out data stay unused):
+fit samples, every other selected effect refitted each time (selection and test data stay unused):
 
   - a setting the fitted values imply (Effect.implied_setting: the time shift, whose exact
     column at dt0 gives the fitted value dt = dt0 when the model holds) by fixed-point
@@ -41,6 +41,13 @@ def refine(context, segments, design, chosen):
     return state.design, state.chosen
 
 
+def restricted(context, segments, design, chosen):
+    """The design of the chosen candidates alone on the segments' current masks (e.g. after
+    the fit masks were widened), weighted as `design`; and the candidates renumbered."""
+    state = _State(context, segments, design, _renumbered(chosen))
+    return state.design, state.chosen
+
+
 class _State:
     """The chosen candidates, their columns per segment and their restricted design."""
 
@@ -63,7 +70,7 @@ class _State:
         old = self.chosen[index]
         effect = old.effect.at(setting)
         chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
-        columns = [{**cols, effect.key: np.asarray(effect.columns(self.context, seg.signals, seg.tau_model), float)}
+        columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg)}
                    for cols, seg in zip(self.columns, self.segments)]
         return chosen, columns, self.restricted(chosen, columns)
 
@@ -74,7 +81,7 @@ class _State:
         """Moments of the chosen candidates only, weighted as the selection's design."""
         n = self.weights.size
         size = sum(c.size for c in chosen)
-        fit, held = dz.empty(n, size), dz.empty(n, size)
+        fit, select, test = dz.empty(n, size), dz.empty(n, size), dz.empty(n, size)
         for seg, cols in zip(self.segments, columns):
             for j in range(n):
                 acting = [c for c in chosen if c.joint is None or c.joint == j]
@@ -82,12 +89,13 @@ class _State:
                     A, slots = dz.joint_matrix(acting, cols, j)
                 else:
                     A, slots = np.zeros((seg.residual.shape[0], 0)), np.zeros(0, dtype=int)
-                for moments, mask in ((fit, seg.fit), (held, seg.held)):
+                for moments, mask in ((fit, seg.fit), (select, seg.select), (test, seg.test)):
                     if mask.any():
                         dz.accumulate(moments, A[mask], slots, seg.residual[mask, j], j)
             fit.count += int(seg.fit.sum())
-            held.count += int(seg.held.sum())
-        return type(self.template)(chosen, fit, held, self.weights)
+            select.count += int(seg.select.sum())
+            test.count += int(seg.test.sum())
+        return type(self.template)(chosen, fit, select, test, self.weights)
 
 
 def _refine_one(state, index) -> None:

@@ -1,12 +1,12 @@
-"""Forward selection of effects by what they do on held-out data.
+"""Forward selection of effects by what they do on selection data (not the fit's samples).
 
 Fit: weighted least squares on the fit samples, every joint's rows divided by the RMS of
 its nominal residual there (so a joint with a large residual does not drown the others).
-Gain: on the held-out samples, the decrease of the residual's mean square relative to its
+Gain: on the selection samples, the decrease of the residual's mean square relative to its
 value before the step, on the candidate's own joint (per-joint effects) or summed over joints
-(arm-wide effects). A step adds the candidate with the largest held-out gain if
+(arm-wide effects). A step adds the candidate with the largest selection gain if
 
-  - the gain is at least `min_gain` (default 0.05: 5 % of one joint's current held-out mean
+  - the gain is at least `min_gain` (default 0.05: 5 % of one joint's current selection mean
     square), so an effect must generalise, not merely fit, and
   - its fitted values are significant on the fit data (chi-square test of x_c^T Cov_cc^-1 x_c,
     p < `alpha`), so noise alone does not qualify, and
@@ -106,13 +106,13 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     return float(stats.chi2.sf(chi2, int(keep.sum())))
 
 
-def heldout_mse(design, chosen) -> np.ndarray:
+def selection_mse(design, chosen) -> np.ndarray:
     fit = solve(design, chosen)
-    return design.held.mse(fit.slots, fit.x) if chosen else design.held.c / max(design.held.count, 1)
+    return design.select.mse(fit.slots, fit.x) if chosen else design.select.c / max(design.select.count, 1)
 
 
-def heldout_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
-    """Relative decrease of the held-out mean square: on the candidate's own joint for a
+def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
+    """Relative decrease of the selection mean square: on the candidate's own joint for a
     per-joint effect (a refit of arm-wide effects must not lend it credit from other joints),
     summed over joints for an arm-wide effect."""
     relative = (before - after) / np.maximum(before, 1e-300)
@@ -123,7 +123,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
     """Forward steps; the significance test here assumes uncorrelated residuals (prune() then
     applies the honest, correlation-scaled test to what was selected)."""
     selection = Selection([])
-    current = heldout_mse(design, [])
+    current = selection_mse(design, [])
     tau = 1.0
     while len(selection.chosen) < max_steps:
         families = {c.family for c in selection.chosen}
@@ -133,8 +133,8 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
                 continue
             chosen = selection.chosen + [cand]
             fit = solve(design, chosen)
-            mse = design.held.mse(fit.slots, fit.x)
-            gain = heldout_gain(cand, current, mse)
+            mse = design.select.mse(fit.slots, fit.x)
+            gain = selection_gain(cand, current, mse)
             if not selection.chosen:
                 selection.first_gains[cand.key] = gain
             if gain >= min_gain and cand.effect.plausible(fit.x[-cand.size:]):
@@ -146,13 +146,13 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
         near = [t for t in qualified if t[0] >= NEAR_BEST * best]
         gain, cand, mse, _, _ = min(near, key=lambda t: (t[1].size, -t[0]))
         selection.chosen.append(cand)
-        selection.steps.append({"candidate": cand.key, "gain": gain, "heldout_rms": np.sqrt(mse).tolist()})
+        selection.steps.append({"candidate": cand.key, "gain": gain, "selection_rms": np.sqrt(mse).tolist()})
         current = mse
     return selection
 
 
 def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list, float, list]:
-    """Backward elimination: drop an effect whose held-out gain, with all the others kept, is
+    """Backward elimination: drop an effect whose selection gain, with all the others kept, is
     not positive; then, with deviations scaled by the correlation time of the residual the
     chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
     effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
@@ -162,9 +162,9 @@ def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list
         tau = correlation(chosen, fit)
         if not chosen:
             return chosen, tau, dropped
-        with_all = design.held.mse(fit.slots, fit.x)
-        # An effect that no longer helps on held-out data once the others are in goes first.
-        gains = [heldout_gain(c, heldout_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
+        with_all = design.select.mse(fit.slots, fit.x)
+        # An effect that no longer helps on selection data once the others are in goes first.
+        gains = [selection_gain(c, selection_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
         if min(gains) <= 0:
             dropped.append(chosen.pop(int(np.argmin(gains))).key)
             continue

@@ -17,6 +17,8 @@ class Context:
     p: np.ndarray
     s: np.ndarray
     sign_velocity: float = 0.002  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
+    q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
+    qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
 
     def sign(self, qd: np.ndarray) -> np.ndarray:
         return np.tanh(qd / self.sign_velocity)
@@ -32,6 +34,7 @@ class Effect:
     units: tuple = ()
     label = ""  # a variant's setting, e.g. "vs = 0.1 rad/s"
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
+    suspect = False  # a symptom rather than a cause: always reported with a warning
 
     def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the

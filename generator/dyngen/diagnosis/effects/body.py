@@ -20,8 +20,17 @@ class Payload(Effect):
     parameters = STANDARD_NAMES_PER_LINK
     units = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
 
+    max_mass = np.inf  # kg: the arm's own mass (set in columns); a heavier "payload" is refused
+
+    def plausible(self, values):
+        """A body has a positive mass, not more than the arm's, and its centre of mass
+        within a metre of the flange frame."""
+        m = values[0]
+        return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
+
     def columns(self, context, signals, tau_model):
         n = signals.q.shape[1]
+        self.max_mass = float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0]))
         out = np.empty(signals.q.shape + (PER_LINK,))
         for k in range(PER_LINK):
             unit = np.zeros(PER_LINK * n)
