@@ -72,8 +72,10 @@ def effect_columns(effects, context, segment) -> dict:
 
 def columns_of(effect, context, segment) -> np.ndarray:
     """An effect's columns passed through the recording's filter, like the torque they explain
-    (a filtered step of friction is then compared with a filtered step, not a sharp one)."""
-    return segment.signals.filtered(np.asarray(effect.columns(context, segment.signals, segment.tau_model), float))
+    (a filtered step of friction is then compared with a filtered step, not a sharp one).
+    Computed once per segment and effect setting (the selection and the pruning ask again)."""
+    return context.memo(("columns", id(segment), effect.key), lambda: segment.signals.filtered(
+        np.asarray(effect.columns(context, segment.signals, segment.tau_model), float)))
 
 
 def joint_matrix(candidates, columns: dict, joint: int) -> tuple[np.ndarray, np.ndarray]:

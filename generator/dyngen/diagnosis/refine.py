@@ -27,7 +27,8 @@ from scipy.optimize import minimize_scalar
 from . import design as dz
 from .selection import solve
 
-REFINE_TOLERANCE = 1e-3  # relative (fixed point) or of the search interval's width
+REFINE_TOLERANCE = 1e-3  # relative (fixed point)
+SEARCH_TOLERANCE = 0.01  # in the logarithm of a searched setting: 1 %
 MAX_ITERATIONS = 30
 
 
@@ -72,7 +73,35 @@ class _State:
         chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
         columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg)}
                    for cols, seg in zip(self.columns, self.segments)]
-        return chosen, columns, self.restricted(chosen, columns)
+        return chosen, columns, self.updated(chosen, columns, index)
+
+    def updated(self, chosen, columns, index):
+        """self.design with the rows and columns of candidate `index` recomputed (the others'
+        moments do not change when one candidate's setting does)."""
+        cand = chosen[index]
+        new = cand.slots
+        design = self.design
+        moments = [dz.Moments(m.G.copy(), m.b.copy(), m.c.copy(), m.count)
+                   for m in (design.fit, design.select, design.test)]
+        joints = range(self.weights.size) if cand.joint is None else [cand.joint]
+        for m in moments:
+            for j in joints:
+                m.G[j][new, :] = 0.0
+                m.G[j][:, new] = 0.0
+                m.b[j][new] = 0.0
+        for seg, cols in zip(self.segments, columns):
+            for j in joints:
+                acting = [c for c in chosen if c.joint is None or c.joint == j]
+                A, slots = dz.joint_matrix(acting, cols, j)
+                B = cols[cand.effect.key][:, j, :]
+                for m, mask in zip(moments, (seg.fit, seg.select, seg.test)):
+                    if mask.any():
+                        cross = A[mask].T @ B[mask]
+                        m.G[j][np.ix_(slots, new)] += cross
+                        m.G[j][np.ix_(new, slots)] += cross.T
+                        m.G[j][np.ix_(new, new)] -= B[mask].T @ B[mask]  # counted twice above
+                        m.b[j][new] += B[mask].T @ seg.residual[mask, j]
+        return type(self.template)(chosen, *moments, self.weights)
 
     def accept(self, trial):
         self.chosen, self.columns, self.design = trial
@@ -118,9 +147,11 @@ def _refine_one(state, index) -> None:
         chosen, _, design = state.trial(index, setting)
         return _weighted_sse(design, solve(design, chosen))
 
-    lo, hi = interval
-    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"xatol": REFINE_TOLERANCE * (hi - lo)})
-    state.accept(state.trial(index, float(best.x)))
+    # Searched in the logarithm of the setting (a velocity scale matters by its ratio).
+    lo, hi = np.log(interval[0]), np.log(interval[1])
+    best = minimize_scalar(lambda u: cost(float(np.exp(u))), bounds=(lo, hi), method="bounded",
+                           options={"xatol": SEARCH_TOLERANCE})
+    state.accept(state.trial(index, float(np.exp(best.x))))
 
 
 def _renumbered(chosen) -> list:

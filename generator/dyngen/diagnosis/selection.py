@@ -38,8 +38,15 @@ NEAR_BEST = 0.9
 class Fit:
     x: np.ndarray  # values at the chosen slots
     slots: np.ndarray
-    covariance: np.ndarray  # white-residual covariance (scaled later for correlation)
-    sigma2: float
+    covariance: np.ndarray | None  # white-residual covariance (scaled later for correlation), or only
+    sigma2: float                  # the block of `block` (see solve)
+    block: slice | None = None
+
+    def covariance_of(self, k: slice) -> np.ndarray:
+        if self.block is None:
+            return self.covariance[k, k]
+        assert k == self.block, "covariance computed for another block"
+        return self.covariance
 
 
 @dataclass
@@ -49,26 +56,47 @@ class Selection:
     first_gains: dict = field(default_factory=dict)  # candidate key -> gain when tried alone
 
 
-def solve(design, chosen) -> Fit:
+def solve(design, chosen, block: slice | None = None, covariance: bool = True) -> Fit:
     """Weighted least squares of the chosen candidates on the fit samples (moments only).
 
     The covariance is the sandwich H^-1 (sum_j w_j^4 s_j^2 G_j) H^-1 with s_j^2 joint j's own
     residual variance: joints differ in noise, and the weights (from the nominal residual,
-    which contains the very effects sought) are not their noise levels."""
+    which contains the very effects sought) are not their noise levels. With `block`, only
+    that block of it is computed (the forward selection tests one candidate at a time); with
+    covariance False, none."""
     slots = np.concatenate([c.slots for c in chosen]) if chosen else np.zeros(0, dtype=int)
     H = design.H[np.ix_(slots, slots)]
     g = design.g[slots]
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    inverse = _inverse(H / np.outer(d, d)) / np.outer(d, d)
-    x = inverse @ g
+    apply = _solver(H / np.outer(d, d))
+    x = apply(g / d) / d
+    if not covariance:
+        return Fit(x, slots, None, float("nan"), block)
     fit = design.fit
     w2 = design.weights ** 2
     G = fit.G[:, slots][:, :, slots]
     sse = np.maximum(fit.c - 2 * fit.b[:, slots] @ x + np.einsum("k,jkl,l->j", x, G, x), 0.0)
     s2 = sse / max(fit.count - len(slots), 1)  # per joint
     middle = np.einsum("j,jkl->kl", w2 ** 2 * s2, G)
-    covariance = inverse @ middle @ inverse
-    return Fit(x, slots, covariance, float(w2 @ s2) / len(s2))
+    unit = np.eye(len(slots))[:, block if block is not None else slice(None)]
+    columns = apply(unit / d[:, None]) / d[:, None]  # the needed columns of H^-1
+    return Fit(x, slots, columns.T @ middle @ columns, float(w2 @ s2) / len(s2), block)
+
+
+def _solver(Hs: np.ndarray):
+    """b -> Hs^-1 b for a unit-diagonal normal matrix: Cholesky, or a pseudo-inverse when
+    columns are dependent (dependent columns then share no value instead of taking arbitrary
+    large ones)."""
+    if Hs.size == 0:
+        return lambda b: np.zeros_like(b)
+    try:
+        factor = linalg.cho_factor(Hs, check_finite=False)
+        if np.min(np.abs(np.diag(factor[0]))) > 1e-5:  # condition below about 1e10
+            return lambda b: linalg.cho_solve(factor, b, check_finite=False)
+    except linalg.LinAlgError:
+        pass
+    inverse = _inverse(Hs)
+    return lambda b: inverse @ b
 
 
 def _inverse(Hs: np.ndarray) -> np.ndarray:
@@ -96,7 +124,7 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     the residual's correlation time in samples (see correlation.py)."""
     offset = sum(c.size for c in chosen[:chosen.index(candidate)])
     k = slice(offset, offset + candidate.size)
-    x, C = fit.x[k], fit.covariance[k, k] * correlation
+    x, C = fit.x[k], fit.covariance_of(k) * correlation
     vals, vecs = np.linalg.eigh(C)
     keep = vals > 1e-12 * max(vals.max(initial=0.0), 1e-300)
     if not keep.any():
@@ -132,12 +160,14 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             if cand.family in families:
                 continue
             chosen = selection.chosen + [cand]
-            fit = solve(design, chosen)
+            fit = solve(design, chosen, covariance=False)
             mse = design.select.mse(fit.slots, fit.x)
             gain = selection_gain(cand, current, mse)
             if not selection.chosen:
                 selection.first_gains[cand.key] = gain
             if gain >= min_gain and cand.effect.plausible(fit.x[-cand.size:]):
+                size = len(fit.x)
+                fit = solve(design, chosen, block=slice(size - cand.size, size))
                 trials.append((gain, cand, mse, fit, chosen))
         qualified = [t for t in trials if significant(t[3], t[1], t[4], alpha, tau)]
         if not qualified:

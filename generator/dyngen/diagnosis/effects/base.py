@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,6 +19,13 @@ class Context:
     sign_velocity: float = 0.002  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
     q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
     qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
+    cache: dict = field(default_factory=dict)  # columns and shared intermediates, per recording (memo)
+
+    def memo(self, key, compute):
+        """compute() once per key for the life of one diagnosis (its recordings do not change)."""
+        if key not in self.cache:
+            self.cache[key] = compute()
+        return self.cache[key]
 
     def sign(self, qd: np.ndarray) -> np.ndarray:
         return np.tanh(qd / self.sign_velocity)

@@ -39,7 +39,7 @@ class Tilt(Effect):
 
     def columns(self, context, signals, tau_model):
         self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
-        G = gravity_matrix(context.robot, context.p, signals.q)  # (T, N, 3)
+        G = _gravity(context, signals)  # (T, N, 3)
         u1, u2 = tilt_directions(context.robot)
         return np.stack([G @ u1, G @ u2], axis=-1)
 
@@ -56,12 +56,17 @@ class GravityScale(Effect):
 
     def columns(self, context, signals, tau_model):
         self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
-        G = gravity_matrix(context.robot, context.p, signals.q)
+        G = _gravity(context, signals)
         u1, u2 = tilt_directions(context.robot)
         return (G @ np.cross(u1, u2))[:, :, None]
 
     def plausible(self, values):
         return bool(abs(values[0]) < MAX_GRAVITY_SCALE * self.g)
+
+
+def _gravity(context, signals) -> np.ndarray:
+    """G(q) of a recording, computed once for the tilt and the gravity scale."""
+    return context.memo(("gravity_matrix", id(signals)), lambda: gravity_matrix(context.robot, context.p, signals.q))
 
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
