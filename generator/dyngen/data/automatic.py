@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-NOISE_SHARE = 0.01  # acceleration noise allowed, relative to the motion's acceleration RMS
+NOISE_SHARE = 0.003  # acceleration noise allowed, relative to the motion's acceleration RMS
 MAX_FRACTION = 0.2  # the cutoff stays below this fraction of the sampling rate
 MIN_CUTOFF = 0.5  # Hz
 NO_FILTER_NOISE = 1e-12  # rad: positions this clean are differentiated without a filter

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import baseline as simple_model
 from . import design as dz
-from . import phases, roles
+from . import joints, phases, roles
 from .correlation import integrated_time
 from .effects import Context, library
 from .refine import refine, restricted
@@ -48,6 +48,7 @@ class Diagnosis:
     selection_after: list
     selection_simple: list
     simple_wins: list  # 1-based joints where the simple model beat the effects on selection data
+    # (joint_models below: per joint "effects", "simple" or "effects + simple", joints.py)
     simple_values: list  # per joint b, Fc, Fv
     peak_before: list
     noise_rms: list  # per joint estimate of the white part of the final judged residual
@@ -59,6 +60,8 @@ class Diagnosis:
     superseded: list  # per-joint effects on joints the simple model won
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
     warnings: list = field(default_factory=list)
+    joint_models: list = field(default_factory=list)
+    completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
     conditioning: list = field(default_factory=list)  # per recording: what was done to it
     segments: list = field(default_factory=list)  # roles.Segment, for figures
 
@@ -142,13 +145,16 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     chosen, tau_corr, dropped = prune(design, selection.chosen, correlation, options.alpha)
     design, chosen = refine(context, segments, design, chosen)  # velocity scales, exact time shift
     chosen, final, refused = _plausible(design, chosen)
-    # Which model wins each joint: the effects or the simple model, both fitted on the fit
-    # samples only and compared on the selection samples.
+    correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
+    # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
+    # compared on the selection samples (joints.py).
     simple = simple_model.fit(segments)
     sel_before = design.select.c / max(design.select.count, 1)
     sel_effects = design.select.mse(final.slots, final.x) if chosen else sel_before.copy()
     sel_simple = _simple_mse(segments, simple, "select", n)
-    wins = [j for j in range(n) if design.select.count and sel_simple[j] < sel_effects[j]]
+    modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain) if design.select.count \
+        else [joints.EFFECTS] * n
+    wins = [j for j in range(n) if modes[j] == joints.SIMPLE]
     described = [_describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
     # The choice made, every sample of the fit recordings sets the values (selection blocks
     # included; separate selection recordings stay out of it, as test recordings do).
@@ -163,19 +169,15 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     _values(described, design, chosen, final, tau_corr, robot)
     judged = "test" if design.test.count else "selection"
     judged_moments = design.test if judged == "test" else design.select
-
-    for seg in segments:  # the final model: effects, and the simple model on the joints it won
-        if wins:
-            seg.correction[:, wins] = simple_model.predict(simple, seg)[:, wins]
     before = judged_moments.c / max(judged_moments.count, 1)
     effects_mse = judged_moments.mse(final.slots, final.x) if chosen else before.copy()
     simple_mse = _simple_mse(segments, simple, judged, n)
-    after = effects_mse.copy()
-    after[wins] = simple_mse[wins]
+    completed = joints.apply(context, segments, chosen, final.x, simple, modes)
     mask = (lambda seg: seg.test) if judged == "test" else (lambda seg: seg.select)
     used = [seg for seg in segments if mask(seg).any()]
     held_before = np.vstack([seg.residual[mask(seg)] for seg in used])
     held_after = np.vstack([(seg.residual - seg.correction)[mask(seg)] for seg in used])
+    after = np.mean(held_after ** 2, axis=0)
     masks = [phases.labels(seg.signals.t[mask(seg)], seg.signals.q[mask(seg)], seg.signals.qd[mask(seg)],
                            seg.signals.qdd[mask(seg)]) for seg in used]
     masks = {name: np.vstack([m[name] for m in masks]) for name in phases.PHASES}
@@ -199,6 +201,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         *(np.sqrt(x).tolist() for x in (sel_before, sel_effects, sel_simple)), [j + 1 for j in wins],
         simple.values.tolist(), np.abs(held_before).max(axis=0).tolist(), noise.tolist(), where, candidates,
         selection.steps, dropped, refused, superseded, tau_corr, segments=segments)
+    result.joint_models = modes
+    result.completed = completed
     result.conditioning = [{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
                            for role, group in (("fit", fit_signals), ("select", select_signals or []),
                                                ("test", test or [])) for sig in group]

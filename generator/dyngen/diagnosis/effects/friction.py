@@ -1,9 +1,7 @@
 """Joint friction and rotor inertia: per joint, linear in their values.
 
     Coulomb:   Fc * tanh(qd / vc)                 [Nm] at a velocity scale vc (variants; refined once selected)
-    viscous:   Fv * qd                            [Nm s/rad], qd clipped to the velocities of the fit
-                                                  data: beyond them real friction often saturates, and a
-                                                  slope fitted on slow motion would be extrapolated
+    viscous:   Fv * qd                            [Nm s/rad]
     Stribeck:  Fs * sign(qd) * exp(-(qd/vs)^2)    [Nm] at a fixed vs (variants; vs refined once selected)
     direction: dFc * |sign(qd)|                   [Nm]: Coulomb levels Fc + dFc moving forwards and
                                                   Fc - dFc backwards (gears and seals are not symmetric)
@@ -86,8 +84,7 @@ class Viscous(_Dissipative):
     name, parameters, units = "viscous", ("Fv",), ("Nm s/rad",)
 
     def columns(self, context, signals, tau_model):
-        qd = signals.qd if context.qd_range is None else np.clip(signals.qd, *context.qd_range)
-        return qd[:, :, None]
+        return signals.qd[:, :, None]
 
 
 class Stribeck(_Dissipative):
