@@ -28,6 +28,7 @@ from .recording import Recording
 
 AUTO = "auto"
 EDGE_PERIODS = 1.0  # trimmed at each end: this many periods of the cutoff (the filter's start-up)
+PAD_PERIODS = 2.0  # the recording is continued this many periods of the cutoff before filtering
 
 
 @dataclass(frozen=True)
@@ -148,10 +149,28 @@ def _lowpass(name: str, rate: float, cutoff: float, order: int):
     if not 1 <= order <= 12:
         raise InputError(name, "order", f"{order} must be between 1 and 12")
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
+    reach = int(np.ceil(PAD_PERIODS * rate / cutoff))
 
     def apply(x):
         x = np.asarray(x, dtype=float)
-        pad = min(x.shape[0] - 1, 3 * (2 * len(sos) + 1))
-        return signal.sosfiltfilt(sos, x, axis=0, padlen=pad)
+        T = x.shape[0]
+        pad = min(reach, T - 1)
+        if pad < 8:
+            return signal.sosfiltfilt(sos, x, axis=0, padlen=min(T - 1, 3 * (2 * len(sos) + 1)))
+        # A recording rarely starts or ends at rest: continued by a quadratic in time (value,
+        # slope and curvature continuous), the filter's start-up does not bend the second
+        # derivative the way scipy's odd extension would (its curvature flips at the edge).
+        head = _continued(x[:pad][::-1], pad)[::-1]
+        tail = _continued(x[-pad:], pad)
+        return signal.sosfiltfilt(sos, np.concatenate([head, x, tail]), axis=0, padlen=0)[pad:pad + T]
 
     return apply
+
+
+def _continued(y: np.ndarray, n: int) -> np.ndarray:
+    """n samples after y (time along axis 0), from a quadratic fitted to y."""
+    k = np.arange(y.shape[0], dtype=float)
+    coefficients = np.polyfit(k, y.reshape(y.shape[0], -1), 2)
+    ahead = np.arange(y.shape[0], y.shape[0] + n, dtype=float)
+    out = np.vander(ahead, 3) @ coefficients
+    return out.reshape((n,) + y.shape[1:])

@@ -8,7 +8,8 @@ rest-to-rest trajectories). Once such an effect is selected, its setting is refi
 fit samples, every other selected effect refitted each time (selection and test data stay unused):
 
   - a setting the fitted values imply (Effect.implied_setting: the time shift, whose exact
-    column at dt0 gives the fitted value dt = dt0 when the model holds) by fixed-point
+    column at dt0 gives the fitted value dt = dt0 when the model holds; the tilt, whose
+    second-order change along gravity follows from the angles) by fixed-point
     iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE;
   - a setting independent of the values (Effect.search_interval: the Stribeck velocity) by a
     bounded scalar search for the smallest weighted fit residual.
@@ -136,7 +137,8 @@ def _refine_one(state, index) -> None:
             if setting is None:
                 return
             state.accept(state.trial(index, setting))
-            if abs(setting - current.setting) <= REFINE_TOLERANCE * abs(setting):
+            step = np.linalg.norm(np.subtract(setting, current.setting))
+            if step <= REFINE_TOLERANCE * max(np.linalg.norm(setting), 1e-12):
                 return
         return
     interval = effect.search_interval(state.values(index))

@@ -142,8 +142,15 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         return _correlation(segments, design.weights)
 
     selection = forward(design, options.min_gain, options.alpha)
-    chosen, tau_corr, dropped = prune(design, selection.chosen, correlation, options.alpha)
-    design, chosen = refine(context, segments, design, chosen)  # velocity scales, exact time shift
+    # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
+    # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
+    design, chosen = refine(context, segments, design, selection.chosen)
+    chosen, tau_corr, dropped = prune(design, chosen, correlation, options.alpha)
+    narrow = _narrow_stribeck(chosen)
+    chosen = [c for c in chosen if c not in narrow]
+    dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
+    if dropped:
+        design, chosen = refine(context, segments, design, chosen)
     chosen, final, refused = _plausible(design, chosen)
     correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
     # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
@@ -228,6 +235,14 @@ def _plausible(design, chosen):
         offset = sum(c.size for c in chosen[:chosen.index(worst)])
         refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
         chosen = [c for c in chosen if c is not worst]
+
+
+def _narrow_stribeck(chosen) -> list:
+    """Stribeck terms whose velocity is less than twice the Coulomb velocity scale on their
+    joint: there the two laws trade shape with each other, and no static friction is shown."""
+    scale = {c.joint: c.effect.velocity for c in chosen if c.effect.name == "coulomb"}
+    return [c for c in chosen if c.effect.name == "stribeck" and c.joint in scale
+            and c.effect.velocity < 2 * scale[c.joint]]
 
 
 def _simple_mse(segments, simple, role, n) -> np.ndarray:

@@ -3,11 +3,14 @@
 The gravity torque is linear in the gravity vector: g(q) = G(q) gvec, with column k of G the
 joint torques that a unit gravity along base axis k would cause.
 
-tilt: a rotation of the base turns gvec by d gvec perpendicular to it (to first order; the
-  change along gravity, |gvec| (1 - cos angle), is 0.013 m/s^2 for 3 deg and is left out), so
-  the residual is G(q) d gvec with two columns G(q) u1, G(q) u2, u1 and u2 unit vectors
-  perpendicular to the model's gravity. A rotation cannot change gravity's magnitude, so a
-  tilt has no third column. The angles follow from the rotated vector, and are named by the
+tilt: a rotation of the base turns gvec by d gvec, so the residual is G(q) d gvec. Across
+  gravity, d gvec = dg1 u1 + dg2 u2 (u1, u2 unit vectors perpendicular to the model's gravity):
+  two fitted values. Along gravity a rotation shortens the component by exactly what keeps
+  |gvec| unchanged, -(dg1^2 + dg2^2) / (2 |g|) to second order (0.013 m/s^2 for 3 deg: small,
+  but a diagnosis that left it out would report it as a gravity scale). It is not a third
+  value: column k is G u_k - G n dg_k0 / (2 |g|) at the current estimate dg_k0, refined by
+  fixed-point iteration once the tilt is selected (refine.py), so a tilt cannot change
+  gravity's magnitude. The angles follow from the rotated vector, and are named by the
   base axes they turn gravity towards (tilt_axes). Tilts beyond MAX_TILT_DEG are not a
   mounting error and are refused.
 gravity_scale: G(q) n dg, n along gravity: the gravity torque of every link scaled alike. No
@@ -36,12 +39,29 @@ class Tilt(Effect):
     parameters = ("dg1", "dg2")
     units = ("m/s^2", "m/s^2")
     g = 9.81  # set from the robot in columns()
+    refinable = True
+
+    def __init__(self, estimate=(0.0, 0.0)):
+        self.estimate = tuple(float(x) for x in estimate)  # dg1, dg2 of the second-order term
+        self.label = "" if not any(self.estimate) else f"dg0=({self.estimate[0]:.6g},{self.estimate[1]:.6g})"
+
+    @property
+    def setting(self):
+        return np.array(self.estimate)
+
+    def implied_setting(self, values):
+        return np.array(values[:2], dtype=float) if np.any(values[:2]) else None
+
+    def at(self, setting):
+        return Tilt(setting)
 
     def columns(self, context, signals, tau_model):
         self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
         G = _gravity(context, signals)  # (T, N, 3)
         u1, u2 = tilt_directions(context.robot)
-        return np.stack([G @ u1, G @ u2], axis=-1)
+        along = G @ np.cross(u1, u2)
+        return np.stack([G @ u1 - along * self.estimate[0] / (2 * self.g),
+                         G @ u2 - along * self.estimate[1] / (2 * self.g)], axis=-1)
 
     def plausible(self, values):
         return bool(np.hypot(*values[:2]) < self.g * np.sin(np.radians(MAX_TILT_DEG)))
