@@ -18,7 +18,9 @@ Then prune() drops, one by one, selected effects whose values are not significan
 deviations are scaled for the correlation in time of the residual they leave.
 
 Among candidates within 10 % of the best gain, the one with fewest values wins (a payload is
-preferred to the 43 coefficient errors that could also express it). Selection stops when no
+preferred to the 43 coefficient errors that could also express it), and a secondary effect
+(Effect.secondary: direction-dependent Coulomb, which on a joint that never stops is a
+sensor offset; the gravity scale, a symptom) only if no plainer one is near. Selection stops when no
 candidate qualifies: with data that hold no unmodelled effect, nothing is selected.
 """
 
@@ -174,6 +176,8 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             break
         best = max(t[0] for t in qualified)
         near = [t for t in qualified if t[0] >= NEAR_BEST * best]
+        if any(not t[1].effect.secondary for t in near):  # a tie goes to the plainer explanation
+            near = [t for t in near if not t[1].effect.secondary]
         gain, cand, mse, _, _ = min(near, key=lambda t: (t[1].size, -t[0]))
         selection.chosen.append(cand)
         selection.steps.append({"candidate": cand.key, "gain": gain, "selection_rms": np.sqrt(mse).tolist()})

@@ -58,6 +58,7 @@ class Coulomb(_Dissipative):
 
 class Direction(Effect):
     name, parameters, units = "direction", ("dFc",), ("Nm",)
+    secondary = True
 
     def columns(self, context, signals, tau_model):
         return np.abs(context.sign(signals.qd))[:, :, None]

@@ -71,7 +71,7 @@ class GravityScale(Effect):
     name, scope = "gravity_scale", "arm"
     parameters = ("dg",)
     units = ("m/s^2",)
-    suspect = True
+    suspect = secondary = True
     g = 9.81
 
     def columns(self, context, signals, tau_model):
