@@ -74,6 +74,7 @@ class Case:
     name: str
     effects: Effects = field(default_factory=Effects)
     coefficient_error: float = 0.0  # relative error of the model's masses and inertias
+    tracked: bool = False  # forward simulation under a controller (sticky friction, mujoco_tracking.py)
 
 
 CASES = [
@@ -92,6 +93,15 @@ CASES = [
     Case("friction_offset", Effects(coulomb={1: 1.0}, viscous={1: 0.5}, offset={5: 0.8})),
     Case("payload_coulomb", Effects(payload=PAYLOAD, coulomb={6: 1.0})),
     Case("gain_viscous", Effects(gain={2: 0.05}, viscous={6: 0.5})),
+]
+
+# Friction as real joints have it: the arm tracks its reference in a forward simulation, and
+# friction (MuJoCo's stiff friction loss, a Stribeck excess through qfrc_applied) sticks at
+# reversals and rests (tests/oracles/mujoco_tracking.py).
+TRACKED_CASES = [
+    Case("sticky", Effects(coulomb={2: 0.9, 4: 0.5}, viscous={2: 0.4}), tracked=True),
+    Case("stribeck_sticky", Effects(coulomb={4: 0.6}, stribeck={4: (0.6, 0.08)}), tracked=True),
+    Case("sticky_offset", Effects(coulomb={6: 0.4}, offset={1: 0.3}), tracked=True),
 ]
 
 # Settings between the diagnosis's variants (Stribeck vs 0.03/0.1/0.3 rad/s, time shifts
@@ -231,11 +241,30 @@ def case_files(case: Case, index: int, robot, p_true, trajs, noise: float, seed:
     With an encoder, positions carry its noise and steps and the files have no qd, qdd."""
     files = {f"{case.name}.mujoco.xml": simulator_xml(robot, p_true, case.effects)}
     for k, (kind, traj) in enumerate(trajs.items()):
-        m = measure(robot, p_true, traj, case.effects, noise, seed=[seed, index, k])
+        if case.tracked:
+            from .mujoco_tracking import track
+
+            m, friction = track(robot, p_true, p_model_of(robot), traj.t, traj.at, case.effects, noise,
+                                seed=[seed, index, k])
+            files[f"{case.name}.{kind}.friction.csv"] = _table(friction)
+        else:
+            m = measure(robot, p_true, traj, case.effects, noise, seed=[seed, index, k])
         if encoder is not None:
             m = encoded(m, encoder, seed=[seed, index, k, 1])
         files[f"{case.name}.{kind}.csv"] = csv_text(m, velocities=encoder is None)
     return files
+
+
+def _table(x) -> str:
+    import io
+
+    out = io.StringIO()
+    np.savetxt(out, x, fmt="%.12g", delimiter=",")
+    return out.getvalue()
+
+
+def p_model_of(robot) -> np.ndarray:
+    return nominal_model(robot)
 
 
 def write_cases(folder, rate_hz: float = 1000.0, noise: float = NOISE, seed: int = 0, cases=CASES,

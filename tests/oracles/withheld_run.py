@@ -19,14 +19,14 @@ from dyngen.diagnosis import diagnose
 from dyngen.diagnosis.report import to_json
 
 from .perfect import perfect_rms
-from .withheld_cases import CASES, OFF_GRID_CASES, nominal_model, simulated_parameters
+from .withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, nominal_model, simulated_parameters
 from .withheld_verdict import problems, truth_text, verdict_text
 
 DIRECTIONS = {"forward": ("fit", "holdout"), "backward": ("holdout", "fit")}
 
 
 def case_by_name(name):
-    return next(c for c in [*CASES, *OFF_GRID_CASES] if c.name == name)
+    return next(c for c in [*CASES, *OFF_GRID_CASES, *TRACKED_CASES] if c.name == name)
 
 
 def run(robot, model, folder, doc, name: str, direction: str = "forward", options=None) -> dict:
@@ -41,7 +41,10 @@ def run(robot, model, folder, doc, name: str, direction: str = "forward", option
     result = diagnose(robot, model, p_model, [fit], None, test=[test], **kwargs)
     seconds = time.perf_counter() - start
     d = json.loads(to_json(result, {}))
-    perfect = perfect_rms(robot, p_true, case.effects, test)
+    friction = None
+    if case.tracked:
+        friction = np.loadtxt(folder / entry[test_key].replace(".csv", ".friction.csv"), delimiter=",", ndmin=2)
+    perfect = perfect_rms(robot, p_true, case.effects, test, friction)
     found = problems(entry["effects"], d, perfect, p_model)
     return {"case": name, "direction": direction, "truth": truth_text(entry["effects"]), "verdict": verdict_text(d),
             "before": d["rms_before"], "after": d["rms_after"], "simple": d["rms_simple"],

@@ -21,6 +21,7 @@ from .effects import Context, library
 from .refine import refine, restricted
 from .selection import ALPHA, MIN_GAIN, forward, prune, selection_gain, solve
 
+EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
 
 
@@ -263,6 +264,15 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
     if d.judged_on == "selection":
         out.append("no test recording (--test): the residual 'after' is measured on the selection data, which chose "
                    "the effects; it is not a held-out figure")
+    # Laws fitted on one range of motion and judged beyond it (friction at higher speeds).
+    if test_signals:
+        fast_fit = np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in fit_signals]), axis=0)
+        fast_test = np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in test_signals]), axis=0)
+        beyond = [j for j in range(d.joints) if fast_test[j] > EXTRAPOLATION * fast_fit[j]]
+        if beyond:
+            out.append("the test data move joint(s) " + ", ".join(
+                f"{j + 1} ({fast_test[j]:.2g} vs {fast_fit[j]:.2g} rad/s)" for j in beyond)
+                + " faster than any fit data: velocity-dependent laws are extrapolated there")
     for fit, test, diff in roles.repeated(fit_signals, test_signals):
         out.append(f"{test} repeats the trajectory of {fit} (RMS position difference {diff:.3g} rad): the test shows "
                    "that the effects repeat, not that they generalise to other motions")

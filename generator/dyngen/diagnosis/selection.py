@@ -6,8 +6,9 @@ Gain: on the selection samples, the decrease of the residual's mean square relat
 value before the step, on the candidate's own joint (per-joint effects) or summed over joints
 (arm-wide effects). A step adds the candidate with the largest selection gain if
 
-  - the gain is at least `min_gain` (default 0.05: 5 % of one joint's current selection mean
-    square), so an effect must generalise, not merely fit, and
+  - the gain is at least `min_gain` per fitted value (default 0.05: 5 % of one joint's current
+    selection mean square for a one-value effect, 30 % for the six values of a position
+    ripple), so an effect must generalise, not merely fit, and pay for its values, and
   - its fitted values are significant on the fit data (chi-square test of x_c^T Cov_cc^-1 x_c,
     p < `alpha`), so noise alone does not qualify, and
   - they are physically plausible (friction opposes motion, a rotor inertia is positive, a
@@ -167,7 +168,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             gain = selection_gain(cand, current, mse)
             if not selection.chosen:
                 selection.first_gains[cand.key] = gain
-            if gain >= min_gain and cand.effect.plausible(fit.x[-cand.size:]):
+            if gain >= min_gain * np.sqrt(cand.size) and cand.effect.plausible(fit.x[-cand.size:]):
                 size = len(fit.x)
                 fit = solve(design, chosen, block=slice(size - cand.size, size))
                 trials.append((gain, cand, mse, fit, chosen))
