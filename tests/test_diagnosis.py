@@ -47,7 +47,7 @@ def run(lwr, extra, seed=0, **options):
         t, at, q, qd, qdd, tau = trajectories[name]
         measured = noisy(extra(name, t, at, q, qd, qdd, tau), NOISE, seed + k)
         data.append(signals(name, t, q, qd, qdd, measured))
-    return diagnose(robot, model, p, [data[0]], [data[1]])
+    return diagnose(robot, model, p, [data[0]], None, test=[data[1]])  # selection on blocks of the fit data
 
 
 def claims(d):
