@@ -10,9 +10,10 @@ are fitted on the fit samples and compared on the selection samples:
              were each chosen for a large gain may still lack an offset or a plain friction
              term that none of them covers.
 
-The effects stay unless another model is better on the selection data by at least `min_gain`
-(the gain an effect needs to be selected at all), so that three more numbers fitting noise do
-not replace a finding. The decision is made with the values fitted on the fit samples only;
+The effects stay unless another model does better on the selection data, where the model with
+more values on the joint must gain `min_gain` of the mean square per extra value (what an
+effect must gain to be selected at all), so that three numbers fitting noise do not replace a
+one-value finding, and six ripple harmonics do not displace the simple model on a whim. The decision is made with the values fitted on the fit samples only;
 `apply` then sets each joint's correction with the final values.
 """
 
@@ -83,13 +84,23 @@ def decide(context, segments, chosen, x, simple, min_gain: float) -> list[str]:
             sse[SIMPLE] += float(np.sum((r - baseline.predict(simple, seg)[m, j]) ** 2))
             if acting:
                 sse[COMPLETED] += float(np.sum((r - _completed_predict(context, chosen, x, values, seg, j)[m]) ** 2))
+        own = sum(c.size for c in chosen if c.joint == j)  # values of the effects on this joint
+        size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES)}
         best = EFFECTS
-        if sse[SIMPLE] < (1 - min_gain) * sse[best]:
-            best = SIMPLE
-        if acting and sse[COMPLETED] < (1 - min_gain) * sse[best]:
-            best = COMPLETED
+        for other in (SIMPLE, COMPLETED) if acting else (SIMPLE,):
+            if _better(sse[other], size[other], sse[best], size[best], min_gain):
+                best = other
         modes.append(best)
     return modes
+
+
+def _better(sse, size, best_sse, best_size, min_gain) -> bool:
+    """Whether a model beats the current best on selection data, the one with more values
+    having to gain `min_gain` of the mean square per extra value (as an effect must to be
+    selected), the one with fewer values winning ties."""
+    if size > best_size:
+        return sse < (1 - min_gain) ** (size - best_size) * best_sse
+    return sse <= best_sse / (1 - min_gain) ** (best_size - size)
 
 
 def apply(context, segments, chosen, x, simple, modes) -> dict:
