@@ -13,8 +13,8 @@ qfrc_applied at every step.
 
 The recorded torque is that actuator torque (the arm's true dynamics and friction are what
 it moves against); sensor effects (gain, offset, noise) are added to the recording. The true
-friction torque (constraint, damping and applied Stribeck) is returned beside it, for the
-perfect-model bound (perfect.py). Semi-implicit Euler at STEP s, recorded at the target rate.
+friction torque (constraint, damping and applied Stribeck) is returned beside it, for checks.
+Semi-implicit Euler at STEP s, recorded at the target rate.
 """
 
 from __future__ import annotations

@@ -244,23 +244,13 @@ def case_files(case: Case, index: int, robot, p_true, trajs, noise: float, seed:
         if case.tracked:
             from .mujoco_tracking import track
 
-            m, friction = track(robot, p_true, p_model_of(robot), traj.t, traj.at, case.effects, noise,
-                                seed=[seed, index, k])
-            files[f"{case.name}.{kind}.friction.csv"] = _table(friction)
+            m, _ = track(robot, p_true, p_model_of(robot), traj.t, traj.at, case.effects, noise, seed=[seed, index, k])
         else:
             m = measure(robot, p_true, traj, case.effects, noise, seed=[seed, index, k])
         if encoder is not None:
             m = encoded(m, encoder, seed=[seed, index, k, 1])
         files[f"{case.name}.{kind}.csv"] = csv_text(m, velocities=encoder is None)
     return files
-
-
-def _table(x) -> str:
-    import io
-
-    out = io.StringIO()
-    np.savetxt(out, x, fmt="%.12g", delimiter=",")
-    return out.getvalue()
 
 
 def p_model_of(robot) -> np.ndarray:

@@ -41,10 +41,7 @@ def run(robot, model, folder, doc, name: str, direction: str = "forward", option
     result = diagnose(robot, model, p_model, [fit], None, test=[test], **kwargs)
     seconds = time.perf_counter() - start
     d = json.loads(to_json(result, {}))
-    friction = None
-    if case.tracked:
-        friction = np.loadtxt(folder / entry[test_key].replace(".csv", ".friction.csv"), delimiter=",", ndmin=2)
-    perfect = perfect_rms(robot, p_true, case.effects, test, friction)
+    perfect = perfect_rms(robot, p_true, case.effects, test)
     found = problems(entry["effects"], d, perfect, p_model)
     return {"case": name, "direction": direction, "truth": truth_text(entry["effects"]), "verdict": verdict_text(d),
             "before": d["rms_before"], "after": d["rms_after"], "simple": d["rms_simple"],
