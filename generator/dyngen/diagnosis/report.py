@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 def to_json(d, sources: dict) -> str:
