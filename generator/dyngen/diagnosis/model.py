@@ -53,8 +53,10 @@ def with_payload(diagnosis, p: np.ndarray) -> np.ndarray:
     payload = next((e for e in diagnosis.selected if e["effect"] == "payload"), None)
     if payload is None or None in payload["values"].values():
         return np.asarray(p, dtype=float)
+    from .effects.body import standard_of_payload
+
     s = standard_from_dynamic(p)
-    s[-PER_LINK:] += np.array(list(payload["values"].values()))
+    s[-PER_LINK:] += standard_of_payload(payload["values"])
     return dynamic_from_standard(s)
 
 

@@ -153,6 +153,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     if dropped:
         design, chosen = refine(context, segments, design, chosen)
     chosen, final, refused = _plausible(design, chosen)
+    design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
     correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
     # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
     # compared on the selection samples (joints.py).
@@ -236,6 +237,26 @@ def _plausible(design, chosen):
         offset = sum(c.size for c in chosen[:chosen.index(worst)])
         refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
         chosen = [c for c in chosen if c is not worst]
+
+
+def _consistent_payload(context, segments, design, chosen, final, refused):
+    """A payload whose fitted inertia is no body's (a negative principal moment about its centre
+    of mass) is replaced by a point mass at its fitted centre, and everything refitted: the data
+    determine m and m c, not that inertia, and an impossible inertia mispredicts other motions."""
+    from .effects.body import PointPayload, consistent_inertia
+
+    offset = 0
+    for i, c in enumerate(chosen):
+        values = final.x[offset: offset + c.size]
+        offset += c.size
+        if c.effect.name != "payload" or c.size != 10 or consistent_inertia(values):
+            continue
+        refused.append({"candidate": "payload inertia (no body has it; kept as a point mass)",
+                        "values": values[4:].tolist()})
+        replaced = chosen[:i] + [dz.Candidate(PointPayload(values[1:4] / values[0]), None, 0, 4)] + chosen[i + 1:]
+        design, chosen = restricted(context, segments, design, replaced)
+        return design, chosen, solve(design, chosen)
+    return design, chosen, final
 
 
 def _narrow_stribeck(chosen) -> list:
