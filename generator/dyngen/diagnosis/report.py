@@ -53,7 +53,8 @@ def _value_text(e) -> str:
         text = f"{len(parts)} values; most significant: " + ", ".join(
             f"{n} = {e['values'][n]:.3g} +- {e['std'][n]:.2g}" for _, n in shown)
     for key, value in e.get("variant", {}).items():
-        text += f" (at {key} = {value:.3g})"
+        shown = f"({', '.join(f'{x:.3g}' for x in value)})" if isinstance(value, (list, tuple)) else f"{value:.3g}"
+        text += f" (at {key} = {shown})"
     derived = e.get("derived") or {}
     if "tilt_deg" in derived:
         (a1, a2), (s1, s2), (u1, u2) = derived["tilt_deg"], derived["tilt_std_deg"], derived["tilt_towards"]

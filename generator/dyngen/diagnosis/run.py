@@ -251,7 +251,8 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
         offset += c.size
         if c.effect.name != "payload" or c.size != 10 or consistent_inertia(values):
             continue
-        refused.append({"candidate": "payload inertia (no body has it; kept as a point mass)",
+        refused.append({"candidate": "the payload's inertia about its centre of mass (a negative principal moment; "
+                                     "the payload is kept as a point mass at its fitted centre)",
                         "values": values[4:].tolist()})
         replaced = chosen[:i] + [dz.Candidate(PointPayload(values[1:4] / values[0]), None, 0, 4)] + chosen[i + 1:]
         design, chosen = restricted(context, segments, design, replaced)
@@ -306,15 +307,15 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
         predicted = np.sqrt((M ** 2) @ (np.asarray(sig.qdd_noise) ** 2))
         bad = [j for j in range(d.joints) if predicted[j] ** 2 > DIFFERENTIATION_SHARE * d.rms_after[j] ** 2]
         if bad:
-            out.append(f"{sig.name}: noise of the differentiated positions dominates the residual on joint(s) "
+            out.append(f"{sig.name}: noise of the differentiated positions makes up most of the residual on joint(s) "
                        f"{', '.join(str(j + 1) for j in bad)} (about "
                        f"{', '.join(f'{predicted[j]:.3g}' for j in bad)} Nm of {', '.join(f'{d.rms_after[j]:.3g}' for j in bad)}"
-                       " Nm): record velocities, or give a lower --cutoff")
+                       " Nm): recorded velocities, or a lower --cutoff, would lower it")
     for e in d.selected:
         if e.get("suspect"):
             out.append(f"{e['effect']} is a symptom, not a cause: {e['suspect']}")
     for r in d.refused:
-        out.append(f"{r['candidate']} refused: its fitted values are not physically possible "
+        out.append(f"{r['candidate']}: refused, its fitted values are not physically possible "
                    f"({', '.join(f'{v:.3g}' for v in r['values'][:4])})")
     if d.simple_wins:
         out.append("on joint(s) " + ", ".join(map(str, d.simple_wins)) + " the simple model (offset + Coulomb + viscous) "
