@@ -61,9 +61,12 @@ def _value_text(e) -> str:
         text += f" (gravity turned {a1:.2f} +- {s1:.2f} deg towards {u1} and {a2:.2f} +- {s2:.2f} deg towards {u2})"
     if "relative" in derived:
         text += f" (gravity torques scaled by {1 + derived['relative']:.4f})"
-    if "amplitude_Nm" in derived:
+    if "amplitude_Nm" in derived and derived.get("separable", True):
         text += " (amplitudes of harmonics 1, 2, 3 of the joint position: " + \
                 ", ".join(f"{a:.3g}" for a in derived["amplitude_Nm"]) + " Nm)"
+    elif "amplitude_Nm" in derived:
+        text = (f"a torque of {derived['torque_rms_Nm']:.3g} Nm RMS depending on the joint's position; its harmonics "
+                "are not separable over the positions covered (values flagged, not findings)")
     if "dt_ms" in derived:
         text += f" ({derived['dt_ms']:.2f} +- {derived['dt_std_ms']:.2f} ms)"
     if "mass_kg" in derived:

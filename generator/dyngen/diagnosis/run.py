@@ -21,6 +21,7 @@ from .effects import Context, library
 from .refine import refine, restricted
 from .selection import ALPHA, MIN_GAIN, forward, prune, selection_gain, solve
 
+RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
 
@@ -312,6 +313,10 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
                        f"{', '.join(f'{predicted[j]:.3g}' for j in bad)} Nm of {', '.join(f'{d.rms_after[j]:.3g}' for j in bad)}"
                        " Nm): recorded velocities, or a lower --cutoff, would lower it")
     for e in d.selected:
+        if e["effect"] == "ripple" and not e["derived"].get("separable", True):
+            out.append(f"ripple on joint {e['joints'][0]}: its harmonics are not separable over the positions the fit "
+                       f"data cover (amplitudes {', '.join(f'{a:.3g}' for a in e['derived']['amplitude_Nm'])} Nm for "
+                       f"a torque of {e['derived']['torque_rms_Nm']:.3g} Nm RMS): only their sum is a finding")
         if e.get("suspect"):
             out.append(f"{e['effect']} is a symptom, not a cause: {e['suspect']}")
     for r in d.refused:
@@ -352,6 +357,14 @@ def _values(described, design, chosen, final, tau_corr, robot) -> None:
         e["std"] = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
         e["variant"] = cand.effect.fixed()
         e["derived"] = derived(robot, cand.effect.name, e["values"], e["std"])
+        if cand.effect.name == "ripple" and "amplitude_Nm" in e["derived"]:
+            # Low harmonics over a short range of positions are nearly collinear: large values
+            # of opposite sign whose sum is small. Then only the sum is a finding.
+            j, x = cand.joint, final.x[k]
+            G = design.fit.G[j][np.ix_(cand.slots, cand.slots)]
+            rms = float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
+            e["derived"]["torque_rms_Nm"] = rms
+            e["derived"]["separable"] = bool(sum(e["derived"]["amplitude_Nm"]) <= RIPPLE_SEPARABLE * np.sqrt(2) * rms)
 
 
 def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
