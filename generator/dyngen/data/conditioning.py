@@ -162,7 +162,10 @@ def _lowpass(name: str, rate: float, cutoff: float, order: int):
         # derivative the way scipy's odd extension would (its curvature flips at the edge).
         head = _continued(x[:pad][::-1], pad)[::-1]
         tail = _continued(x[-pad:], pad)
-        return signal.sosfiltfilt(sos, np.concatenate([head, x, tail]), axis=0, padlen=0)[pad:pad + T]
+        # filtered along the last axis of a contiguous copy: several times faster than along axis 0
+        extended = np.ascontiguousarray(np.concatenate([head, x, tail]).reshape(T + 2 * pad, -1).T)
+        out = signal.sosfiltfilt(sos, extended, axis=-1, padlen=0)[:, pad:pad + T]
+        return np.ascontiguousarray(out.T).reshape(x.shape)
 
     return apply
 
