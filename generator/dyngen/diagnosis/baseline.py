@@ -32,7 +32,7 @@ def columns(signals) -> np.ndarray:
     if hit is not None and hit[0] is signals:
         return hit[1]
     qd = signals.qd
-    out = signals.filtered(np.stack([np.ones_like(qd), np.tanh(qd / VELOCITY), qd], axis=-1))
+    out = np.stack([np.ones_like(qd), signals.filtered(np.tanh(qd / VELOCITY)), qd], axis=-1)
     if len(_CACHE) > 16:  # recordings of earlier diagnoses
         _CACHE.clear()
     _CACHE[id(signals)] = (signals, out)

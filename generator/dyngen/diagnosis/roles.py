@@ -41,7 +41,9 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
     out = []
 
     def segment(sig, fit, select, test):
-        tau_model = sig.filtered(model.batch("rnea", sig.q, sig.qd, sig.qdd, s))  # filtered like the torque
+        # The filtered motion's torque is the filtered torque's model (filtering it again
+        # would smooth twice what the recording smoothed once).
+        tau_model = model.batch("rnea", sig.q, sig.qd, sig.qdd, s)
         return Segment(sig, tau_model, sig.tau - tau_model, fit, select, test)
 
     none = lambda sig: np.zeros(sig.t.size, dtype=bool)  # noqa: E731

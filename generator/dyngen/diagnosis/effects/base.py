@@ -43,6 +43,7 @@ class Effect:
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
     suspect = False  # a symptom rather than a cause: always reported with a warning
     secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
+    switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
 
     def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the

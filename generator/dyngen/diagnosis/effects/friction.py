@@ -33,7 +33,7 @@ class _Dissipative(Effect):
 
 class Coulomb(_Dissipative):
     name, parameters, units = "coulomb", ("Fc",), ("Nm",)
-    refinable = True
+    refinable = switching = True
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)
@@ -58,7 +58,7 @@ class Coulomb(_Dissipative):
 
 class Direction(Effect):
     name, parameters, units = "direction", ("dFc",), ("Nm",)
-    secondary = True
+    secondary = switching = True
 
     def columns(self, context, signals, tau_model):
         return np.abs(context.sign(signals.qd))[:, :, None]
@@ -90,7 +90,7 @@ class Viscous(_Dissipative):
 
 class Stribeck(_Dissipative):
     name, parameters, units = "stribeck", ("Fs",), ("Nm",)
-    refinable = True
+    refinable = switching = True
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)
