@@ -71,6 +71,7 @@ def track(robot, p_true, p_nominal, t, reference, effects: Effects = Effects(), 
     n = robot.dof
     q = np.empty((t.size, n))
     qd = np.empty((t.size, n))
+    qdd = np.empty((t.size, n))
     tau = np.empty((t.size, n))
     friction = np.empty((t.size, n))
     for k in range(steps):
@@ -82,7 +83,7 @@ def track(robot, p_true, p_nominal, t, reference, effects: Effects = Effects(), 
         mujoco.mj_forward(true, data)
         if k % every == 0:
             s = k // every
-            q[s], qd[s], tau[s] = data.qpos, data.qvel, command
+            q[s], qd[s], qdd[s], tau[s] = data.qpos, data.qvel, data.qacc, command  # qacc: what this step does
             # friction acting on the joint: constraint (friction loss), damping, Stribeck excess
             friction[s] = -(data.qfrc_constraint + data.qfrc_passive + _stribeck_excess(physical, data.qvel))
         mujoco.mj_step(true, data)
@@ -92,4 +93,4 @@ def track(robot, p_true, p_nominal, t, reference, effects: Effects = Effects(), 
         tau[:, i - 1] += o
     sigma = np.broadcast_to(np.asarray(noise, dtype=float), (n,))
     tau = tau + sigma * np.random.default_rng(seed).standard_normal(tau.shape)
-    return Measurement(np.asarray(t, float), q, qd, np.gradient(qd, t, axis=0), tau), friction
+    return Measurement(np.asarray(t, float), q, qd, qdd, tau), friction
