@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from . import __version__, blas
+from .arguments import real, whole
 
 blas.use_one_thread()  # before numpy loads: the imports below load it
 
@@ -51,16 +52,16 @@ def _extract_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--procedure", choices=("joint", "two-stage"),
                        help="one stage over all coefficients (default), or the paper's two stages: "
                             "gravity (eq. 16), then inertia with the gravity parameters fixed (eq. 19)")
-    group.add_argument("--restarts", type=int, metavar="K", help="random starts, eq. 17 (default 16)")
-    group.add_argument("--seed", type=int, help="seed of the random starts (default 1: reproducible)")
-    group.add_argument("--threads", type=int, default=0, help="threads for the restarts (default: all cores)")
+    group.add_argument("--restarts", type=whole(1, 100000), metavar="K", help="random starts, eq. 17 (default 16)")
+    group.add_argument("--seed", type=whole(0, 2**31 - 1), help="seed of the random starts (default 1: reproducible)")
+    group.add_argument("--threads", type=whole(0, 1024), default=0, help="threads for the restarts (default: all cores)")
     group.add_argument("--global", dest="global_algorithm", choices=("isres", "none"), default="isres",
                        help="global NLopt stage before the local SLSQP refinement (default isres)")
-    group.add_argument("--global-maxeval", type=int, default=1500, metavar="N", help="budget of the global stage")
-    group.add_argument("--local-maxeval", type=int, default=1000, metavar="N", help="budget of the local stage")
-    group.add_argument("--hops", type=int, default=0, metavar="N",
+    group.add_argument("--global-maxeval", type=whole(0, 10**8), default=1500, metavar="N", help="budget of the global stage")
+    group.add_argument("--local-maxeval", type=whole(0, 10**8), default=1000, metavar="N", help="budget of the local stage")
+    group.add_argument("--hops", type=whole(0, 10000), default=0, metavar="N",
                        help="basin-hopping kicks of each restart's local minimum (default 0)")
-    group.add_argument("--margin", type=float,
+    group.add_argument("--margin", type=real(0, 1e5),
                        help="consistency margin: smallest eigenvalue of tr(I)/2 E - I [kg m^2] (default 1e-7)")
     group.add_argument("--identity", action="append", default=None, metavar="EQ",
                        help='an identity imposed on the parameters, e.g. "I7xz = c7x*c7z*m7" (eq. 15); repeatable')
