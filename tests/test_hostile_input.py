@@ -79,6 +79,8 @@ YAML_CASES = {
     "41 joints": (yaml_case("  - {type: revolute, a: 0.25",
                             "  - {type: revolute, a: 0.1, alpha: 0, d: 0, theta: 0}\n" * 39 + "  - {type: revolute, a: 0.25"),
                   [], "at most 20"),
+    "compare outside the folder": (yaml_case("restarts: 2", "restarts: 2\n  compare: ../../etc/passwd"), [],
+                                   "extraction.compare"),
     # names
     "name with a newline": (yaml_case("name: tiny", 'name: "tiny\\n"'), [], "name"),
     "300-character name": (yaml_case("name: tiny", "name: " + "t" * 300), [], "name"),
