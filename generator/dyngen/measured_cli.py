@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import tempfile
 import time
 from pathlib import Path
 
+from .arguments import real, whole
 from .errors import InputError
 from .progress import Progress
+
+MIN_DIAGNOSIS_SAMPLES = 50
 
 
 def _data_options(parser: argparse.ArgumentParser) -> None:
@@ -21,7 +23,7 @@ def _data_options(parser: argparse.ArgumentParser) -> None:
                             "'none'. Default: recorded qd, qdd are used as they are; otherwise q is differentiated "
                             "through a cutoff chosen from the recording (its position noise against the motion's "
                             "acceleration), and the choice is reported")
-    group.add_argument("--order", type=int, default=4, metavar="N", help="Butterworth order (default 4)")
+    group.add_argument("--order", type=whole(1, 12), default=4, metavar="N", help="Butterworth order (default 4)")
     group.add_argument("--differentiate", action="store_true",
                        help="compute qd, qdd from q even when the file has them")
     parser.add_argument("--model", metavar="DIR",
@@ -30,12 +32,16 @@ def _data_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _cutoff(text: str):
+    """A cutoff in Hz, or "auto" (chosen from each recording) or "none" (no filter)."""
     if text in ("auto", "none"):
         return None if text == "none" else "auto"
-    try:
-        return float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: a frequency in Hz, 'auto' or 'none'") from None
+    return real(0, 1e6, above=True)(text)
+
+
+def _enough(name: str, t) -> None:
+    if len(t) < MIN_DIAGNOSIS_SAMPLES:
+        raise InputError(name, "", f"{len(t)} samples; a diagnosis needs at least {MIN_DIAGNOSIS_SAMPLES} "
+                         "(seconds of motion at the recording's rate)")
 
 
 def _conditioning(args):
@@ -63,14 +69,11 @@ def _model(args, robot, progress):
             raise InputError(str(folder), "manifest.json", f"the folder is for {model.manifest['robot']}, "
                              f"not {robot.name} ({robot.dof} joints)")
         return model
-    from .atomic import write_folder
-    from .generate import build
+    from .generate import generate
 
-    bases, emitted = build(robot, progress)
-    folder = Path(tempfile.mkdtemp(prefix="dyngen-")) / robot.name
-    write_folder(folder, emitted.files)
+    generated = generate(robot, None, progress)  # into the per-user cache, not the user's folders
     with progress.step("compile the generated C"):
-        return load(folder)
+        return load(generated.folder)
 
 
 def _read(paths, robot, args, require_torques=True, required=()):
@@ -158,9 +161,9 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     parser.add_argument("--effects", metavar="LIST",
                         help="comma-separated effects to try (default: offset, coulomb, viscous, stribeck, direction, "
                              "ripple, armature, gain, payload, tilt, gravity_scale, time_shift; also: coefficients)")
-    parser.add_argument("--min-gain", type=float, default=None, metavar="G",
+    parser.add_argument("--min-gain", type=real(0, 1), default=None, metavar="G",
                         help="least selection gain to select an effect (default 0.05: 5%% of a joint's mean square)")
-    parser.add_argument("--sign-velocity", type=float, default=0.002, metavar="V",
+    parser.add_argument("--sign-velocity", type=real(0, 1e3, above=True), default=0.002, metavar="V",
                         help="sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V) "
                              "(default 0.002 rad/s; Coulomb's own scale is fitted)")
     args = parser.parse_args(argv)
@@ -184,23 +187,31 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
                              "--select, --test or --holdout with it")
         fractions = parse_fractions(args.split)
         pieces = [split_recording(read_recording(x, robot.dof), fractions) for x in args.data]
+        for recording in (r for rs in pieces for r in rs if r is not None):
+            _enough(recording.name, recording.t)
         fit, select, test = ([condition(r[k], _conditioning(args)) for r in pieces if r[k] is not None]
                              for k in range(3))
     else:
         fit = _read(args.data, robot, args)
         select = _read(args.select, robot, args) if args.select else []
         test = _read(tests, robot, args) if tests else []
+        for path, recording in zip([*args.data, *(args.select or []), *tests], [*fit, *select, *test]):
+            _enough(Path(path).name, recording.t)
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = _model(args, robot, progress)
     options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
                       sign_velocity=args.sign_velocity,
                       **({"min_gain": args.min_gain} if args.min_gain is not None else {}))
-    with progress.step("residual, effects, selection, test"):
-        try:
-            result = diagnose(robot, model, p, fit, select or None, options, test=test)
+    if options.effects is not None:
+        from .diagnosis.effects import library
+
+        try:  # unknown names fail here, naming the option, before anything runs
+            library(options.effects)
         except ValueError as err:
             raise InputError("--effects", "", str(err)) from None
+    with progress.step("residual, effects, selection, test"):
+        result = diagnose(robot, model, p, fit, select or None, options, test=test)
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
     sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": _conditioning_text(fit + select + test)}
