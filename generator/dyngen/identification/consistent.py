@@ -38,8 +38,9 @@ from ..extraction.targets import Target
 from ..parameters import PER_LINK
 from .least_squares import fit as ols_fit
 
-FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature")
-NONNEGATIVE = {"coulomb", "viscous", "armature"}
+FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "stribeck")
+NONNEGATIVE = {"coulomb", "viscous", "armature", "stribeck"}
+STRIBECK_VELOCITY = 0.3  # rad/s: Fs tanh(qd / vs) exp(-(qd / STRIBECK_VELOCITY)^2), static excess
 SMOOTHING_GRID = (0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
 
 
@@ -53,6 +54,7 @@ class ConsistentOptions:
     threads: int = 0
     max_rounds: int = 8  # active-set rounds for the sign constraints on friction
     weighted: bool = True  # rows scaled by 1 / sigma_joint
+    nonnegative: frozenset = frozenset(NONNEGATIVE)
     prior: np.ndarray | None = None  # dynamic parameters (10N) to regularise toward (and the reference)
     regularisation: float = 0.0  # weight of || pi - pi(prior) ||^2 in unit-norm columns (~ samples' worth)
 
@@ -92,6 +94,8 @@ class Consistent:
         f = self.friction
         tau = tau + np.nan_to_num(f["coulomb"]) * np.tanh(signals.qd / self.smoothing)
         tau = tau + np.nan_to_num(f["viscous"]) * signals.qd + np.nan_to_num(f["offset"])
+        tau = tau + np.nan_to_num(f["stribeck"]) * np.tanh(signals.qd / self.smoothing) * np.exp(
+            -(signals.qd / STRIBECK_VELOCITY) ** 2)
         return tau + np.nan_to_num(f["armature"]) * signals.qdd
 
 
@@ -119,6 +123,9 @@ def _friction_columns(signals, kinds, smoothing, armature_ok) -> tuple[list, lis
                 col[:, j] = signals.qd[:, j]
             elif kind == "offset":
                 col[:, j] = 1.0
+            elif kind == "stribeck":
+                v = signals.qd[:, j]
+                col[:, j] = np.tanh(v / smoothing[j]) * np.exp(-(v / STRIBECK_VELOCITY) ** 2)
             else:
                 col[:, j] = signals.qdd[:, j]
             cols.append(col.reshape(-1))
@@ -233,7 +240,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     exe = driver.build(folder)
 
     nf = F.shape[1]
-    bounded = np.array([kind in NONNEGATIVE for kind, _ in labels], dtype=bool)
+    bounded = np.array([kind in options.nonnegative for kind, _ in labels], dtype=bool)
     free = np.ones(nf, dtype=bool)
     rounds, result, f_full = 0, None, np.zeros(nf)
     for rounds in range(1, options.max_rounds + 1):
