@@ -27,6 +27,7 @@ dyngen: robot dynamic models as exact, standalone C from a DH table.
                                        base coefficients by least squares from recordings
   dyngen diagnose ROBOT.yaml --params P.yaml --data a.csv [--holdout b.csv]
                                        where the measured-model gap lies and which effect explains it
+  dyngen excite ROBOT.yaml [-o CSV]    an optimised excitation trajectory within the joint limits
 
 Run `dyngen COMMAND --help` for a command's options. The YAML schema and the parameter
 conventions are in docs/conventions.md; examples/ has the KUKA LWR IV+ and other arms.
@@ -237,7 +238,14 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     return run(argv, prog)
 
 
-COMMANDS = {"generate": cmd_generate, "extract": cmd_extract, "identify": cmd_identify, "diagnose": cmd_diagnose}
+def cmd_excite(argv, prog="dyngen excite") -> int:
+    from .excitation.command import cmd_excite as run
+
+    return run(argv, prog)
+
+
+COMMANDS = {"generate": cmd_generate, "extract": cmd_extract, "identify": cmd_identify, "diagnose": cmd_diagnose,
+            "excite": cmd_excite}
 
 
 def main(argv=None) -> int:
