@@ -1,33 +1,43 @@
 """Physically consistent identification with friction: the extraction's convex problem with the
 data's cost.
 
-    min_{s, f}  || Y pi(s) + F f - tau ||_W^2     (W: rows scaled by 1 / sigma_joint)
-    s.t.  every link consistent (pseudo-inertia positive definite, with the extraction's margin),
-          the YAML's bounds and total mass, Fc >= 0, Fv >= 0, Ia >= 0 (offsets free)
+    min_{s, f}  || Y pi(s) + F f - tau ||_W^2  +  lambda || pi(s) - pi(prior) ||_D^2
+    s.t.  every link consistent (pseudo-inertia positive definite less the extraction's margin),
+          the YAML's bounds and total mass, per joint: Fc >= 0, Fc + Fv V >= 0, Ia >= 0
 
-pi(s) are the full base coefficients (linear in the standard parameters s), F the per-joint
-friction columns [tanh(qd_j / vs_j), qd_j, 1, qdd_j] (Coulomb with a fitted smoothing velocity
-vs_j, viscous, offset, rotor inertia where the rigid body does not already carry it).
+pi(s) are the full base coefficients (linear in the standard parameters s); W scales the rows of
+joint j by 1 / sigma_j (its noise estimate); F holds per joint the columns of Coulomb friction
+tanh(qd_j / vs_j) (vs_j fitted), viscous friction qd_j, an offset 1 and rotor inertia qdd_j
+(where the rigid body does not already carry it: joint 1's is part of link 1's inertia).
+Friction must oppose motion at every velocity the joint can reach (|qd| <= V, its velocity limit):
+Fc >= 0 and Fc + Fv V >= 0. A slightly negative Fv is allowed by that, and real joints need
+it: on the LWR4+ Coulomb friction falls with speed (a Stribeck-like shape) and the fitted Fv of
+joint 5 is -0.23 Nm s/rad with Fc = 1.1 Nm. The cone is spanned by two generators with
+non-negative weights, (Fc, Fv) = alpha (0, 1) + beta (V, -1), so every constraint on f is a sign.
 
-One solver, not two. The cost is quadratic in (pi, f); for the friction values that are free
-(not held at their bound 0) it is minimised in closed form, which leaves a quadratic in pi
-alone, || R pi - v ||^2 + const with R the Cholesky factor of the Schur complement of the Gram
-matrix. That is exactly the extraction's cost || W pi(s) - v ||^2, so the extraction's barrier
-Newton method (templates/extract/barrier.cpp.j2) solves it unchanged. Positivity of friction is
-an active set around it (Lawson-Hanson): a friction value that comes out negative is held at 0,
-one held at 0 whose gradient asks to grow is freed again; a handful of rounds at most.
+One solver, not two. The cost is quadratic in (pi, f); for the friction weights that are free
+(not held at their bound 0) it is minimised in closed form, which leaves a quadratic in pi alone,
+|| R pi - v ||^2 + const, R the Cholesky factor of the Gram matrix's Schur complement. That is
+exactly the extraction's cost || W pi(p) - v ||^2, so the extraction's driver (its barrier Newton
+method in s, templates/extract/barrier.cpp.j2) solves it unchanged, bounds, total mass and
+consistency included; among equally good parameter sets it returns the one closest to the
+prior (the parameters the data cannot see stay near it). The signs of the friction weights are
+an active set around it (Lawson-Hanson): a weight that comes out negative is held at 0, one held
+at 0 whose gradient asks to grow is freed again; two or three rounds in practice.
 
-Weights and uncertainty come from the unconstrained fit of the same columns (ordinary least
-squares): sigma_j is the RMS of joint j's residual, the standard deviations are those of the
-weighted fit (uncorrelated residuals assumed: lower bounds for filtered signals), and a
-coefficient is "not excited" as in least_squares.fit.
+lambda (unit-norm columns: lambda = 1 weighs like one well-excited column's worth of data) is
+chosen on held-out data: the `select` recordings, or else every third 2-s block of the fit data.
+The model is then refitted on all fit data. Test data are never seen here.
+
+Statistics come from the unconstrained weighted least squares of the same columns (the
+residual per joint gives sigma_j; std and "not excited" as in least_squares.fit).
 
 Public entry point: identify_consistent(robot, model, folder, signals, options) -> Consistent.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,28 +45,28 @@ from ..extraction import driver
 from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import Stage, build_problem, consistency_margin
 from ..extraction.targets import Target
-from ..parameters import PER_LINK
+from ..parameters import PER_LINK, dynamic_name
 from .least_squares import fit as ols_fit
 
-FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "stribeck")
-NONNEGATIVE = {"coulomb", "viscous", "armature", "stribeck"}
-STRIBECK_VELOCITY = 0.3  # rad/s: Fs tanh(qd / vs) exp(-(qd / STRIBECK_VELOCITY)^2), static excess
-SMOOTHING_GRID = (0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
+FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature")
+SMOOTHING_GRID = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
+REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
+BLOCK_SECONDS = 2.0  # held-out blocks when no select data are given
 
 
 @dataclass
 class ConsistentOptions:
     friction: tuple = FRICTION_KINDS  # which per-joint columns to include
-    smoothing: float | None = None  # fixed vs for every joint; None: chosen per joint on the fit data
+    smoothing: float | None = None  # vs for every joint; None: chosen per joint on the fit data
     margin: float = 1e-7  # consistency margin [kg m^2], as the extraction's
-    restarts: int = 4
+    restarts: int = 2
     seed: int = 1
     threads: int = 0
-    max_rounds: int = 8  # active-set rounds for the sign constraints on friction
+    max_rounds: int = 8  # active-set rounds for the signs of the friction weights
     weighted: bool = True  # rows scaled by 1 / sigma_joint
-    nonnegative: frozenset = frozenset(NONNEGATIVE)
-    prior: np.ndarray | None = None  # dynamic parameters (10N) to regularise toward (and the reference)
-    regularisation: float = 0.0  # weight of || pi - pi(prior) ||^2 in unit-norm columns (~ samples' worth)
+    prior: np.ndarray | None = None  # dynamic parameters (10N); default the YAML's nominal
+    regularisation: float | None = None  # None: chosen on held-out data from REGULARISATION_GRID
+    grid: tuple = REGULARISATION_GRID
 
 
 @dataclass
@@ -74,29 +84,26 @@ class Consistent:
     residual_rms: np.ndarray  # (N,) RMS of the consistent model's residual on the fit data
     ols_residual_rms: np.ndarray  # (N,) the same for the unconstrained fit
     lambda_min: np.ndarray  # (N,) consistency margin of each link
+    regularisation: float
+    selection: list  # (lambda, held-out weighted mean square) tried
     rounds: int
-    extraction_cost: float
     dropped_armature: list = field(default_factory=list)  # joints whose rotor inertia the body carries
     at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
+    velocity_limits: np.ndarray | None = None
 
     def joint_dynamics(self) -> list:
-        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers."""
-        out = []
-        for j in range(len(self.sigma)):
-            out.append({"damping": _nz(self.friction["viscous"][j]), "friction": _nz(self.friction["coulomb"][j]),
-                        "armature": _nz(self.friction["armature"][j])})
-        return out
+        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
+        damping must be >= 0: a negative Fv is left out there, and said so by the caller)."""
+        f = self.friction
+        return [{"damping": max(_nz(f["viscous"][j]), 0.0), "friction": _nz(f["coulomb"][j]),
+                 "armature": _nz(f["armature"][j])} for j in range(len(self.sigma))]
 
     def predict(self, model, signals) -> np.ndarray:
         """Torques (T, N) of this model (rigid body + friction + offset + rotor inertia) on signals."""
         Y = model.batch("regressor", signals.q, signals.qd, signals.qdd)
-        tau = Y @ self.pi
-        f = self.friction
-        tau = tau + np.nan_to_num(f["coulomb"]) * np.tanh(signals.qd / self.smoothing)
-        tau = tau + np.nan_to_num(f["viscous"]) * signals.qd + np.nan_to_num(f["offset"])
-        tau = tau + np.nan_to_num(f["stribeck"]) * np.tanh(signals.qd / self.smoothing) * np.exp(
-            -(signals.qd / STRIBECK_VELOCITY) ** 2)
-        return tau + np.nan_to_num(f["armature"]) * signals.qdd
+        f = {k: np.nan_to_num(v) for k, v in self.friction.items()}
+        return (Y @ self.pi + f["coulomb"] * np.tanh(signals.qd / self.smoothing) + f["viscous"] * signals.qd
+                + f["offset"] + f["armature"] * signals.qdd)
 
 
 def _nz(x) -> float:
@@ -107,35 +114,8 @@ def _nz(x) -> float:
 # the design: base regressor and friction columns
 
 
-def _friction_columns(signals, kinds, smoothing, armature_ok) -> tuple[list, list]:
-    """Columns (rows = samples x joints, in the regressor's row order) and their (kind, joint)."""
-    n = signals.q.shape[1]
-    cols, labels = [], []
-    T = signals.q.shape[0]
-    for j in range(n):
-        for kind in kinds:
-            if kind == "armature" and not armature_ok[j]:
-                continue
-            col = np.zeros((T, n))
-            if kind == "coulomb":
-                col[:, j] = np.tanh(signals.qd[:, j] / smoothing[j])
-            elif kind == "viscous":
-                col[:, j] = signals.qd[:, j]
-            elif kind == "offset":
-                col[:, j] = 1.0
-            elif kind == "stribeck":
-                v = signals.qd[:, j]
-                col[:, j] = np.tanh(v / smoothing[j]) * np.exp(-(v / STRIBECK_VELOCITY) ** 2)
-            else:
-                col[:, j] = signals.qdd[:, j]
-            cols.append(col.reshape(-1))
-            labels.append((kind, j))
-    return cols, labels
-
-
 def identifiable_armature(model, dof: int, seed: int = 0) -> list[bool]:
-    """Whether joint j's rotor inertia Ia_j qdd_j is independent of the rigid-body base columns
-    (joint 1's is not: the first link's inertia about axis 1 enters alone, the same way)."""
+    """Whether joint j's rotor inertia Ia_j qdd_j is independent of the rigid-body base columns."""
     rng = np.random.default_rng(seed)
     states = 40
     q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))
@@ -150,54 +130,163 @@ def identifiable_armature(model, dof: int, seed: int = 0) -> list[bool]:
     return ok
 
 
-def _design(model, signals_list, kinds, smoothing, armature_ok):
-    Ys, Fs, taus = [], [], []
-    labels = None
+def _labels(kinds, armature_ok, dof) -> list:
+    return [(kind, j) for j in range(dof) for kind in kinds if kind != "armature" or armature_ok[j]]
+
+
+def _friction_matrix(signals, labels, smoothing) -> np.ndarray:
+    """Natural friction columns (rows: samples x joints, the regressor's order)."""
+    T, n = signals.q.shape
+    F = np.zeros((T, n, len(labels)))
+    for k, (kind, j) in enumerate(labels):
+        F[:, j, k] = {"coulomb": lambda: np.tanh(signals.qd[:, j] / smoothing[j]), "viscous": lambda: signals.qd[:, j],
+                      "offset": lambda: np.ones(T), "armature": lambda: signals.qdd[:, j]}[kind]()
+    return F.reshape(T * n, len(labels))
+
+
+def _design(model, signals_list, labels, smoothing):
+    Ys, Fs, taus, samples = [], [], [], []
     for s in signals_list:
         Y = model.batch("regressor", s.q, s.qd, s.qdd)
         Ys.append(Y.reshape(-1, Y.shape[-1]))
-        cols, labels = _friction_columns(s, kinds, smoothing, armature_ok)
-        Fs.append(np.column_stack(cols) if cols else np.zeros((Ys[-1].shape[0], 0)))
+        Fs.append(_friction_matrix(s, labels, smoothing))
         taus.append(np.asarray(s.tau).reshape(-1))
-    return np.vstack(Ys), np.vstack(Fs), np.concatenate(taus), labels
+        samples.append(s.t)
+    return np.vstack(Ys), np.vstack(Fs), np.concatenate(taus)
 
 
-def _choose_smoothing(model, signals_list, kinds, armature_ok, dof) -> np.ndarray:
-    """Per joint, the vs of SMOOTHING_GRID whose unconstrained fit leaves joint j the least
-    residual (all joints at the same candidate; the columns of a joint barely move the others)."""
-    if "coulomb" not in kinds:
-        return np.full(dof, SMOOTHING_GRID[0])
-    best = np.full(dof, np.inf)
-    choice = np.full(dof, SMOOTHING_GRID[0])
+def _choose_smoothing(model, signals_list, labels, dof) -> np.ndarray:
+    """Per joint, the vs of SMOOTHING_GRID whose unconstrained fit leaves joint j the least residual."""
+    best, choice = np.full(dof, np.inf), np.full(dof, 0.02)
+    Y = np.vstack([model.batch("regressor", s.q, s.qd, s.qdd).reshape(s.q.shape[0] * dof, -1) for s in signals_list])
+    tau = np.concatenate([np.asarray(s.tau).reshape(-1) for s in signals_list])
     for vs in SMOOTHING_GRID:
-        Y, F, tau, _ = _design(model, signals_list, kinds, np.full(dof, vs), armature_ok)
+        F = np.vstack([_friction_matrix(s, labels, np.full(dof, vs)) for s in signals_list])
         A = np.hstack([Y, F])
-        x, *_ = np.linalg.lstsq(A / np.linalg.norm(A, axis=0).clip(1e-300), tau, rcond=None)
-        r = (tau - (A / np.linalg.norm(A, axis=0).clip(1e-300)) @ x).reshape(-1, dof)
-        ms = np.mean(r ** 2, axis=0)
+        A = A / np.where(np.linalg.norm(A, axis=0) > 0, np.linalg.norm(A, axis=0), 1.0)
+        x, *_ = np.linalg.lstsq(A, tau, rcond=None)
+        ms = np.mean(((tau - A @ x).reshape(-1, dof)) ** 2, axis=0)
         better = ms < best
         best[better], choice[better] = ms[better], vs
     return choice
+
+
+def _generators(labels, r, V) -> np.ndarray:
+    """M with natural = M generator weights: per joint (Fc, Fv) = alpha (0, 1) + beta (V, -1)."""
+    n = r + len(labels)
+    M = np.eye(n)
+    index = {lab: r + k for k, lab in enumerate(labels)}
+    for (kind, j), k in index.items():
+        if kind == "coulomb" and ("viscous", j) in index:
+            v = index[("viscous", j)]
+            # generator column k now means beta (Fc = V beta, Fv gets -beta); v means alpha
+            M[:, k] = 0
+            M[k, k] = V[j]
+            M[v, k] = -1.0
+    return M
 
 
 # ---------------------------------------------------------------------------------------------
 # the fit
 
 
+class _Solver:
+    """The reduced problems for one data set: Gram matrix in generator weights, the driver."""
+
+    def __init__(self, robot, model, folder, options, labels, r, V, prior):
+        self.model, self.options, self.labels, self.r = model, options, labels, r
+        self.bounded = np.array([kind in ("coulomb", "viscous", "armature") for kind, _ in labels], dtype=bool)
+        self.M = _generators(labels, r, V)
+        self.extract_options = ExtractOptions(restarts=options.restarts, seed=options.seed, threads=options.threads,
+                                              global_algorithm="none", margin=options.margin)
+        described = robot_with_default_bounds(robot)
+        if prior is not None:
+            from ..description.robot import LinkValues
+
+            links = np.asarray(prior, dtype=float).reshape(-1, PER_LINK)
+            described = replace(described, nominal=tuple(LinkValues.from_tuple(row) for row in links))
+        self.problem = build_problem(described, self.extract_options)
+        self.exe = driver.build(folder)
+        self.pi_prior = model("pi_full", prior) if prior is not None else None
+
+    def solve(self, A, b, lam):
+        """(pi, natural friction values, rounds, extraction result) for weighted rows A, b."""
+        r = self.r
+        Ag = A @ self.M
+        scale = np.linalg.norm(Ag, axis=0)
+        scale = np.where(scale > 0, scale, 1.0)
+        As = Ag / scale
+        G, g = As.T @ As, As.T @ b
+        if lam > 0 and self.pi_prior is not None:
+            G[:r, :r] += lam * np.eye(r)
+            g[:r] += lam * self.pi_prior * scale[:r]
+        nf = len(self.labels)
+        free = np.ones(nf, dtype=bool)
+        rounds, y_f = 0, np.zeros(nf)
+        for rounds in range(1, self.options.max_rounds + 1):
+            fi = r + np.flatnonzero(free)
+            Gff = G[np.ix_(fi, fi)]
+            Lf = np.linalg.cholesky(Gff + 1e-12 * np.eye(len(fi)))
+            X = np.linalg.solve(Lf, G[np.ix_(fi, np.arange(r))])
+            xg = np.linalg.solve(Lf, g[fi])
+            S = G[:r, :r] - X.T @ X  # Schur complement: the cost's Hessian in the scaled pi
+            h = g[:r] - X.T @ xg
+            Ls = np.linalg.cholesky(S + 1e-12 * np.eye(r))
+            # cost(y) = || Ls^T y - Ls^-1 h ||^2 + const, y = scale pi
+            W = Ls.T * scale[:r][None, :]
+            v = np.linalg.solve(Ls, h)
+            stage = Stage("identify", [Target("full", W, v)], np.ones(self.problem.lower.size, dtype=bool),
+                          self.problem.reference.copy())
+            result = driver.run(self.exe, self.problem, stage, self.extract_options)
+            if result.status != "ok":
+                raise RuntimeError("consistent identification: no parameters satisfy the bounds and total mass")
+            pi = self.model("pi_full", result.p)
+            y = pi * scale[:r]
+            y_f = np.zeros(nf)
+            y_f[free] = np.linalg.solve(Lf.T, xg - X @ y)
+            negative = free & self.bounded & (y_f < 0)
+            if negative.any():
+                free &= ~negative
+                continue
+            grad = G[r:, :r] @ y + G[r:, r:] @ y_f - g[r:]
+            wants = (~free) & self.bounded & (grad < -1e-10)
+            if not wants.any():
+                break
+            free |= wants
+        weights = y_f / scale[r:]
+        natural = self.M[r:, r:] @ weights
+        return pi, natural, rounds, result
+
+
+def _blocks(signals_list, seconds=BLOCK_SECONDS):
+    """Per recording, a boolean mask of its samples in every third block of `seconds` (held out)."""
+    masks = []
+    for s in signals_list:
+        block = np.floor((s.t - s.t[0]) / seconds).astype(int)
+        masks.append(block % 3 == 2)
+    return masks
+
+
 def identify_consistent(robot, model, folder, signals_list, options: ConsistentOptions | None = None,
-                        on_progress=None) -> Consistent:
-    """robot: description (bounds, total mass, nominal); model: runtime.load of its generated
-    folder `folder` (which holds <robot>_extract.cpp); signals_list: conditioned recordings."""
+                        select=None) -> Consistent:
+    """robot: description (bounds, total mass, nominal, velocity limits); model: runtime.load of
+    its generated folder `folder` (which holds <robot>_extract.cpp); signals_list: conditioned
+    recordings with torques to fit; select: recordings to choose lambda on (default: every third
+    2-s block of the fit data)."""
     options = options or ConsistentOptions()
     dof = robot.dof
     names = [e["standard"] for e in model.manifest["coefficients"]["full"]["expressions"]]
+    r = len(names)
     kinds = tuple(k for k in FRICTION_KINDS if k in options.friction)
     armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
+    labels = _labels(kinds, armature_ok, dof)
     smoothing = (np.full(dof, float(options.smoothing)) if options.smoothing
-                 else _choose_smoothing(model, signals_list, kinds, armature_ok, dof))
-    Y, F, tau, labels = _design(model, signals_list, kinds, smoothing, armature_ok)
-    r = Y.shape[1]
-    joint_of_row = np.arange(Y.shape[0]) % dof
+                 else _choose_smoothing(model, signals_list, labels, dof))
+    Y, F, tau = _design(model, signals_list, labels, smoothing)
+    V = velocity_limits(robot, signals_list)
+    prior = options.prior
+    if prior is None and robot.nominal is not None:
+        prior = np.array([v for link in robot.nominal for v in link.as_tuple()])
 
     # Unconstrained fit: per-joint noise (the weights), then the weighted fit's statistics.
     A = np.hstack([Y, F])
@@ -205,96 +294,58 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     first = ols_fit(A, tau, column_names)
     res = (tau - A @ first.values).reshape(-1, dof)
     sigma = np.sqrt(np.mean(res ** 2, axis=0)) if options.weighted else np.ones(dof)
-    sigma = np.maximum(sigma, 1e-6 * max(sigma.max(), 1e-12))
-    w = 1.0 / sigma[joint_of_row]
+    sigma = np.maximum(sigma, 1e-9 + 1e-6 * sigma.max())
+    w = np.tile(1.0 / sigma, Y.shape[0] // dof)
     Aw, bw = A * w[:, None], tau * w
     ols = ols_fit(Aw, bw, column_names)
     ols_rms = np.sqrt(np.mean(((tau - A @ ols.values).reshape(-1, dof)) ** 2, axis=0))
 
-    # Gram matrix of the scaled weighted columns: everything after this is small.
-    scale = np.linalg.norm(Aw, axis=0)
-    scale = np.where(scale > 0, scale, 1.0)
-    As = Aw / scale
-    G = As.T @ As
-    g = As.T @ bw
-    bb = float(bw @ bw)
-
-    problem_options = ExtractOptions(restarts=options.restarts, seed=options.seed, threads=options.threads,
-                                     global_algorithm="none", margin=options.margin)
-    bounded_robot = robot_with_default_bounds(robot)
-    if options.prior is not None:
-        from dataclasses import replace
-
-        from ..description.robot import LinkValues
-
-        links = np.asarray(options.prior, dtype=float).reshape(-1, PER_LINK)
-        bounded_robot = replace(bounded_robot, nominal=tuple(LinkValues.from_tuple(row) for row in links))
-    problem = build_problem(bounded_robot, problem_options)
-    if options.prior is not None and options.regularisation > 0:
-        # Tikhonov toward the prior's base coefficients, in the unit-norm columns (y = scale pi)
-        y_prior = model("pi_full", np.asarray(options.prior, dtype=float)) * scale[:r]
-        G = G.copy()
-        G[:r, :r] += options.regularisation * np.eye(r)
-        g = g.copy()
-        g[:r] += options.regularisation * y_prior
-    exe = driver.build(folder)
-
-    nf = F.shape[1]
-    bounded = np.array([kind in options.nonnegative for kind, _ in labels], dtype=bool)
-    free = np.ones(nf, dtype=bool)
-    rounds, result, f_full = 0, None, np.zeros(nf)
-    for rounds in range(1, options.max_rounds + 1):
-        fi = r + np.flatnonzero(free)
-        pi_idx = np.arange(r)
-        Gff = G[np.ix_(fi, fi)]
-        Gfp = G[np.ix_(fi, pi_idx)]
-        Lf = np.linalg.cholesky(Gff + 1e-14 * np.eye(len(fi)) * max(np.trace(Gff), 1.0))
-        X = np.linalg.solve(Lf, Gfp)  # Lf^-1 Gfp
-        xg = np.linalg.solve(Lf, g[fi])
-        S = G[:r, :r] - X.T @ X  # Schur complement: the cost's Hessian in the scaled pi
-        h = g[:r] - X.T @ xg
-        Ls = np.linalg.cholesky(S + 1e-13 * np.trace(S) / r * np.eye(r))
-        # cost(pi_scaled) = || Ls^T y - Ls^-1 h ||^2 + const, y = scale * pi
-        W = Ls.T * scale[:r][None, :]
-        v = np.linalg.solve(Ls, h)
-        stage = Stage("identify", [Target("full", W, v)], np.ones(PER_LINK * dof, dtype=bool),
-                      problem.reference.copy())
-        result = driver.run(exe, problem, stage, problem_options,
-                            (lambda d, t: on_progress(rounds, d, t)) if on_progress else None)
-        if result.status != "ok":
-            raise RuntimeError("consistent identification: no feasible parameters (bounds, total mass)")
-        pi = model("pi_full", result.p)
-        y_pi = pi * scale[:r]
-        # friction values that minimise the cost for this pi
-        f_scaled = np.zeros(nf)
-        f_scaled[free] = np.linalg.solve(Lf.T, xg - X @ y_pi)
-        negative = free & bounded & (f_scaled < 0)
-        if negative.any():
-            free &= ~negative
-            continue
-        grad = 2 * (G[r:, :r] @ y_pi + G[r:, r:] @ f_scaled - g[r:])
-        wants = (~free) & bounded & (grad < -1e-9 * max(1.0, abs(bb)))
-        if not wants.any():
-            break
-        free |= wants
-    f_full = f_scaled / scale[r:]
+    solver = _Solver(robot, model, folder, options, labels, r, V, prior)
+    selection = []
+    lam = options.regularisation
+    if lam is None:
+        lam = 0.0
+        if prior is not None and len(options.grid) > 1:
+            if select:
+                fit_rows, Ys, Fs, ts = np.ones(Y.shape[0], dtype=bool), *_design(model, select, labels, smoothing)
+                As, bs = np.hstack([Ys, Fs]), ts
+            else:
+                held = np.concatenate([np.repeat(m, dof) for m in _blocks(signals_list)])
+                fit_rows, As, bs = ~held, A[held], tau[held]
+            ws = np.tile(1.0 / sigma, As.shape[0] // dof)
+            best = np.inf
+            for candidate in options.grid:
+                pi, f, _, _ = solver.solve(Aw[fit_rows], bw[fit_rows], candidate)
+                score = float(np.mean(((bs - As @ np.concatenate([pi, f])) * ws) ** 2))
+                selection.append((float(candidate), score))
+                if score < best:
+                    best, lam = score, float(candidate)
+    pi, f_nat, rounds, result = solver.solve(Aw, bw, lam)
     friction = {k: np.full(dof, np.nan) for k in FRICTION_KINDS}
-    for (kind, j), value in zip(labels, f_full):
-        friction[kind][j] = value
     for kind in kinds:
-        friction[kind] = np.where(np.isnan(friction[kind]), 0.0, friction[kind]) if kind != "armature" else \
-            np.where(np.array(armature_ok), np.nan_to_num(friction[kind]), np.nan)
-    pred = Y @ pi + F @ f_full
-    rms = np.sqrt(np.mean(((tau - pred).reshape(-1, dof)) ** 2, axis=0))
-    lam = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
-    return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam,
-                      rounds, float(result.cost), [j + 1 for j in range(dof) if not armature_ok[j]],
-                      pinned(problem, result.p))
+        friction[kind][:] = 0.0
+    friction["armature"][[j for j in range(dof) if not armature_ok[j]]] = np.nan
+    for (kind, j), value in zip(labels, f_nat):
+        friction[kind][j] = value
+    rms = np.sqrt(np.mean(((tau - A @ np.concatenate([pi, f_nat])).reshape(-1, dof)) ** 2, axis=0))
+    lam_min = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
+    return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
+                      lam, selection, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
+                      pinned(solver.problem, result.p), V)
+
+
+def velocity_limits(robot, signals_list) -> np.ndarray:
+    """V_j: the YAML's velocity limit, or else 1.5 times the largest |qd_j| in the data."""
+    seen = np.max(np.vstack([np.abs(s.qd) for s in signals_list]), axis=0)
+    out = []
+    for j, joint in enumerate(robot.joints):
+        lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
+        out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
+    return np.array(out, dtype=float)
 
 
 def pinned(problem, p, rel: float = 1e-6) -> list:
-    from ..parameters import dynamic_name
-
+    """Names of the parameters at (within rel of the range from) one of their bounds."""
     span = np.maximum(problem.upper - problem.lower, 1e-300)
     at = (np.abs(p - problem.lower) < rel * span) | (np.abs(problem.upper - p) < rel * span)
     return [dynamic_name(j // PER_LINK + 1, j % PER_LINK) for j in np.flatnonzero(at)]
@@ -302,11 +353,9 @@ def pinned(problem, p, rel: float = 1e-6) -> list:
 
 def robot_with_default_bounds(robot):
     """The YAML's bounds, or (none given) wide ones: a link 1 g to 1000 kg, its centre of mass
-    within 2 m of its frame, inertias within +-100 kg m^2 (consistency does the real work)."""
+    within 2 m of its frame, inertias within 100 kg m^2 (consistency does the real work)."""
     if robot.lower is not None:
         return robot
-    from dataclasses import replace
-
     from ..description.robot import LinkValues
 
     lo = LinkValues(1e-3, (-2.0, -2.0, -2.0), (0.0, -100.0, -100.0, 0.0, -100.0, 0.0))
