@@ -47,6 +47,7 @@ from ..extraction.problem import Stage, build_problem, consistency_margin
 from ..extraction.targets import Target
 from ..parameters import PER_LINK, dynamic_name
 from .least_squares import fit as ols_fit
+from .tilt import tilt_columns
 
 FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature")
 SMOOTHING_GRID = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
@@ -67,6 +68,7 @@ class ConsistentOptions:
     prior: np.ndarray | None = None  # dynamic parameters (10N); default the YAML's nominal
     regularisation: float | None = None  # None: chosen on held-out data from REGULARISATION_GRID
     grid: tuple = REGULARISATION_GRID
+    tilt: bool = False  # two more columns: a horizontal gravity component dg (a tilted base), prior's masses
 
 
 @dataclass
@@ -90,6 +92,7 @@ class Consistent:
     dropped_armature: list = field(default_factory=list)  # joints whose rotor inertia the body carries
     at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
     velocity_limits: np.ndarray | None = None
+    tilt_model: tuple | None = None  # (robot, parameters) the tilt columns are evaluated with
 
     def joint_dynamics(self) -> list:
         """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
@@ -102,7 +105,10 @@ class Consistent:
         """Torques (T, N) of this model (rigid body + friction + offset + rotor inertia) on signals."""
         Y = model.batch("regressor", signals.q, signals.qd, signals.qdd)
         f = {k: np.nan_to_num(v) for k, v in self.friction.items()}
-        return (Y @ self.pi + f["coulomb"] * np.tanh(signals.qd / self.smoothing) + f["viscous"] * signals.qd
+        tilt = 0.0
+        if self.tilt_model is not None:
+            tilt = tilt_columns(*self.tilt_model, signals.q) @ f["tilt"]
+        return (tilt + Y @ self.pi + f["coulomb"] * np.tanh(signals.qd / self.smoothing) + f["viscous"] * signals.qd
                 + f["offset"] + f["armature"] * signals.qdd)
 
 
@@ -144,12 +150,16 @@ def _friction_matrix(signals, labels, smoothing) -> np.ndarray:
     return F.reshape(T * n, len(labels))
 
 
-def _design(model, signals_list, labels, smoothing):
+def _design(model, signals_list, labels, smoothing, tilt=None):
+    """Y, [F | tilt columns], tau; tilt: None or (robot, prior parameters)."""
     Ys, Fs, taus, samples = [], [], [], []
     for s in signals_list:
         Y = model.batch("regressor", s.q, s.qd, s.qdd)
         Ys.append(Y.reshape(-1, Y.shape[-1]))
-        Fs.append(_friction_matrix(s, labels, smoothing))
+        F = _friction_matrix(s, [lab for lab in labels if lab[0] != "tilt"], smoothing)
+        if tilt is not None:
+            F = np.hstack([F, tilt_columns(tilt[0], tilt[1], s.q).reshape(F.shape[0], 2)])
+        Fs.append(F)
         taus.append(np.asarray(s.tau).reshape(-1))
         samples.append(s.t)
     return np.vstack(Ys), np.vstack(Fs), np.concatenate(taus)
@@ -282,15 +292,19 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     labels = _labels(kinds, armature_ok, dof)
     smoothing = (np.full(dof, float(options.smoothing)) if options.smoothing
                  else _choose_smoothing(model, signals_list, labels, dof))
-    Y, F, tau = _design(model, signals_list, labels, smoothing)
     V = velocity_limits(robot, signals_list)
     prior = options.prior
     if prior is None and robot.nominal is not None:
         prior = np.array([v for link in robot.nominal for v in link.as_tuple()])
+    tilt = None
+    if options.tilt and prior is not None:
+        tilt = (robot, prior)
+        labels = labels + [("tilt", 0), ("tilt", 1)]
+    Y, F, tau = _design(model, signals_list, labels, smoothing, tilt)
 
     # Unconstrained fit: per-joint noise (the weights), then the weighted fit's statistics.
     A = np.hstack([Y, F])
-    column_names = names + [f"{kind} j{j + 1}" for kind, j in labels]
+    column_names = names + [f"{kind} j{j + 1}" if kind != "tilt" else f"tilt dg_{'xy'[j]}" for kind, j in labels]
     first = ols_fit(A, tau, column_names)
     res = (tau - A @ first.values).reshape(-1, dof)
     sigma = np.sqrt(np.mean(res ** 2, axis=0)) if options.weighted else np.ones(dof)
@@ -307,7 +321,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
         lam = 0.0
         if prior is not None and len(options.grid) > 1:
             if select:
-                fit_rows, Ys, Fs, ts = np.ones(Y.shape[0], dtype=bool), *_design(model, select, labels, smoothing)
+                fit_rows, Ys, Fs, ts = np.ones(Y.shape[0], dtype=bool), *_design(model, select, labels, smoothing, tilt)
                 As, bs = np.hstack([Ys, Fs]), ts
             else:
                 held = np.concatenate([np.repeat(m, dof) for m in _blocks(signals_list)])
@@ -322,16 +336,17 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
                     best, lam = score, float(candidate)
     pi, f_nat, rounds, result = solver.solve(Aw, bw, lam)
     friction = {k: np.full(dof, np.nan) for k in FRICTION_KINDS}
+    friction["tilt"] = np.zeros(2)
     for kind in kinds:
         friction[kind][:] = 0.0
     friction["armature"][[j for j in range(dof) if not armature_ok[j]]] = np.nan
     for (kind, j), value in zip(labels, f_nat):
-        friction[kind][j] = value
+        friction[kind][j] = value  # for the tilt, j is the direction (x, y)
     rms = np.sqrt(np.mean(((tau - A @ np.concatenate([pi, f_nat])).reshape(-1, dof)) ** 2, axis=0))
     lam_min = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
     return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
                       lam, selection, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
-                      pinned(solver.problem, result.p), V)
+                      pinned(solver.problem, result.p), V, tilt)
 
 
 def velocity_limits(robot, signals_list) -> np.ndarray:
