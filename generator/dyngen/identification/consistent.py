@@ -49,7 +49,8 @@ from ..parameters import PER_LINK, dynamic_name
 from .least_squares import fit as ols_fit
 from .tilt import tilt_columns
 
-FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature")
+FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
+DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
 SMOOTHING_GRID = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
 REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
 BLOCK_SECONDS = 2.0  # held-out blocks when no select data are given
@@ -57,7 +58,7 @@ BLOCK_SECONDS = 2.0  # held-out blocks when no select data are given
 
 @dataclass
 class ConsistentOptions:
-    friction: tuple = FRICTION_KINDS  # which per-joint columns to include
+    friction: tuple = DEFAULT_KINDS  # which per-joint columns to include ("ripple": cos q_j, sin q_j too)
     smoothing: float | None = None  # vs for every joint; None: chosen per joint on the fit data
     margin: float = 1e-7  # consistency margin [kg m^2], as the extraction's
     restarts: int = 2
@@ -109,7 +110,8 @@ class Consistent:
         if self.tilt_model is not None:
             tilt = tilt_columns(*self.tilt_model, signals.q) @ f["tilt"]
         return (tilt + Y @ self.pi + f["coulomb"] * np.tanh(signals.qd / self.smoothing) + f["viscous"] * signals.qd
-                + f["offset"] + f["armature"] * signals.qdd)
+                + f["offset"] + f["armature"] * signals.qdd + f["ripple_cos"] * np.cos(signals.q)
+                + f["ripple_sin"] * np.sin(signals.q))
 
 
 def _nz(x) -> float:
@@ -146,7 +148,8 @@ def _friction_matrix(signals, labels, smoothing) -> np.ndarray:
     F = np.zeros((T, n, len(labels)))
     for k, (kind, j) in enumerate(labels):
         F[:, j, k] = {"coulomb": lambda: np.tanh(signals.qd[:, j] / smoothing[j]), "viscous": lambda: signals.qd[:, j],
-                      "offset": lambda: np.ones(T), "armature": lambda: signals.qdd[:, j]}[kind]()
+                      "offset": lambda: np.ones(T), "armature": lambda: signals.qdd[:, j],
+                      "ripple_cos": lambda: np.cos(signals.q[:, j]), "ripple_sin": lambda: np.sin(signals.q[:, j])}[kind]()
     return F.reshape(T * n, len(labels))
 
 
@@ -287,7 +290,8 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     dof = robot.dof
     names = [e["standard"] for e in model.manifest["coefficients"]["full"]["expressions"]]
     r = len(names)
-    kinds = tuple(k for k in FRICTION_KINDS if k in options.friction)
+    wanted = set(options.friction) | ({"ripple_cos", "ripple_sin"} if "ripple" in options.friction else set())
+    kinds = tuple(k for k in FRICTION_KINDS if k in wanted)
     armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
     labels = _labels(kinds, armature_ok, dof)
     smoothing = (np.full(dof, float(options.smoothing)) if options.smoothing
