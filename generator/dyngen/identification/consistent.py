@@ -26,7 +26,8 @@ an active set around it (Lawson-Hanson): a weight that comes out negative is hel
 at 0 whose gradient asks to grow is freed again; two or three rounds in practice.
 
 lambda (unit-norm columns: lambda = 1 weighs like one well-excited column's worth of data) is
-chosen on held-out data: the `select` recordings, or else every third 2-s block of the fit data.
+chosen on held-out data: the `select` recordings, or else by cross-validation over contiguous
+parts of the fit recordings (default five: each held out once), with the one-standard-error rule.
 The model is then refitted on all fit data. Test data are never seen here.
 
 Statistics come from the unconstrained weighted least squares of the same columns (the
@@ -46,14 +47,13 @@ from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import Stage, build_problem, consistency_margin
 from ..extraction.targets import Target
 from ..parameters import PER_LINK, dynamic_name
-from .least_squares import fit as ols_fit
+from .least_squares import WEAK, Estimate
 from .tilt import tilt_columns
 
 FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
 DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
 SMOOTHING_GRID = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
 REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
-BLOCK_SECONDS = 2.0  # held-out blocks when no select data are given
 
 
 @dataclass
@@ -69,6 +69,8 @@ class ConsistentOptions:
     prior: np.ndarray | None = None  # dynamic parameters (10N); default the YAML's nominal
     regularisation: float | None = None  # None: chosen on held-out data from REGULARISATION_GRID
     grid: tuple = REGULARISATION_GRID
+    folds: int = 5  # contiguous parts for choosing the regularisation when no select data are given
+    rule: str = "1se"  # "1se" (one-standard-error rule) or "min" (the best held-out score)
     tilt: bool = False  # two more columns: a horizontal gravity component dg (a tilted base), prior's masses
 
 
@@ -94,6 +96,7 @@ class Consistent:
     at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
     velocity_limits: np.ndarray | None = None
     tilt_model: tuple | None = None  # (robot, parameters) the tilt columns are evaluated with
+    dropped_columns: list = field(default_factory=list)  # friction/tilt columns the data cannot separate
 
     def joint_dynamics(self) -> list:
         """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
@@ -176,12 +179,48 @@ def _choose_smoothing(model, signals_list, labels, dof) -> np.ndarray:
     for vs in SMOOTHING_GRID:
         F = np.vstack([_friction_matrix(s, labels, np.full(dof, vs)) for s in signals_list])
         A = np.hstack([Y, F])
-        A = A / np.where(np.linalg.norm(A, axis=0) > 0, np.linalg.norm(A, axis=0), 1.0)
-        x, *_ = np.linalg.lstsq(A, tau, rcond=None)
+        x = _least_squares(A, tau)
         ms = np.mean(((tau - A @ x).reshape(-1, dof)) ** 2, axis=0)
         better = ms < best
         best[better], choice[better] = ms[better], vs
     return choice
+
+
+def _least_squares(A, b) -> np.ndarray:
+    """Minimum-norm-ish least squares through the Gram matrix of unit-norm columns (pseudo-inverse
+    cut at WEAK^2 of the largest eigenvalue): A has ~10^5 rows and ~10^2 columns, and forming
+    A^T A once is ten times faster than an SVD or QR of A."""
+    norms = np.linalg.norm(A, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    As = A / scale
+    ev, V = np.linalg.eigh(As.T @ As)
+    keep = ev > WEAK ** 2 * ev[-1]
+    return (V[:, keep] @ ((V[:, keep].T @ (As.T @ b)) / ev[keep])) / scale
+
+
+def _statistics(A, b, names) -> Estimate:
+    """least_squares.fit's Estimate (values, std, condition numbers, unexcited) from the Gram
+    matrix's eigen-decomposition: the squared singular values and right singular vectors of A."""
+    rows, cols = A.shape
+    norms = np.linalg.norm(A, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    As = A / scale
+    G = As.T @ As
+    ev, V = np.linalg.eigh(G)
+    ev, V = ev[::-1], V[:, ::-1]
+    sv = np.sqrt(np.maximum(ev, 0.0))
+    strong = sv > WEAK * sv[0]
+    x = (V[:, strong] @ ((V[:, strong].T @ (As.T @ b)) / ev[strong])) / scale
+    residual = b - A @ x
+    sigma2 = float(residual @ residual) / max(rows - int(strong.sum()), 1)
+    loading = (V[:, ~strong].T ** 2).sum(axis=0)
+    unexcited = [k for k in range(cols) if loading[k] > 0.5 or norms[k] == 0]
+    std = np.sqrt(sigma2 * np.diag((V[:, strong] / ev[strong]) @ V[:, strong].T)) / scale
+    std[unexcited] = np.inf
+    raw = np.sqrt(np.maximum(np.linalg.eigvalsh(A.T @ A), 0.0))
+    condition = float(raw[-1] / raw[0]) if raw[0] > 0 else float("inf")
+    scaled = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    return Estimate(list(names), x, std, condition, scaled, float(np.sqrt(np.mean(residual ** 2))), rows, unexcited)
 
 
 def _generators(labels, r, V) -> np.ndarray:
@@ -222,7 +261,7 @@ class _Solver:
         self.exe = driver.build(folder)
         self.pi_prior = model("pi_full", prior) if prior is not None else None
 
-    def solve(self, A, b, lam):
+    def solve(self, A, b, lam, restarts=None):
         """(pi, natural friction values, rounds, extraction result) for weighted rows A, b."""
         r = self.r
         Ag = A @ self.M
@@ -250,7 +289,8 @@ class _Solver:
             v = np.linalg.solve(Ls, h)
             stage = Stage("identify", [Target("full", W, v)], np.ones(self.problem.lower.size, dtype=bool),
                           self.problem.reference.copy())
-            result = driver.run(self.exe, self.problem, stage, self.extract_options)
+            opts = self.extract_options if restarts is None else replace(self.extract_options, restarts=restarts)
+            result = driver.run(self.exe, self.problem, stage, opts)
             if result.status != "ok":
                 raise RuntimeError("consistent identification: no parameters satisfy the bounds and total mass")
             pi = self.model("pi_full", result.p)
@@ -271,13 +311,15 @@ class _Solver:
         return pi, natural, rounds, result
 
 
-def _blocks(signals_list, seconds=BLOCK_SECONDS):
-    """Per recording, a boolean mask of its samples in every third block of `seconds` (held out)."""
-    masks = []
+def _folds(signals_list, folds: int):
+    """Per recording, the part (0 .. folds - 1) of each sample: contiguous stretches of equal
+    duration. Held-out parts are other stretches of motion, not samples interleaved with the fit
+    (which the fit would predict almost as well as its own, favouring no regularisation)."""
+    out = []
     for s in signals_list:
-        block = np.floor((s.t - s.t[0]) / seconds).astype(int)
-        masks.append(block % 3 == 2)
-    return masks
+        u = (s.t - s.t[0]) / max(s.t[-1] - s.t[0], 1e-300)
+        out.append(np.minimum((u * folds).astype(int), folds - 1))
+    return out
 
 
 def identify_consistent(robot, model, folder, signals_list, options: ConsistentOptions | None = None,
@@ -309,13 +351,28 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     # Unconstrained fit: per-joint noise (the weights), then the weighted fit's statistics.
     A = np.hstack([Y, F])
     column_names = names + [f"{kind} j{j + 1}" if kind != "tilt" else f"tilt dg_{'xy'[j]}" for kind, j in labels]
-    first = ols_fit(A, tau, column_names)
-    res = (tau - A @ first.values).reshape(-1, dof)
+    res = (tau - A @ _least_squares(A, tau)).reshape(-1, dof)
     sigma = np.sqrt(np.mean(res ** 2, axis=0)) if options.weighted else np.ones(dof)
     sigma = np.maximum(sigma, 1e-9 + 1e-6 * sigma.max())
     w = np.tile(1.0 / sigma, Y.shape[0] // dof)
     Aw, bw = A * w[:, None], tau * w
-    ols = ols_fit(Aw, bw, column_names)
+    ols = _statistics(Aw, bw, column_names)
+    # Friction, ripple or tilt columns the data cannot tell from the rest (e.g. a ripple cos q_j,
+    # sin q_j of a joint whose gravity torque has the same shape) would take arbitrary values
+    # without a bound to stop them: they are left out and named.
+    drop = {k - r for k in ols.unexcited if k >= r}
+    if tilt is not None and any(labels[k][0] == "tilt" for k in drop):
+        drop |= {k for k, lab in enumerate(labels) if lab[0] == "tilt"}
+        tilt = None
+    dropped = [column_names[r + k] for k in sorted(drop)]
+    if drop:
+        keep = [k for k in range(len(labels)) if k not in drop]
+        labels = [labels[k] for k in keep]
+        F = F[:, keep]
+        A = np.hstack([Y, F])
+        column_names = names + [column_names[r + k] for k in keep]
+        Aw = A * w[:, None]
+        ols = _statistics(Aw, bw, column_names)
     ols_rms = np.sqrt(np.mean(((tau - A @ ols.values).reshape(-1, dof)) ** 2, axis=0))
 
     solver = _Solver(robot, model, folder, options, labels, r, V, prior)
@@ -325,19 +382,30 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
         lam = 0.0
         if prior is not None and len(options.grid) > 1:
             if select:
-                fit_rows, Ys, Fs, ts = np.ones(Y.shape[0], dtype=bool), *_design(model, select, labels, smoothing, tilt)
-                As, bs = np.hstack([Ys, Fs]), ts
-            else:
-                held = np.concatenate([np.repeat(m, dof) for m in _blocks(signals_list)])
-                fit_rows, As, bs = ~held, A[held], tau[held]
-            ws = np.tile(1.0 / sigma, As.shape[0] // dof)
-            best = np.inf
-            for candidate in options.grid:
-                pi, f, _, _ = solver.solve(Aw[fit_rows], bw[fit_rows], candidate)
-                score = float(np.mean(((bs - As @ np.concatenate([pi, f])) * ws) ** 2))
-                selection.append((float(candidate), score))
-                if score < best:
-                    best, lam = score, float(candidate)
+                Ys, Fs, ts = _design(model, select, labels, smoothing, tilt)
+                folds = [(np.ones(Y.shape[0], dtype=bool), np.hstack([Ys, Fs]), ts)]
+            else:  # contiguous parts of every recording: each is held out once
+                part = np.concatenate([np.repeat(m, dof) for m in _folds(signals_list, options.folds)])
+                folds = [(part != k, A[part == k], tau[part == k]) for k in range(options.folds)]
+            scores = np.zeros((len(folds), len(options.grid)))
+            for k, (fit_rows, As, bs) in enumerate(folds):
+                ws = np.tile(1.0 / sigma, As.shape[0] // dof)
+                for i, candidate in enumerate(options.grid):
+                    # the problem is convex: one restart finds its minimum (the final fit uses more)
+                    pi, f, _, _ = solver.solve(Aw[fit_rows], bw[fit_rows], candidate, restarts=1)
+                    scores[k, i] = float(np.mean(((bs - As @ np.concatenate([pi, f])) * ws) ** 2))
+            mean = scores.mean(axis=0)
+            best = int(np.argmin(mean))
+            chosen = best
+            if options.rule == "1se" and len(folds) > 1:
+                # the one-standard-error rule: the strongest pull toward the prior whose held-out
+                # score is within one standard error of the best (a held-out part of the same
+                # recording flatters the fit, so the least regularised model that "wins" there
+                # generalises worse to other motions)
+                se = scores[:, best].std(ddof=1) / np.sqrt(len(folds))
+                chosen = max(i for i in range(len(mean)) if mean[i] <= mean[best] + se)
+            selection = [(float(c), float(m)) for c, m in zip(options.grid, mean)]
+            lam = float(options.grid[chosen])
     pi, f_nat, rounds, result = solver.solve(Aw, bw, lam)
     friction = {k: np.full(dof, np.nan) for k in FRICTION_KINDS}
     friction["tilt"] = np.zeros(2)
@@ -350,7 +418,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     lam_min = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
     return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
                       lam, selection, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
-                      pinned(solver.problem, result.p), V, tilt)
+                      pinned(solver.problem, result.p), V, tilt, dropped)
 
 
 def velocity_limits(robot, signals_list) -> np.ndarray:

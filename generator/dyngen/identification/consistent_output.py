@@ -88,6 +88,8 @@ def summary_lines(robot, c) -> list[str]:
     if c.ols.unexcited:
         out.append(f"  {len(c.ols.unexcited)} coefficient(s) not excited by the data (set by the prior and "
                    "consistency): " + ", ".join(c.column_names[i] for i in c.ols.unexcited))
+    if c.dropped_columns:
+        out.append("  left out (the data cannot tell them from the rest of the model): " + ", ".join(c.dropped_columns))
     if c.at_bounds:
         out.append(f"  parameters at a bound of the YAML: {', '.join(c.at_bounds)}")
     negative = [j + 1 for j in range(n) if c.friction["viscous"][j] < 0]
