@@ -53,6 +53,7 @@ from .tilt import tilt_columns
 FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
 DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
 SMOOTHING_GRID = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
+LAG_GRID = (0.0, 0.01, 0.02, 0.04)  # s, candidates for the Coulomb term's lag behind the velocity
 REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
 
 
@@ -71,7 +72,8 @@ class ConsistentOptions:
     grid: tuple = REGULARISATION_GRID
     folds: int = 5  # contiguous parts for choosing the regularisation when no select data are given
     rule: str = "1se"  # "1se" (one-standard-error rule) or "min" (the best held-out score)
-    tilt: bool = False  # two more columns: a horizontal gravity component dg (a tilted base), prior's masses
+    tilt: bool = False
+    friction_lag: bool = True  # Coulomb term follows the velocity with a per-joint lag from LAG_GRID  # two more columns: a horizontal gravity component dg (a tilted base), prior's masses
 
 
 @dataclass
@@ -97,6 +99,7 @@ class Consistent:
     velocity_limits: np.ndarray | None = None
     tilt_model: tuple | None = None  # (robot, parameters) the tilt columns are evaluated with
     dropped_columns: list = field(default_factory=list)  # friction/tilt columns the data cannot separate
+    lags: np.ndarray | None = None  # (N,) lag of the Coulomb term behind the velocity [s]
 
     def joint_dynamics(self) -> list:
         """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
@@ -112,7 +115,8 @@ class Consistent:
         tilt = 0.0
         if self.tilt_model is not None:
             tilt = tilt_columns(*self.tilt_model, signals.q) @ f["tilt"]
-        return (tilt + Y @ self.pi + f["coulomb"] * np.tanh(signals.qd / self.smoothing) + f["viscous"] * signals.qd
+        return (tilt + Y @ self.pi + f["coulomb"] * np.column_stack([
+            coulomb_column(signals, j, self.smoothing, self.lags) for j in range(len(self.sigma))]) + f["viscous"] * signals.qd
                 + f["offset"] + f["armature"] * signals.qdd + f["ripple_cos"] * np.cos(signals.q)
                 + f["ripple_sin"] * np.sin(signals.q))
 
@@ -145,24 +149,35 @@ def _labels(kinds, armature_ok, dof) -> list:
     return [(kind, j) for j in range(dof) for kind in kinds if kind != "armature" or armature_ok[j]]
 
 
-def _friction_matrix(signals, labels, smoothing) -> np.ndarray:
+def lagged(t, x, lag: float) -> np.ndarray:
+    """x(t - lag), held at x(t_0) before the start."""
+    return x if lag <= 0 else np.interp(t - lag, t, x)
+
+
+def coulomb_column(signals, j, smoothing, lags) -> np.ndarray:
+    """tanh(qd_j(t - lag_j) / vs_j): Coulomb friction, smoothed, following the velocity with a lag."""
+    lag = 0.0 if lags is None else lags[j]
+    return np.tanh(lagged(signals.t, signals.qd[:, j], lag) / smoothing[j])
+
+
+def _friction_matrix(signals, labels, smoothing, lags=None) -> np.ndarray:
     """Natural friction columns (rows: samples x joints, the regressor's order)."""
     T, n = signals.q.shape
     F = np.zeros((T, n, len(labels)))
     for k, (kind, j) in enumerate(labels):
-        F[:, j, k] = {"coulomb": lambda: np.tanh(signals.qd[:, j] / smoothing[j]), "viscous": lambda: signals.qd[:, j],
+        F[:, j, k] = {"coulomb": lambda: coulomb_column(signals, j, smoothing, lags), "viscous": lambda: signals.qd[:, j],
                       "offset": lambda: np.ones(T), "armature": lambda: signals.qdd[:, j],
                       "ripple_cos": lambda: np.cos(signals.q[:, j]), "ripple_sin": lambda: np.sin(signals.q[:, j])}[kind]()
     return F.reshape(T * n, len(labels))
 
 
-def _design(model, signals_list, labels, smoothing, tilt=None):
+def _design(model, signals_list, labels, smoothing, tilt=None, lags=None):
     """Y, [F | tilt columns], tau; tilt: None or (robot, prior parameters)."""
     Ys, Fs, taus, samples = [], [], [], []
     for s in signals_list:
         Y = model.batch("regressor", s.q, s.qd, s.qdd)
         Ys.append(Y.reshape(-1, Y.shape[-1]))
-        F = _friction_matrix(s, [lab for lab in labels if lab[0] != "tilt"], smoothing)
+        F = _friction_matrix(s, [lab for lab in labels if lab[0] != "tilt"], smoothing, lags)
         if tilt is not None:
             F = np.hstack([F, tilt_columns(tilt[0], tilt[1], s.q).reshape(F.shape[0], 2)])
         Fs.append(F)
@@ -183,6 +198,21 @@ def _choose_smoothing(model, signals_list, labels, dof) -> np.ndarray:
         ms = np.mean(((tau - A @ x).reshape(-1, dof)) ** 2, axis=0)
         better = ms < best
         best[better], choice[better] = ms[better], vs
+    return choice
+
+
+def _choose_lag(model, signals_list, labels, smoothing, dof) -> np.ndarray:
+    """Per joint, the lag of LAG_GRID of the Coulomb term whose unconstrained fit leaves joint j
+    the least residual (like the smoothing, on the fit data)."""
+    best, choice = np.full(dof, np.inf), np.zeros(dof)
+    Y = np.vstack([model.batch("regressor", s.q, s.qd, s.qdd).reshape(s.q.shape[0] * dof, -1) for s in signals_list])
+    tau = np.concatenate([np.asarray(s.tau).reshape(-1) for s in signals_list])
+    for lag in LAG_GRID:
+        F = np.vstack([_friction_matrix(s, labels, smoothing, np.full(dof, lag)) for s in signals_list])
+        A = np.hstack([Y, F])
+        ms = np.mean(((tau - A @ _least_squares(A, tau)).reshape(-1, dof)) ** 2, axis=0)
+        better = ms < best * (1 - 1e-3)  # a lag must earn its place
+        best[better], choice[better] = ms[better], lag
     return choice
 
 
@@ -338,6 +368,8 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     labels = _labels(kinds, armature_ok, dof)
     smoothing = (np.full(dof, float(options.smoothing)) if options.smoothing
                  else _choose_smoothing(model, signals_list, labels, dof))
+    lags = (_choose_lag(model, signals_list, labels, smoothing, dof) if options.friction_lag and "coulomb" in kinds
+            else np.zeros(dof))
     V = velocity_limits(robot, signals_list)
     prior = options.prior
     if prior is None and robot.nominal is not None:
@@ -346,7 +378,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     if options.tilt and prior is not None:
         tilt = (robot, prior)
         labels = labels + [("tilt", 0), ("tilt", 1)]
-    Y, F, tau = _design(model, signals_list, labels, smoothing, tilt)
+    Y, F, tau = _design(model, signals_list, labels, smoothing, tilt, lags)
 
     # Unconstrained fit: per-joint noise (the weights), then the weighted fit's statistics.
     A = np.hstack([Y, F])
@@ -382,7 +414,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
         lam = 0.0
         if prior is not None and len(options.grid) > 1:
             if select:
-                Ys, Fs, ts = _design(model, select, labels, smoothing, tilt)
+                Ys, Fs, ts = _design(model, select, labels, smoothing, tilt, lags)
                 folds = [(np.ones(Y.shape[0], dtype=bool), np.hstack([Ys, Fs]), ts)]
             else:  # contiguous parts of every recording: each is held out once
                 part = np.concatenate([np.repeat(m, dof) for m in _folds(signals_list, options.folds)])
@@ -418,7 +450,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     lam_min = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
     return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
                       lam, selection, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
-                      pinned(solver.problem, result.p), V, tilt, dropped)
+                      pinned(solver.problem, result.p), V, tilt, dropped, lags)
 
 
 def velocity_limits(robot, signals_list) -> np.ndarray:
