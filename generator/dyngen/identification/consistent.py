@@ -52,7 +52,7 @@ from .tilt import tilt_columns
 
 FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
 DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
-SMOOTHING_GRID = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
+SMOOTHING_GRID = (0.0002, 0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
 LAG_GRID = (0.0, 0.01, 0.02, 0.04)  # s, candidates for the Coulomb term's lag behind the velocity
 REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
 
@@ -228,7 +228,28 @@ def _least_squares(A, b) -> np.ndarray:
     return (V[:, keep] @ ((V[:, keep].T @ (As.T @ b)) / ev[keep])) / scale
 
 
-def _statistics(A, b, names) -> Estimate:
+def correlation_factor(residual, dof: int, max_lag: int = 2000) -> float:
+    """How much a residual correlated in time inflates the variance of least-squares estimates:
+    1 + 2 sum_k rho_k (the residual's autocorrelation per joint, summed until it first drops
+    below zero, Bartlett), averaged over joints. Filtered signals have correlation times of many
+    samples; the textbook std (white residuals) would be too small by the square root of this."""
+    r = residual.reshape(-1, dof)
+    factors = []
+    for j in range(dof):
+        x = r[:, j] - r[:, j].mean()
+        n = x.size
+        spectrum = np.fft.rfft(x, 2 * n)
+        acf = np.fft.irfft(spectrum * np.conj(spectrum))[:min(n, max_lag)]
+        if acf[0] <= 0:
+            continue
+        rho = acf / acf[0]
+        stop = np.flatnonzero(rho[1:] < 0)
+        k = stop[0] + 1 if stop.size else rho.size
+        factors.append(max(1.0, 1.0 + 2.0 * rho[1:k].sum()))
+    return float(np.mean(factors)) if factors else 1.0
+
+
+def _statistics(A, b, names, dof: int = 1) -> Estimate:
     """least_squares.fit's Estimate (values, std, condition numbers, unexcited) from the Gram
     matrix's eigen-decomposition: the squared singular values and right singular vectors of A."""
     rows, cols = A.shape
@@ -246,6 +267,7 @@ def _statistics(A, b, names) -> Estimate:
     loading = (V[:, ~strong].T ** 2).sum(axis=0)
     unexcited = [k for k in range(cols) if loading[k] > 0.5 or norms[k] == 0]
     std = np.sqrt(sigma2 * np.diag((V[:, strong] / ev[strong]) @ V[:, strong].T)) / scale
+    std *= np.sqrt(correlation_factor(residual, dof))
     std[unexcited] = np.inf
     raw = np.sqrt(np.maximum(np.linalg.eigvalsh(A.T @ A), 0.0))
     condition = float(raw[-1] / raw[0]) if raw[0] > 0 else float("inf")
@@ -388,7 +410,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     sigma = np.maximum(sigma, 1e-9 + 1e-6 * sigma.max())
     w = np.tile(1.0 / sigma, Y.shape[0] // dof)
     Aw, bw = A * w[:, None], tau * w
-    ols = _statistics(Aw, bw, column_names)
+    ols = _statistics(Aw, bw, column_names, dof)
     # Friction, ripple or tilt columns the data cannot tell from the rest (e.g. a ripple cos q_j,
     # sin q_j of a joint whose gravity torque has the same shape) would take arbitrary values
     # without a bound to stop them: they are left out and named.
@@ -404,7 +426,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
         A = np.hstack([Y, F])
         column_names = names + [column_names[r + k] for k in keep]
         Aw = A * w[:, None]
-        ols = _statistics(Aw, bw, column_names)
+        ols = _statistics(Aw, bw, column_names, dof)
     ols_rms = np.sqrt(np.mean(((tau - A @ ols.values).reshape(-1, dof)) ** 2, axis=0))
 
     solver = _Solver(robot, model, folder, options, labels, r, V, prior)
