@@ -313,14 +313,14 @@ class _Solver:
         self.exe = driver.build(folder)
         self.pi_prior = model("pi_full", prior) if prior is not None else None
 
-    def solve(self, A, b, lam, restarts=None):
-        """(pi, natural friction values, rounds, extraction result) for weighted rows A, b."""
+    def solve(self, gram, rhs, lam, restarts=None):
+        """(pi, natural friction values, rounds, extraction result) for the Gram matrix A^T A and
+        A^T b of the weighted rows A, b (natural columns: coefficients, then friction)."""
         r = self.r
-        Ag = A @ self.M
-        scale = np.linalg.norm(Ag, axis=0)
+        gram, rhs = self.M.T @ gram @ self.M, self.M.T @ rhs
+        scale = np.sqrt(np.maximum(np.diag(gram), 0.0))
         scale = np.where(scale > 0, scale, 1.0)
-        As = Ag / scale
-        G, g = As.T @ As, As.T @ b
+        G, g = gram / np.outer(scale, scale), rhs / scale
         if lam > 0 and self.pi_prior is not None:
             G[:r, :r] += lam * np.eye(r)
             g[:r] += lam * self.pi_prior * scale[:r]
@@ -430,24 +430,32 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     ols_rms = np.sqrt(np.mean(((tau - A @ ols.values).reshape(-1, dof)) ** 2, axis=0))
 
     solver = _Solver(robot, model, folder, options, labels, r, V, prior)
+    gram, rhs = Aw.T @ Aw, Aw.T @ bw
     selection = []
     lam = options.regularisation
     if lam is None:
         lam = 0.0
         if prior is not None and len(options.grid) > 1:
+            # Everything through Gram matrices: a fold's fit data are all data less the fold.
             if select:
                 Ys, Fs, ts = _design(model, select, labels, smoothing, tilt, lags)
-                folds = [(np.ones(Y.shape[0], dtype=bool), np.hstack([Ys, Fs]), ts)]
+                ws = np.tile(1.0 / sigma, Ys.shape[0] // dof)
+                As, bs = np.hstack([Ys, Fs]) * ws[:, None], ts * ws
+                folds = [((gram, rhs), (As.T @ As, As.T @ bs, float(bs @ bs), bs.size))]
             else:  # contiguous parts of every recording: each is held out once
                 part = np.concatenate([np.repeat(m, dof) for m in _folds(signals_list, options.folds)])
-                folds = [(part != k, A[part == k], tau[part == k]) for k in range(options.folds)]
+                folds = []
+                for k in range(options.folds):
+                    Ak, bk = Aw[part == k], bw[part == k]
+                    Gk, gk = Ak.T @ Ak, Ak.T @ bk
+                    folds.append(((gram - Gk, rhs - gk), (Gk, gk, float(bk @ bk), bk.size)))
             scores = np.zeros((len(folds), len(options.grid)))
-            for k, (fit_rows, As, bs) in enumerate(folds):
-                ws = np.tile(1.0 / sigma, As.shape[0] // dof)
+            for k, ((G_fit, g_fit), (Gk, gk, bbk, nk)) in enumerate(folds):
                 for i, candidate in enumerate(options.grid):
                     # the problem is convex: one restart finds its minimum (the final fit uses more)
-                    pi, f, _, _ = solver.solve(Aw[fit_rows], bw[fit_rows], candidate, restarts=1)
-                    scores[k, i] = float(np.mean(((bs - As @ np.concatenate([pi, f])) * ws) ** 2))
+                    pi, f, _, _ = solver.solve(G_fit, g_fit, candidate, restarts=1)
+                    x = np.concatenate([pi, f])
+                    scores[k, i] = (bbk - 2 * x @ gk + x @ Gk @ x) / nk
             mean = scores.mean(axis=0)
             best = int(np.argmin(mean))
             chosen = best
@@ -460,7 +468,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
                 chosen = max(i for i in range(len(mean)) if mean[i] <= mean[best] + se)
             selection = [(float(c), float(m)) for c, m in zip(options.grid, mean)]
             lam = float(options.grid[chosen])
-    pi, f_nat, rounds, result = solver.solve(Aw, bw, lam)
+    pi, f_nat, rounds, result = solver.solve(gram, rhs, lam)
     friction = {k: np.full(dof, np.nan) for k in FRICTION_KINDS}
     friction["tilt"] = np.zeros(2)
     for kind in kinds:
