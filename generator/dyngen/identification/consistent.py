@@ -186,31 +186,56 @@ def _design(model, signals_list, labels, smoothing, tilt=None, lags=None):
     return np.vstack(Ys), np.vstack(Fs), np.concatenate(taus)
 
 
-def _choose_smoothing(model, signals_list, labels, dof) -> np.ndarray:
+class _Columns:
+    """The unconstrained fit for many variants of the friction columns, fast: the regressor's
+    Gram matrix is formed once, and a friction column of joint j only meets joint j's rows."""
+
+    def __init__(self, model, signals_list, dof):
+        self.signals, self.dof = signals_list, dof
+        self.Y3 = np.concatenate([model.batch("regressor", s.q, s.qd, s.qdd) for s in signals_list])  # (T, N, r)
+        self.tau = np.vstack([np.asarray(s.tau) for s in signals_list])  # (T, N)
+        Y = self.Y3.reshape(-1, self.Y3.shape[2])
+        self.GY, self.gY = Y.T @ Y, Y.T @ self.tau.reshape(-1)
+
+    def residual_ms(self, labels, smoothing, lags=None) -> np.ndarray:
+        """Per joint, the mean square residual of the least squares with these friction columns."""
+        F = np.vstack([_friction_matrix(s, labels, smoothing, lags) for s in self.signals])
+        F3 = F.reshape(self.Y3.shape[0], self.dof, -1)
+        r, k = self.GY.shape[0], F.shape[1]
+        G = np.zeros((r + k, r + k))
+        g = np.zeros(r + k)
+        G[:r, :r], g[:r] = self.GY, self.gY
+        for j in range(self.dof):
+            cols = np.flatnonzero(np.any(F3[:, j, :] != 0, axis=0))
+            c = F3[:, j, cols]
+            G[:r, r + cols] += self.Y3[:, j, :].T @ c
+            G[np.ix_(r + cols, r + cols)] += c.T @ c
+            g[r + cols] += c.T @ self.tau[:, j]
+        G[r:, :r] = G[:r, r:].T
+        scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
+        ev, V = np.linalg.eigh(G / np.outer(scale, scale))
+        keep = ev > WEAK ** 2 * ev[-1]
+        x = (V[:, keep] @ ((V[:, keep].T @ (g / scale)) / ev[keep])) / scale
+        pred = self.Y3 @ x[:r] + F3 @ x[r:]
+        return np.mean((self.tau - pred) ** 2, axis=0)
+
+
+def _choose_smoothing(columns, labels, dof) -> np.ndarray:
     """Per joint, the vs of SMOOTHING_GRID whose unconstrained fit leaves joint j the least residual."""
     best, choice = np.full(dof, np.inf), np.full(dof, 0.02)
-    Y = np.vstack([model.batch("regressor", s.q, s.qd, s.qdd).reshape(s.q.shape[0] * dof, -1) for s in signals_list])
-    tau = np.concatenate([np.asarray(s.tau).reshape(-1) for s in signals_list])
     for vs in SMOOTHING_GRID:
-        F = np.vstack([_friction_matrix(s, labels, np.full(dof, vs)) for s in signals_list])
-        A = np.hstack([Y, F])
-        x = _least_squares(A, tau)
-        ms = np.mean(((tau - A @ x).reshape(-1, dof)) ** 2, axis=0)
+        ms = columns.residual_ms(labels, np.full(dof, vs))
         better = ms < best
         best[better], choice[better] = ms[better], vs
     return choice
 
 
-def _choose_lag(model, signals_list, labels, smoothing, dof) -> np.ndarray:
+def _choose_lag(columns, labels, smoothing, dof) -> np.ndarray:
     """Per joint, the lag of LAG_GRID of the Coulomb term whose unconstrained fit leaves joint j
     the least residual (like the smoothing, on the fit data)."""
     best, choice = np.full(dof, np.inf), np.zeros(dof)
-    Y = np.vstack([model.batch("regressor", s.q, s.qd, s.qdd).reshape(s.q.shape[0] * dof, -1) for s in signals_list])
-    tau = np.concatenate([np.asarray(s.tau).reshape(-1) for s in signals_list])
     for lag in LAG_GRID:
-        F = np.vstack([_friction_matrix(s, labels, smoothing, np.full(dof, lag)) for s in signals_list])
-        A = np.hstack([Y, F])
-        ms = np.mean(((tau - A @ _least_squares(A, tau)).reshape(-1, dof)) ** 2, axis=0)
+        ms = columns.residual_ms(labels, smoothing, np.full(dof, lag))
         better = ms < best * (1 - 1e-3)  # a lag must earn its place
         best[better], choice[better] = ms[better], lag
     return choice
@@ -388,9 +413,10 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     kinds = tuple(k for k in FRICTION_KINDS if k in wanted)
     armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
     labels = _labels(kinds, armature_ok, dof)
-    smoothing = (np.full(dof, float(options.smoothing)) if options.smoothing
-                 else _choose_smoothing(model, signals_list, labels, dof))
-    lags = (_choose_lag(model, signals_list, labels, smoothing, dof) if options.friction_lag and "coulomb" in kinds
+    columns = _Columns(model, signals_list, dof) if "coulomb" in kinds else None
+    smoothing = (np.full(dof, float(options.smoothing)) if options.smoothing or columns is None
+                 else _choose_smoothing(columns, labels, dof))
+    lags = (_choose_lag(columns, labels, smoothing, dof) if options.friction_lag and columns is not None
             else np.zeros(dof))
     V = velocity_limits(robot, signals_list)
     prior = options.prior
