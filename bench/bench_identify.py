@@ -117,8 +117,15 @@ def synthetic(seconds=30.0, rate=1000.0):
     from dyngen.data.recording import Recording
     from dyngen.excitation import Settings, random_design
 
+    import tempfile
+
+    # the LWR without the paper's bounds (the random true parameters lie outside them), so that the
+    # barrier and the SDP solve the same problem (the SDP cannot hold bounds on I about the CoM)
     text = (ROOT / "examples" / "lwr.yaml").read_text()
-    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    text = text[:text.index("  bounds:")] + text[text.index("identified:"):]
+    path = Path(tempfile.mkdtemp()) / "lwr_synthetic.yaml"
+    path.write_text(text[:text.index("identified:")])
+    robot = load_robot(path)
     p = random_parameters(7, 5, mass=(0.5, 3.0), second_moment=(0.002, 0.02))
     effects = Effects(coulomb={j: 0.3 + 0.1 * j for j in range(1, 8)}, viscous={j: 0.2 + 0.05 * j for j in range(1, 8)},
                       armature={j: 0.02 * j for j in range(3, 8)})
@@ -127,7 +134,6 @@ def synthetic(seconds=30.0, rate=1000.0):
     step = 2 * np.pi / 2 ** 20
     q = np.round((m.q + 1e-5 * np.random.default_rng(2).standard_normal(m.q.shape)) / step) * step
     s = condition(Recording("synthetic", t, q, None), Conditioning(cutoff=10.0, differentiate=True))
-    del text
     return robot, replace(s, tau=m.tau)
 
 
