@@ -366,7 +366,10 @@ class _Solver:
             v = np.linalg.solve(Ls, h)
             stage = Stage("identify", [Target("full", W, v)], np.ones(self.problem.lower.size, dtype=bool),
                           self.problem.reference.copy())
-            opts = self.extract_options if restarts is None else replace(self.extract_options, restarts=restarts)
+            # cross-validation solves need the fit only: one restart (the problem is convex) and few
+            # evaluations for the driver's nearest-to-prior step, which does not change the fit
+            opts = self.extract_options if restarts is None else replace(self.extract_options, restarts=restarts,
+                                                                            local_maxeval=150)
             result = driver.run(self.exe, self.problem, stage, opts)
             if result.status != "ok":
                 raise RuntimeError("consistent identification: no parameters satisfy the bounds and total mass")
