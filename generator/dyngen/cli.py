@@ -27,6 +27,7 @@ dyngen: robot dynamic models as exact, standalone C from a DH table.
                                        base coefficients by least squares from recordings
   dyngen diagnose ROBOT.yaml --params P.yaml --data a.csv [--test b.csv]
                                        where the measured-model gap lies and which effect explains it
+  dyngen excite ROBOT.yaml [-o CSV]    an optimised excitation trajectory within the joint limits
 
 Run `dyngen COMMAND --help` for a command's options. The YAML schema and the parameter
 conventions are in docs/conventions.md; examples/ has the KUKA LWR IV+ and other arms.
@@ -175,7 +176,8 @@ def _write_extraction(args, robot, folder, extraction, options, seconds, compare
         columns = {compare[0]: compare[1], **columns}
     residual_rows = report.residual_comparison(robot, extraction, columns, folder)
     table = report.consistency_table(columns)
-    write_file(out / "consistency.md", table + "\n")
+    warnings = "".join(f"**{line}**\n\n" for line in report.unreachable(robot, extraction))
+    write_file(out / "consistency.md", warnings + table + "\n")
     exported = []
     if not robot.gravity_symbols:  # simulators need a numeric gravity
         from .export import write_all
@@ -258,7 +260,14 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     return run(argv, prog)
 
 
-COMMANDS = {"generate": cmd_generate, "extract": cmd_extract, "identify": cmd_identify, "diagnose": cmd_diagnose}
+def cmd_excite(argv, prog="dyngen excite") -> int:
+    from .excitation.command import cmd_excite as run
+
+    return run(argv, prog)
+
+
+COMMANDS = {"generate": cmd_generate, "extract": cmd_extract, "identify": cmd_identify, "diagnose": cmd_diagnose,
+            "excite": cmd_excite}
 
 
 def main(argv=None) -> int:
