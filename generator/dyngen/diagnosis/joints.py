@@ -10,6 +10,10 @@ are fitted on the fit samples and compared on the selection samples:
              were each chosen for a large gain may still lack an offset or a plain friction
              term that none of them covers.
 
+  consistent the link parameters re-identified, physically consistent, with their own friction
+             (reidentify.py), where they were computed: it must gain `min_gain` of the mean
+             square over the best of the three others on the joint's selection data.
+
 The effects stay unless another model does better on the selection data, where the model with
 more values on the joint must gain `min_gain` of the mean square per extra value (what an
 effect must gain to be selected at all), so that three numbers fitting noise do not replace a
@@ -24,7 +28,7 @@ import numpy as np
 from . import baseline
 from . import design as dz
 
-EFFECTS, SIMPLE, COMPLETED = "effects", "simple", "effects + simple"
+EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple", "consistent parameters"
 
 
 def _split(chosen, x):
@@ -67,15 +71,16 @@ def _completed_predict(context, chosen, x, values, seg, j):
     return arm + np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]]) @ values
 
 
-def decide(context, segments, chosen, x, simple, min_gain: float) -> list[str]:
-    """Per joint EFFECTS, SIMPLE or COMPLETED; seg.correction holds the effects' torques."""
+def decide(context, segments, chosen, x, simple, min_gain: float, consistent=None) -> list[str]:
+    """Per joint EFFECTS, SIMPLE, COMPLETED or (given consistent: per segment its corrections
+    (T, N)) CONSISTENT; seg.correction holds the effects' torques."""
     n = segments[0].residual.shape[1]
     modes = []
     for j in range(n):
         acting = any(c.joint is None or c.joint == j for c in chosen)
         values = _completed_fit(context, chosen, x, segments, j) if acting else None
-        sse = {EFFECTS: 0.0, SIMPLE: 0.0, COMPLETED: 0.0}
-        for seg in segments:
+        sse = {EFFECTS: 0.0, SIMPLE: 0.0, COMPLETED: 0.0, CONSISTENT: 0.0}
+        for i, seg in enumerate(segments):
             m = seg.select
             if not m.any():
                 continue
@@ -84,12 +89,16 @@ def decide(context, segments, chosen, x, simple, min_gain: float) -> list[str]:
             sse[SIMPLE] += float(np.sum((r - baseline.predict(simple, seg)[m, j]) ** 2))
             if acting:
                 sse[COMPLETED] += float(np.sum((r - _completed_predict(context, chosen, x, values, seg, j)[m]) ** 2))
+            if consistent is not None:
+                sse[CONSISTENT] += float(np.sum((r - consistent[i][m, j]) ** 2))
         own = sum(c.size for c in chosen if c.joint == j)  # values of the effects on this joint
         size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES)}
         best = EFFECTS
         for other in (SIMPLE, COMPLETED) if acting else (SIMPLE,):
             if _better(sse[other], size[other], sse[best], size[best], min_gain):
                 best = other
+        if consistent is not None and sse[CONSISTENT] < (1 - min_gain) * sse[best]:
+            best = CONSISTENT
         modes.append(best)
     return modes
 
@@ -103,12 +112,16 @@ def _better(sse, size, best_sse, best_size, min_gain) -> bool:
     return sse <= best_sse / (1 - min_gain) ** (best_size - size)
 
 
-def apply(context, segments, chosen, x, simple, modes) -> dict:
-    """Set seg.correction per joint by its mode (the effects' torques already there);
-    returns {joint (1-based): values of the completed model} for the report."""
+def apply(context, segments, chosen, x, simple, modes, consistent=None) -> dict:
+    """Set seg.correction per joint by its mode (the effects' torques already there; consistent:
+    per segment the consistent model's corrections); returns {joint (1-based): values of the
+    completed model} for the report."""
     completed = {}
     for j, mode in enumerate(modes):
-        if mode == SIMPLE:
+        if mode == CONSISTENT:
+            for seg, c in zip(segments, consistent):
+                seg.correction[:, j] = c[:, j]
+        elif mode == SIMPLE:
             for seg in segments:
                 seg.correction[:, j] = baseline.predict(simple, seg)[:, j]
         elif mode == COMPLETED:

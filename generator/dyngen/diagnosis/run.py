@@ -15,7 +15,7 @@ import numpy as np
 
 from . import baseline as simple_model
 from . import design as dz
-from . import joints, phases, roles
+from . import joints, phases, reidentify, roles
 from .correlation import integrated_time
 from .effects import Context, library
 from .refine import refine, restricted
@@ -33,6 +33,7 @@ class Options:
     alpha: float = ALPHA
     sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd) (Stribeck, direction)
     block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
+    reidentify: bool = True  # consistent link parameters as a per-joint alternative (reidentify.py)
 
 
 @dataclass
@@ -66,6 +67,8 @@ class Diagnosis:
     completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
     conditioning: list = field(default_factory=list)  # per recording: what was done to it
     segments: list = field(default_factory=list)  # roles.Segment, for figures
+    consistent: dict | None = None  # "link parameters off": reidentify.finding, where the consistent model won
+    reidentified: object = None  # its identification.consistent.Consistent (for the written parameters)
 
 
 @dataclass
@@ -164,7 +167,12 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     sel_simple = _simple_mse(segments, simple, "select", n)
     modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain) if design.select.count \
         else [joints.EFFECTS] * n
+    reid, consistent = None, None
+    if options.reidentify and design.select.count:
+        reid, consistent, modes = _reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
+                                                options.min_gain)
     wins = [j for j in range(n) if modes[j] == joints.SIMPLE]
+    replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
     described = [_describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
     # The choice made, every sample of the fit recordings sets the values (selection blocks
     # included; separate selection recordings stay out of it, as test recordings do).
@@ -175,6 +183,10 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         if chosen:
             design, chosen = restricted(context, segments, design, chosen)
             final = solve(design, chosen)
+        if reid is not None:  # refitted on every fit sample, its regularisation as chosen
+            reid = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
+                                       regularisation=reid.regularisation)
+            consistent = reidentify.corrections(reid, model, segments)
     tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
     _values(described, design, chosen, final, tau_corr, robot)
     judged = "test" if design.test.count else "selection"
@@ -182,7 +194,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     before = judged_moments.c / max(judged_moments.count, 1)
     effects_mse = judged_moments.mse(final.slots, final.x) if chosen else before.copy()
     simple_mse = _simple_mse(segments, simple, judged, n)
-    completed = joints.apply(context, segments, chosen, final.x, simple, modes)
+    completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
     mask = (lambda seg: seg.test) if judged == "test" else (lambda seg: seg.select)
     used = [seg for seg in segments if mask(seg).any()]
     held_before = np.vstack([seg.residual[mask(seg)] for seg in used])
@@ -199,10 +211,10 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     noise = np.std(np.diff(held_after, axis=0), axis=0) / np.sqrt(2)
     selected, superseded = [], []
     for c, e in zip(chosen, described):
-        if c.joint is not None and c.joint in wins:
+        if c.joint is not None and c.joint in replaced:
             superseded.append(e)
             continue
-        e["joints"] = [j for j in e["joints"] if j - 1 not in wins]
+        e["joints"] = [j for j in e["joints"] if j - 1 not in replaced]
         selected.append(e)
     candidates = [{"candidate": k, "selection_gain": g} for k, g in
                   sorted(selection.first_gains.items(), key=lambda kv: -kv[1])]
@@ -213,11 +225,33 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         selection.steps, dropped, refused, superseded, tau_corr, segments=segments)
     result.joint_models = modes
     result.completed = completed
+    if reid is not None:
+        result.consistent = reidentify.finding(robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT])
+        result.reidentified = reid
     result.conditioning = [{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
                            for role, group in (("fit", fit_signals), ("select", select_signals or []),
                                                ("test", test or [])) for sig in group]
     result.warnings = _warnings(result, model, s, fit_signals, select_signals or [], test or [], used)
     return result
+
+
+def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):
+    """(Consistent result, its corrections per segment, modes) where the consistent link
+    parameters win a joint on selection data, else (None, None, modes) (reidentify.py)."""
+    effects = [seg.correction.copy() for seg in segments]
+    joints.apply(context, segments, chosen, x, simple, modes)  # the per-joint models, fit-only values
+    remaining = [seg.residual - seg.correction for seg in segments]
+    for seg, c in zip(segments, effects):
+        seg.correction = c
+    if not reidentify.gate(robot, model, p, segments, remaining, min_gain):
+        return None, None, modes
+    result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
+                                 reidentify.pieces(segments, "select"))
+    consistent = reidentify.corrections(result, model, segments)
+    new = joints.decide(context, segments, chosen, x, simple, min_gain, consistent)
+    if joints.CONSISTENT not in new:
+        return None, None, modes
+    return result, consistent, new
 
 
 def _plausible(design, chosen):
@@ -322,6 +356,13 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
     for r in d.refused:
         out.append(f"{r['candidate']}: refused, its fitted values are not physically possible "
                    f"({', '.join(f'{v:.3g}' for v in r['values'][:4])})")
+    if d.consistent:
+        c = d.consistent
+        out.append("link parameters off: on joint(s) " + ", ".join(map(str, c["joints"])) + " physically consistent "
+                   "link parameters re-identified from the fit data (with friction, offsets, rotor inertia and a "
+                   f"tilted base; regularised toward the given parameters with weight {c['regularisation']:g}, chosen "
+                   "on selection data) did better than every effect and the simple model on selection data, and "
+                   "are used there; they are written out (consistent/)")
     if d.simple_wins:
         out.append("on joint(s) " + ", ".join(map(str, d.simple_wins)) + " the simple model (offset + Coulomb + viscous) "
                    "did better than the selected effects on selection data and is kept there")

@@ -1,0 +1,123 @@
+"""The link parameters re-identified, physically consistent, as a per-joint alternative model.
+
+A diagnosis explains the residual with named effects; when the link parameters themselves are
+off (masses, centres of mass, inertias), no effect of the library covers it, and the
+unconstrained "errors in every base coefficient" over-fits. Here the consistent identification
+with friction (identification/consistent.py: every link's pseudo-inertia positive definite,
+friction that opposes motion, a tilted base, regularised toward the diagnosed parameters) is
+the alternative, with the three roles of data kept:
+
+  gate    cheap: the residual the per-joint models leave on the fit samples, regressed on the
+          rigid body's base columns and a tilted base's two columns (unconstrained); if that
+          gains nothing on any joint's selection samples, the parameters are not shown to be
+          off, and nothing more is done (a residual that is noise, as with every effect found,
+          never gains);
+  fit     consistent identification on the fit samples, decimated to about RATE Hz, with the
+          regularisation toward the diagnosed parameters chosen from GRID on the selection
+          samples (one restart: the problem is convex);
+  select  per joint, the consistent model wins only where it beats the best other model on the
+          selection samples by `min_gain` of the mean square (joints.py);
+  refit   on every fit sample (the selection blocks included, as the effects are), with the
+          chosen regularisation.
+
+Test data are never seen here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+RATE = 200.0  # Hz: samples used by the re-identification (the motion's band is far below)
+GRID = (0.3, 3.0)  # regularisation toward the diagnosed parameters, chosen on selection data
+FRICTION = ("coulomb", "viscous", "offset", "armature", "ripple")
+
+
+def pieces(segments, role: str) -> list:
+    """Conditioned signals of every contiguous run of `role` samples, decimated to ~RATE Hz."""
+    out = []
+    for seg in segments:
+        sig, mask = seg.signals, getattr(seg, role)
+        idx = np.flatnonzero(mask)
+        if not idx.size:
+            continue
+        step = max(1, int(round(sig.rate / RATE)))
+        breaks = np.flatnonzero(np.diff(idx) > 1)
+        for a, b in zip(np.r_[0, breaks + 1], np.r_[breaks, idx.size - 1]):
+            k = np.arange(idx[a], idx[b] + 1, step)
+            if k.size < 20:
+                continue
+            out.append(dataclasses.replace(sig, t=sig.t[k], q=sig.q[k], qd=sig.qd[k], qdd=sig.qdd[k], tau=sig.tau[k],
+                                           trim=0, extra={}))
+    return out
+
+
+def _gate_columns(robot, model, p, seg, k):
+    from ..identification.tilt import tilt_columns
+
+    sig = seg.signals
+    Y = model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
+    return np.concatenate([Y, tilt_columns(robot, p, sig.q[k])], axis=2)
+
+
+def gate(robot, model, p, segments, remaining, min_gain: float) -> list[int]:
+    """Joints (0-based) on whose selection samples the unconstrained fit of the rigid body's
+    base columns and a tilt to `remaining` (per segment, the residual left by the per-joint
+    models) gains at least `min_gain` of the mean square."""
+    G = g = None
+    sel = []
+    for seg, rest in zip(segments, remaining):
+        step = max(1, int(round(seg.signals.rate / RATE)))
+        for role in ("fit", "select"):
+            k = np.flatnonzero(getattr(seg, role))[::step]
+            if not k.size:
+                continue
+            A, r = _gate_columns(robot, model, p, seg, k), rest[k]
+            if role == "fit":
+                A2 = A.reshape(-1, A.shape[2])
+                G = A2.T @ A2 if G is None else G + A2.T @ A2
+                g = A2.T @ r.reshape(-1) if g is None else g + A2.T @ r.reshape(-1)
+            else:
+                sel.append((A, r))
+    if G is None or not sel:
+        return []
+    scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
+    ev, V = np.linalg.eigh(G / np.outer(scale, scale))
+    keep = ev > 1e-10 * ev[-1]
+    x = (V[:, keep] @ ((V[:, keep].T @ (g / scale)) / ev[keep])) / scale
+    before = sum(np.sum(r ** 2, axis=0) for _, r in sel)
+    after = sum(np.sum((r - A @ x) ** 2, axis=0) for A, r in sel)
+    return [j for j in range(before.size) if after[j] < (1 - min_gain) * before[j]]
+
+
+def identify(robot, model, p, fit_pieces, select_pieces=None, regularisation=None):
+    """The consistent identification (regularised toward p) on decimated pieces."""
+    from ..identification.consistent import ConsistentOptions, identify_consistent
+
+    options = ConsistentOptions(friction=FRICTION, prior=np.asarray(p, dtype=float), tilt=True, restarts=1,
+                                grid=GRID, regularisation=regularisation)
+    return identify_consistent(robot, model, model.folder, fit_pieces, options, select=select_pieces)
+
+
+def corrections(result, model, segments) -> list:
+    """Per segment (T, N): the consistent model's torque less the diagnosed model's."""
+    return [result.predict(model, seg.signals) - seg.tau_model for seg in segments]
+
+
+def finding(robot, result, joints: list) -> dict:
+    """The report's entry: joints where the consistent parameters won, and the parameters."""
+    from ..parameters import PER_LINK
+
+    links = np.asarray(result.p).reshape(-1, PER_LINK)
+    f = {k: [None if not np.isfinite(x) else float(x) for x in np.atleast_1d(v)] for k, v in result.friction.items()}
+    return {
+        "joints": [j + 1 for j in joints],
+        "regularisation": result.regularisation,
+        "selection": [{"regularisation": a, "selection_weighted_ms": b} for a, b in result.selection],
+        "link_parameters": [row.tolist() for row in links],
+        "friction": f, "smoothing": result.smoothing.tolist(),
+        "lambda_min": result.lambda_min.tolist(), "at_bounds": list(result.at_bounds),
+        "dropped_columns": list(result.dropped_columns),
+        "fit_rms": result.residual_rms.tolist(),
+    }
