@@ -21,7 +21,8 @@ def to_json(d, sources: dict) -> str:
         "peak_before": d.peak_before, "noise_rms": d.noise_rms, "correlation_samples": d.correlation_samples,
         "selected": d.selected, "superseded": d.superseded, "refused": d.refused, "where": d.where,
         "candidates": d.candidates, "steps": d.steps, "dropped": d.dropped, "warnings": d.warnings,
-        "recordings": d.conditioning,
+        "recordings": d.conditioning, "joint_models": d.joint_models,
+        "link_parameters_off": d.consistent,
     }
     return json.dumps(_plain(doc), indent=1) + "\n"
 
@@ -141,6 +142,23 @@ def markdown(d, sources: dict) -> str:
                   + ".", ""]
     if d.dropped:
         lines += [f"Selected at first, then dropped as not significant: {', '.join(d.dropped)}.", ""]
+    if d.consistent:
+        c = d.consistent
+        lines += ["## Link parameters off", "",
+                  f"On joint(s) {', '.join(map(str, c['joints']))}, physically consistent link parameters "
+                  "re-identified from the fit data (every link's pseudo-inertia positive definite; with per-joint "
+                  "Coulomb, viscous, offset, rotor inertia, position ripple and a tilted base; regularised toward the "
+                  f"given parameters with weight {c['regularisation']:g}, chosen on selection data from "
+                  + ", ".join(f"{s['regularisation']:g}" for s in c["selection"])
+                  + ") did better than every effect and the simple model on selection data, and are used there. "
+                  "The parameters are in consistent/identified.yaml (URDF and MJCF beside it).", ""]
+        if d.reidentified is not None:
+            from types import SimpleNamespace
+
+            from ..identification.consistent_output import summary_lines as consistent_summary
+
+            lines += ["```"] + consistent_summary(SimpleNamespace(name=d.robot, dof=d.joints), d.reidentified) \
+                + ["```", ""]
     lines += ["## Candidates tried alone (selection gain)", "",
               ", ".join(f"{c['candidate']} {c['selection_gain']:+.3f}" for c in d.candidates[:15]), ""]
     return "\n".join(lines)
@@ -157,5 +175,8 @@ def summary_lines(d) -> list[str]:
     for e in d.selected:
         joints = ",".join(map(str, e["joints"])) or "-"
         out.append(f"  {e['effect']:<12} joints {joints:<14} gain {e['selection_gain']:.3f}  {_value_text(e)}")
+    if d.consistent:
+        out.append(f"  link parameters off: consistent re-identified parameters used on joint(s) "
+                   f"{', '.join(map(str, d.consistent['joints']))} (consistent/identified.yaml)")
     out += [f"  warning: {w}" for w in d.warnings]
     return out
