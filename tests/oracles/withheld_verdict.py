@@ -88,6 +88,11 @@ def problems(truth: list[dict], d: dict, noise, p_model=None) -> list[str]:
         out.append(f"{name} injected, not found")
     for name in sorted(set(arm) - expected_arm):
         out.append(f"{name} claimed, not injected")
+    # The re-identified consistent link parameters (diagnosis/reidentify.py) claim that the link
+    # parameters are off: only where they were.
+    off = d.get("link_parameters_off")
+    if off and not any(e["effect"] == "coefficients" for e in truth):
+        out.append(f"link parameters off claimed (joints {off['joints']}), not injected")
     # Where the nominal residual stood above this bound, the effects must bring it down to it
     # (joints already at the noise may move by a hair either way: fitted values carry noise).
     bound = np.broadcast_to(np.asarray(noise, dtype=float), (len(d["rms_after"]),))

@@ -17,8 +17,10 @@ the alternative, with the three roles of data kept:
           samples (one restart: the problem is convex);
   select  per joint, the consistent model wins only where it beats the best other model on the
           selection samples by `min_gain` of the mean square (joints.py);
-  refit   on every fit sample (the selection blocks included, as the effects are), with the
-          chosen regularisation.
+  kept    as fitted on the fit samples: unlike the effects, it is not refitted with the
+          selection blocks added. (Refitted so, on the withheld "coefficients" case at 500 Hz,
+          the barrier solve of identify_consistent pinned m2 at its bound and left 0.19 Nm on
+          joint 2 where the fit on the fit blocks alone left 0.02: not understood yet.)
 
 Test data are never seen here.
 """
@@ -31,6 +33,7 @@ import numpy as np
 
 RATE = 200.0  # Hz: samples used by the re-identification (the motion's band is far below)
 GRID = (0.3, 3.0)  # regularisation toward the diagnosed parameters, chosen on selection data
+RESTARTS = 2  # of the final solve (the held-out choice of the regularisation uses one)
 FRICTION = ("coulomb", "viscous", "offset", "armature", "ripple")
 
 
@@ -95,7 +98,7 @@ def identify(robot, model, p, fit_pieces, select_pieces=None, regularisation=Non
     """The consistent identification (regularised toward p) on decimated pieces."""
     from ..identification.consistent import ConsistentOptions, identify_consistent
 
-    options = ConsistentOptions(friction=FRICTION, prior=np.asarray(p, dtype=float), tilt=True, restarts=1,
+    options = ConsistentOptions(friction=FRICTION, prior=np.asarray(p, dtype=float), tilt=True, restarts=RESTARTS,
                                 grid=GRID, regularisation=regularisation)
     return identify_consistent(robot, model, model.folder, fit_pieces, options, select=select_pieces)
 

@@ -183,10 +183,6 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         if chosen:
             design, chosen = restricted(context, segments, design, chosen)
             final = solve(design, chosen)
-        if reid is not None:  # refitted on every fit sample, its regularisation as chosen
-            reid = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
-                                       regularisation=reid.regularisation)
-            consistent = reidentify.corrections(reid, model, segments)
     tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
     _values(described, design, chosen, final, tau_corr, robot)
     judged = "test" if design.test.count else "selection"
