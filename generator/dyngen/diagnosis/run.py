@@ -183,6 +183,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         if chosen:
             design, chosen = restricted(context, segments, design, chosen)
             final = solve(design, chosen)
+        if reid is not None:
+            reid, consistent = _refit(robot, model, p, segments, reid, consistent)
     tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
     _values(described, design, chosen, final, tau_corr, robot)
     judged = "test" if design.test.count else "selection"
@@ -248,6 +250,16 @@ def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, 
     if joints.CONSISTENT not in new:
         return None, None, modes
     return result, consistent, new
+
+
+def _refit(robot, model, p, segments, reid, consistent):
+    """The consistent model refitted on every fit sample (selection blocks included), its
+    regularisation as chosen; kept only if it fits about as well as the model from the fit
+    blocks alone (reidentify.REFIT_WORSE), else that model stays."""
+    refit = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"), regularisation=reid.regularisation)
+    if np.all(refit.residual_rms <= reidentify.REFIT_WORSE * reid.residual_rms):
+        return refit, reidentify.corrections(refit, model, segments)
+    return reid, consistent
 
 
 def _plausible(design, chosen):
