@@ -11,8 +11,9 @@ are fitted on the fit samples and compared on the selection samples:
              term that none of them covers.
 
   consistent the link parameters re-identified, physically consistent, with their own friction
-             (reidentify.py), where they were computed: it must gain `min_gain` of the mean
-             square over the best of the three others on the joint's selection data.
+             (reidentify.py), where they were computed: counted as its per-joint values plus one
+             (reidentify.JOINT_VALUES), and it must gain at least `min_gain` of the mean square
+             over the best of the three others on the joint's selection data in any case.
 
 The effects stay unless another model does better on the selection data, where the model with
 more values on the joint must gain `min_gain` of the mean square per extra value (what an
@@ -71,9 +72,11 @@ def _completed_predict(context, chosen, x, values, seg, j):
     return arm + np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]]) @ values
 
 
-def decide(context, segments, chosen, x, simple, min_gain: float, consistent=None) -> list[str]:
+def decide(context, segments, chosen, x, simple, min_gain: float, consistent=None, consistent_values: int = 0) \
+        -> list[str]:
     """Per joint EFFECTS, SIMPLE, COMPLETED or (given consistent: per segment its corrections
-    (T, N)) CONSISTENT; seg.correction holds the effects' torques."""
+    (T, N), with consistent_values values counted per joint) CONSISTENT; seg.correction holds
+    the effects' torques."""
     n = segments[0].residual.shape[1]
     modes = []
     for j in range(n):
@@ -97,7 +100,8 @@ def decide(context, segments, chosen, x, simple, min_gain: float, consistent=Non
         for other in (SIMPLE, COMPLETED) if acting else (SIMPLE,):
             if _better(sse[other], size[other], sse[best], size[best], min_gain):
                 best = other
-        if consistent is not None and sse[CONSISTENT] < (1 - min_gain) * sse[best]:
+        if consistent is not None and _better(sse[CONSISTENT], consistent_values, sse[best], size[best], min_gain) \
+                and sse[CONSISTENT] < (1 - min_gain) * sse[best]:
             best = CONSISTENT
         modes.append(best)
     return modes

@@ -7,7 +7,7 @@ with friction (identification/consistent.py: every link's pseudo-inertia positiv
 friction that opposes motion, a tilted base, regularised toward the diagnosed parameters) is
 the alternative, with the three roles of data kept:
 
-  gate    cheap: the residual the per-joint models leave on the fit samples, regressed on the
+  gate    cheap: the residual the selected effects leave on the fit samples, regressed on the
           rigid body's base columns and a tilted base's two columns (unconstrained); if that
           gains nothing on any joint's selection samples, the parameters are not shown to be
           off, and nothing more is done (a residual that is noise, as with every effect found,
@@ -16,7 +16,8 @@ the alternative, with the three roles of data kept:
           regularisation toward the diagnosed parameters chosen from GRID on the selection
           samples (one restart: the problem is convex);
   select  per joint, the consistent model wins only where it beats the best other model on the
-          selection samples by `min_gain` of the mean square (joints.py);
+          selection samples as a model with JOINT_VALUES values must (joints.py): a joint at the
+          noise is not taken by six friction columns fitting it;
   refit   on every fit sample (the selection blocks included, as the effects are) with the
           chosen regularisation, kept only if its residual on its fit data is nowhere more than
           REFIT_WORSE times the first one's. (On the withheld "coefficients" case at 500 Hz, the
@@ -33,10 +34,12 @@ import dataclasses
 import numpy as np
 
 RATE = 200.0  # Hz: samples used by the re-identification (the motion's band is far below)
+GATE_RATE = 50.0  # Hz: samples used by the gate (a rough test; 0.1 s for 30 s of data)
 GRID = (0.3, 3.0)  # regularisation toward the diagnosed parameters, chosen on selection data
 REFIT_WORSE = 1.25  # the refit must fit its (larger) data about as well as the first fit did
 RESTARTS = 2  # of the final solve (the held-out choice of the regularisation uses one)
 FRICTION = ("coulomb", "viscous", "offset", "armature", "ripple")
+JOINT_VALUES = 7  # per joint: Fc, Fv, offset, Ia, two ripple values, and one for the shared link parameters
 
 
 def pieces(segments, role: str) -> list:
@@ -73,7 +76,7 @@ def gate(robot, model, p, segments, remaining, min_gain: float) -> list[int]:
     G = g = None
     sel = []
     for seg, rest in zip(segments, remaining):
-        step = max(1, int(round(seg.signals.rate / RATE)))
+        step = max(1, int(round(seg.signals.rate / GATE_RATE)))
         for role in ("fit", "select"):
             k = np.flatnonzero(getattr(seg, role))[::step]
             if not k.size:

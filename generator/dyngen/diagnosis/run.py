@@ -236,17 +236,13 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
 def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):
     """(Consistent result, its corrections per segment, modes) where the consistent link
     parameters win a joint on selection data, else (None, None, modes) (reidentify.py)."""
-    effects = [seg.correction.copy() for seg in segments]
-    joints.apply(context, segments, chosen, x, simple, modes)  # the per-joint models, fit-only values
-    remaining = [seg.residual - seg.correction for seg in segments]
-    for seg, c in zip(segments, effects):
-        seg.correction = c
+    remaining = [seg.residual - seg.correction for seg in segments]  # after the effects (fit-only values)
     if not reidentify.gate(robot, model, p, segments, remaining, min_gain):
         return None, None, modes
     result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
                                  reidentify.pieces(segments, "select"))
     consistent = reidentify.corrections(result, model, segments)
-    new = joints.decide(context, segments, chosen, x, simple, min_gain, consistent)
+    new = joints.decide(context, segments, chosen, x, simple, min_gain, consistent, reidentify.JOINT_VALUES)
     if joints.CONSISTENT not in new:
         return None, None, modes
     return result, consistent, new
