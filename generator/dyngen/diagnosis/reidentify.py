@@ -8,16 +8,16 @@ friction that opposes motion, a tilted base, regularised toward the diagnosed pa
 the alternative, with the three roles of data kept:
 
   gate    cheap: the residual the selected effects leave on the fit samples, regressed on the
-          rigid body's base columns and a tilted base's two columns (unconstrained); if that
-          gains nothing on any joint's selection samples, the parameters are not shown to be
-          off, and nothing more is done (a residual that is noise, as with every effect found,
-          never gains);
+          rigid body's base columns (unconstrained, at GATE_RATE); the joints where that gains
+          `min_gain` of the mean square on the selection samples are those whose residual the
+          link parameters explain; none, and nothing more is done (a residual that is noise, as
+          with every effect found, never gains; a tilt the effects left is not the links');
   fit     consistent identification on the fit samples, decimated to about RATE Hz, with the
           regularisation toward the diagnosed parameters chosen from GRID on the selection
           samples (one restart: the problem is convex);
-  select  per joint, the consistent model wins only where it beats the best other model on the
-          selection samples as a model with JOINT_VALUES values must (joints.py): a joint at the
-          noise is not taken by six friction columns fitting it;
+  select  per joint, on the gate's joints only, the consistent model wins where it beats the
+          best other model on the selection samples as a model with JOINT_VALUES values must
+          (joints.py): a joint at the noise is not taken by six friction columns fitting it;
   refit   on every fit sample (the selection blocks included, as the effects are) with the
           chosen regularisation, kept only if its residual on its fit data is nowhere more than
           REFIT_WORSE times the first one's. (On the withheld "coefficients" case at 500 Hz, the
@@ -61,17 +61,14 @@ def pieces(segments, role: str) -> list:
     return out
 
 
-def _gate_columns(robot, model, p, seg, k):
-    from ..identification.tilt import tilt_columns
-
+def _gate_columns(model, seg, k):
     sig = seg.signals
-    Y = model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
-    return np.concatenate([Y, tilt_columns(robot, p, sig.q[k])], axis=2)
+    return model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
 
 
-def gate(robot, model, p, segments, remaining, min_gain: float) -> list[int]:
+def gate(model, segments, remaining, min_gain: float) -> list[int]:
     """Joints (0-based) on whose selection samples the unconstrained fit of the rigid body's
-    base columns and a tilt to `remaining` (per segment, the residual left by the per-joint
+    base columns to `remaining` (per segment, the residual left by the per-joint
     models) gains at least `min_gain` of the mean square."""
     G = g = None
     sel = []
@@ -81,7 +78,7 @@ def gate(robot, model, p, segments, remaining, min_gain: float) -> list[int]:
             k = np.flatnonzero(getattr(seg, role))[::step]
             if not k.size:
                 continue
-            A, r = _gate_columns(robot, model, p, seg, k), rest[k]
+            A, r = _gate_columns(model, seg, k), rest[k]
             if role == "fit":
                 A2 = A.reshape(-1, A.shape[2])
                 G = A2.T @ A2 if G is None else G + A2.T @ A2

@@ -237,12 +237,15 @@ def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, 
     """(Consistent result, its corrections per segment, modes) where the consistent link
     parameters win a joint on selection data, else (None, None, modes) (reidentify.py)."""
     remaining = [seg.residual - seg.correction for seg in segments]  # after the effects (fit-only values)
-    if not reidentify.gate(robot, model, p, segments, remaining, min_gain):
+    flagged = reidentify.gate(model, segments, remaining, min_gain)
+    if not flagged:
         return None, None, modes
     result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
                                  reidentify.pieces(segments, "select"))
     consistent = reidentify.corrections(result, model, segments)
     new = joints.decide(context, segments, chosen, x, simple, min_gain, consistent, reidentify.JOINT_VALUES)
+    # only on joints whose residual the link parameters were shown to explain (the gate)
+    new = [m if m != joints.CONSISTENT or j in flagged else old for j, (m, old) in enumerate(zip(new, modes))]
     if joints.CONSISTENT not in new:
         return None, None, modes
     return result, consistent, new
