@@ -174,6 +174,11 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     parser.add_argument("--sign-velocity", type=real(0, 1e3, above=True), default=0.002, metavar="V",
                         help="sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V) "
                              "(default 0.002 rad/s; Coulomb's own scale is fitted)")
+    parser.add_argument("--reidentify", action="store_true",
+                        help="also re-identify physically consistent link parameters (with friction and a tilted "
+                             "base) from the fit data, and use them on the joints where they beat every effect and the "
+                             "simple model on selection data; says 'link parameters off' and writes them to "
+                             "consistent/ (experimental: see README)")
     args = parser.parse_args(argv)
     from .data import condition, read_recording
     from .data.split import parse_fractions, split_recording
@@ -209,7 +214,7 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
                  f"select and {len(test)} test recording(s)")
     model = _model(args, robot, progress)
     options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
-                      sign_velocity=args.sign_velocity,
+                      sign_velocity=args.sign_velocity, reidentify=args.reidentify,
                       **({"min_gain": args.min_gain} if args.min_gain is not None else {}))
     if options.effects is not None:
         from .diagnosis.effects import library

@@ -33,7 +33,7 @@ class Options:
     alpha: float = ALPHA
     sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd) (Stribeck, direction)
     block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
-    reidentify: bool = True  # consistent link parameters as a per-joint alternative (reidentify.py)
+    reidentify: bool = False  # consistent link parameters as a per-joint alternative (reidentify.py; opt-in)
 
 
 @dataclass
