@@ -410,6 +410,8 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     2-s block of the fit data)."""
     options = options or ConsistentOptions()
     dof = robot.dof
+    signals_list = [_trimmed(s) for s in signals_list]
+    select = [_trimmed(s) for s in select] if select else select
     names = [e["standard"] for e in model.manifest["coefficients"]["full"]["expressions"]]
     r = len(names)
     wanted = set(options.friction) | ({"ripple_cos", "ripple_sin"} if "ripple" in options.friction else set())
@@ -510,6 +512,19 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
                       lam, selection, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
                       pinned(solver.problem, result.p), V, tilt, dropped, lags)
+
+
+def _trimmed(s):
+    """The recording without the filter's start-up at both ends (Signals.trim samples), which is
+    not data (data/conditioning.py)."""
+    k = int(getattr(s, "trim", 0) or 0)
+    if k <= 0 or 2 * k >= len(s.t):
+        return s
+    T = len(s.t)
+    cut = {name: value[k:T - k] for name, value in vars(s).items()
+           if isinstance(value, np.ndarray) and value.ndim >= 1 and value.shape[0] == T}
+    cut["extra"] = {name: v[k:T - k] for name, v in s.extra.items()}
+    return replace(s, trim=0, **cut)
 
 
 def velocity_limits(robot, signals_list) -> np.ndarray:
