@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import InputError
 from ..extraction import driver
 from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import Stage, build_problem, consistency_margin
@@ -416,6 +417,13 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     r = len(names)
     wanted = set(options.friction) | ({"ripple_cos", "ripple_sin"} if "ripple" in options.friction else set())
     kinds = tuple(k for k in FRICTION_KINDS if k in wanted)
+    rows = dof * sum(len(s.t) for s in signals_list)
+    unknowns = r + len(kinds) * dof + (2 if options.tilt else 0)
+    if rows <= 2 * unknowns:  # before anything is compiled or solved
+        raise InputError(", ".join(s.name for s in signals_list), "",
+                         f"under-determined: {rows} equations for {unknowns} coefficients and friction values; "
+                         f"record at least {2 * unknowns // dof + 1} samples (many more, on an exciting trajectory, "
+                         "for a usable estimate)")
     armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
     labels = _labels(kinds, armature_ok, dof)
     columns = _Columns(model, signals_list, dof) if "coulomb" in kinds else None
