@@ -43,13 +43,13 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     """regressors: "gravity" and "full" -> full regressor Model; bases: kind -> BaseSet; models: rnea,
     gravity, mass_matrix and unit_accelerations (the factors of the inertia regressor)."""
     P, n = robot.name, robot.dof
-    joints = robot.joints
+    joint_models = robot.joint_models
     n_stacked = n * (n + 1) // 2
     std_names = [standard_name(i + 1, k) for i in range(n) for k in range(PER_LINK)]
     dyn_text = dynamic_names_text(n)
 
     def fn(name, model, outputs, out, doc):
-        return render_function(P, joints, name, model, outputs, out, doc)
+        return render_function(P, joint_models, name, model, outputs, out, doc)
 
     parameters = [fn("standard_from_dynamic", (m := derivation.standard_from_dynamic()), m.outputs,
                      ("s", (PER_LINK * n,), "standard parameters"), "Standard parameters s from dynamic parameters p.")]
@@ -66,7 +66,7 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
                              f"Jacobian d pi_{kind} / d p (for gradient-based extraction)."))
         doc = f"Base regressor of the {KIND_LABELS[kind]}."
         if kind == "inertia":  # factored: O(n^2) code for its O(n^3) entries
-            regressor_fns.append(render_inertia_regressor(P, joints, models["unit_accelerations"], base, doc))
+            regressor_fns.append(render_inertia_regressor(P, joint_models, models["unit_accelerations"], base, doc))
         else:
             name = {"gravity": "regressor_gravity", "full": "regressor"}[kind]
             regressor_fns.append(fn(name, regressors[kind], base_regressor_outputs(regressors[kind], base),
@@ -91,7 +91,7 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     gravity_symbols = [s.name for s in robot.gravity_symbols]
     common = dict(robot=robot, P=P, M=P.upper(), version=__version__, source=robot.source, kinds=kinds,
                   n_stacked=n_stacked, gravity_symbols=gravity_symbols,
-                  joint_types="".join("R" if j.revolute else "P" for j in joints),
+                  joint_types="".join("R" if j.revolute else "P" for j in joint_models),
                   gravity_text=", ".join(_gravity_text(g) for g in robot.gravity), FRICTION_PER_JOINT=FRICTION_PER_JOINT)
     sources = {f"{P}_parameters.c": ("parameters and base coefficients", parameters),
                f"{P}_regressors.c": ("base regressors", regressor_fns),

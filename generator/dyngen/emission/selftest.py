@@ -59,18 +59,18 @@ def fixed_states(robot) -> list[tuple[list, list, list]]:
 
 def selftest_data(robot, derivation, models: dict) -> SelfTestData:
     """models: the rnea, gravity and mass_matrix Models the C was printed from."""
-    joints = robot.joints
+    joint_models = robot.joint_models
     p = fixed_parameters(robot)
     assert len(p) == PER_LINK * robot.dof
-    s = evaluate(derivation.standard_from_dynamic(), joints, {"p": p})
+    s = evaluate(derivation.standard_from_dynamic(), joint_models, {"p": p})
     gravity = [GRAVITY_SYMBOL_VALUES[k % len(GRAVITY_SYMBOL_VALUES)] for k in range(len(robot.gravity_symbols))]
     states = fixed_states(robot)
     tau, g, M = [], [], []
     for q, qd, qdd in states:
         common = {"q": q, "s": s, "gravity": gravity}
-        tau.append(evaluate(models["rnea"], joints, {**common, "qd": qd, "qdd": qdd}))
-        g.append(evaluate(models["gravity"], joints, common))
-        M.append(evaluate(models["mass_matrix"], joints, common))
+        tau.append(evaluate(models["rnea"], joint_models, {**common, "qd": qd, "qdd": qdd}))
+        g.append(evaluate(models["gravity"], joint_models, common))
+        M.append(evaluate(models["mass_matrix"], joint_models, common))
     return SelfTestData(p, gravity, states, tau, g, M)
 
 
