@@ -698,8 +698,7 @@ class StandardBarrier {
         Z_ = Z_ * N;
         identity_map_ = false;
         p_center_ = p;
-        AZ_ = A_ * Z_;
-        G_ = 2.0 * AZ_.transpose() * AZ_;
+        map_cost();
         usable_ = usable_ && barrier(Eigen::VectorXd::Zero(Z_.cols()), nullptr, nullptr);
     }
 
@@ -832,9 +831,14 @@ class StandardBarrier {
             A_ /= std::sqrt(norm);
             b_ /= std::sqrt(norm);
         }
+        map_cost();
+    }
+    // The cost in z: its matrix A Z and Hessian 2 (A Z)^T A Z, after A or the map s = s_fixed + Z z changed.
+    void map_cost() {
         AZ_ = A_ * Z_;
         G_ = 2.0 * AZ_.transpose() * AZ_;
     }
+    Eigen::VectorXd residual(const Eigen::VectorXd &z) const { return A_ * s_fixed_ + AZ_ * z - b_; }
     static Eigen::VectorXd standard_of(const Eigen::VectorXd &p) {
         Eigen::VectorXd s(kParameters);
         stanford_standard_from_dynamic(p.data(), s.data());
@@ -852,11 +856,11 @@ class StandardBarrier {
         return p;
     }
     double cost(const Eigen::VectorXd &z) const {
-        return (A_ * s_fixed_ + AZ_ * z - b_).squaredNorm();
+        return residual(z).squaredNorm();
     }
     // psi = f / mu + barrier, with gradient and Hessian in z when asked; +inf outside.
     double value(const Eigen::VectorXd &z, double mu, Eigen::VectorXd *grad, Eigen::MatrixXd *hess) const {
-        Eigen::VectorXd gb, r = A_ * s_fixed_ + AZ_ * z - b_;
+        Eigen::VectorXd gb, r = residual(z);
         Eigen::MatrixXd hb;
         double b = 0;
         if (!barrier(z, grad ? &gb : nullptr, hess ? &hb : nullptr, &b)) return HUGE_VAL;
@@ -960,11 +964,10 @@ class StandardBarrier {
         if (P_.has_total_mass && any_mass_free_) {
             double mass = 0;
             for (int link = 0; link < kLinks; ++link) mass += s[10 * link];
-            for (double slack : {mass - P_.mass_lo, P_.mass_hi - mass}) {
-                if (!(slack > 0)) return false;
-                total -= std::log(slack);
-            }
             const double lo = mass - P_.mass_lo, hi = P_.mass_hi - mass;
+            if (!(lo > 0) || !(hi > 0)) return false;
+            total -= std::log(lo);
+            total -= std::log(hi);
             for (int a = 0; a < kLinks; ++a) {
                 gs[10 * a] += -1 / lo + 1 / hi;
                 if (hess)
@@ -1007,13 +1010,16 @@ Outcome run_restart(const Problem &P, const StandardBarrier &barrier, int restar
     // The local refinement: the barrier method in s; without it (identities, fixed inertias) SLSQP,
     // in s when every parameter is free, else in p.
     const bool in_standard = P.free.size() == static_cast<size_t>(kParameters);
-    nlopt_opt local = make(NLOPT_LD_SLSQP, P);
-    nlopt_set_min_objective(local, objective, &c);
-    add_constraints(local, c, eq, P.tolerance);
-    nlopt_set_maxeval(local, P.local_maxeval);
-    nlopt_set_ftol_rel(local, 1e-15);
-    nlopt_set_xtol_rel(local, 1e-13);
-    nlopt_set_stopval(local, kStopCost);
+    nlopt_opt local = nullptr;  // SLSQP in p, built only where it is used
+    if (!barrier.usable() && !in_standard) {
+        local = make(NLOPT_LD_SLSQP, P);
+        nlopt_set_min_objective(local, objective, &c);
+        add_constraints(local, c, eq, P.tolerance);
+        nlopt_set_maxeval(local, P.local_maxeval);
+        nlopt_set_ftol_rel(local, 1e-15);
+        nlopt_set_xtol_rel(local, 1e-13);
+        nlopt_set_stopval(local, kStopCost);
+    }
     auto settle = [&](std::vector<double> &y) {
         Outcome o;
         if (barrier.usable()) {
@@ -1039,7 +1045,7 @@ Outcome run_restart(const Problem &P, const StandardBarrier &barrier, int restar
         if ((feasible && (!was || hop.cost < out.cost)) || (!feasible && !was && hop.violation < out.violation))
             out = hop;
     }
-    nlopt_destroy(local);
+    if (local) nlopt_destroy(local);
     return out;
 }
 

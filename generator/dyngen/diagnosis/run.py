@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..catalogue import RNEA
 from . import design as dz
 from . import phases
 from .correlation import integrated_time
@@ -61,7 +62,7 @@ def _segments(model, s, fit_signals, holdout_signals, options) -> tuple[list, st
     out = []
 
     def segment(sig, fit, held):
-        tau_model = model.batch("rnea", sig.q, sig.qd, sig.qdd, s)
+        tau_model = model.batch(RNEA.name, sig.q, sig.qd, sig.qdd, s)
         return Segment(sig, tau_model, sig.tau - tau_model, fit, held)
 
     if holdout_signals:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...catalogue import REGRESSOR, RNEA
 from ...parameters import PER_LINK, STANDARD_NAMES_PER_LINK
 from .base import Effect
 
@@ -26,7 +27,7 @@ class Payload(Effect):
         for k in range(PER_LINK):
             unit = np.zeros(PER_LINK * n)
             unit[PER_LINK * (n - 1) + k] = 1.0
-            out[:, :, k] = context.model.batch("rnea", signals.q, signals.qd, signals.qdd, unit)
+            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, unit)
         return out
 
 
@@ -44,4 +45,4 @@ class Coefficients(Effect):
     def columns(self, context, signals, tau_model):
         if not self.parameters:
             self.bind(context.model.manifest)
-        return context.model.batch("regressor", signals.q, signals.qd, signals.qdd)
+        return context.model.batch(REGRESSOR.name, signals.q, signals.qd, signals.qdd)
