@@ -5,14 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from pathlib import Path
 
 from . import __version__, blas
 
 blas.use_one_thread()  # before numpy loads: the imports below load it
 
-from .errors import InputError  # noqa: E402
-from .extraction.driver import DriverError  # noqa: E402
-from .extraction.problem import Infeasible  # noqa: E402
+from .errors import DriverError, Infeasible, InputError  # noqa: E402
 from .progress import Progress  # noqa: E402
 
 MAIN_HELP = """\
@@ -106,11 +105,19 @@ def _generate_and_extract(argv, prog, required: bool, description: str) -> int:
     args = parser.parse_args(argv)
     robot = _load(args)
     extracting = required or (bool(robot.identified) and robot.lower is not None)
-    if extracting:
-        _precheck(args, robot)  # bad bounds fail before anything runs or is written
-    result = _generate(args, robot)
-    if extracting:
-        _extract(args, result.robot, result.bases, result.folder)
+    if not extracting:
+        _generate(args, robot)
+        return 0
+    _precheck(args, robot)  # bad bounds fail before anything runs or is written
+    compare = _compared_solution(args, robot)
+    # The model is generated into the per-user cache and copied to -o only once the extraction
+    # has succeeded: a failed extraction writes nothing.
+    result = _generate(args, robot, out_root=None)
+    extraction, options, seconds = _run_extraction(args, result.robot, result.bases, result.folder)
+    from .atomic import write_folder
+
+    write_folder(Path(args.output) / robot.name, result.emitted.files)
+    _write_extraction(args, result.robot, result.folder, extraction, options, seconds, compare)
     return 0
 
 
@@ -127,12 +134,19 @@ def _precheck(args, robot) -> None:
     build_problem(robot, _options_from(args, robot))
 
 
-def _extract(args, robot, bases, folder) -> None:
-    from pathlib import Path
-
-    from .atomic import write_file
+def _compared_solution(args, robot):
+    """The solution to compare with (--compare or the YAML's extraction.compare), read and checked
+    before anything runs: (name, p) or None."""
     from .data.parameters_file import read_link_parameters
-    from .extraction import report
+
+    compare = args.compare or robot.extraction.get("compare")
+    if not compare:
+        return None
+    path = Path(compare) if args.compare else Path(args.robot).parent / compare
+    return path.name, read_link_parameters(path, robot.dof)
+
+
+def _run_extraction(args, robot, bases, folder):
     from .extraction.run import extract
 
     options = _options_from(args, robot)
@@ -145,14 +159,19 @@ def _extract(args, robot, bases, folder) -> None:
 
     with progress.step("build and run the NLopt extractor"):
         extraction = extract(robot, bases, folder, options, on_progress)
-    seconds = time.perf_counter() - start
+    return extraction, options, time.perf_counter() - start
+
+
+def _write_extraction(args, robot, folder, extraction, options, seconds, compare) -> None:
+    from .atomic import write_file
+    from .extraction import report
+
+    progress = Progress(quiet=args.quiet)
     out = Path(args.out) / robot.name
     write_file(out / "extracted.yaml", report.extracted_yaml(robot, extraction, options, seconds))
     columns = {"dyngen": extraction.p}
-    compare = args.compare or robot.extraction.get("compare")
     if compare:
-        path = Path(compare) if args.compare else Path(args.robot).parent / compare
-        columns = {path.name: read_link_parameters(path, robot.dof), **columns}
+        columns = {compare[0]: compare[1], **columns}
     residual_rows = report.residual_comparison(robot, extraction, columns, folder)
     table = report.consistency_table(columns)
     write_file(out / "consistency.md", table + "\n")
@@ -202,27 +221,28 @@ def cmd_generate(argv, prog="dyngen generate") -> int:
     return 0
 
 
-def _generate(args, robot):
+def _generate(args, robot, out_root="from args"):
+    """Generate into args.output (or, with out_root None, into the per-user cache for now)."""
     from .generate import generate
 
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
     progress.say(f"dyngen {__version__}: generating {args.robot}")
-    result = generate(robot, args.output, progress)
+    result = generate(robot, args.output if out_root == "from args" else out_root, progress)
     if not args.quiet:
-        _summary(result, time.perf_counter() - start)
+        _summary(result, Path(args.output) / robot.name, time.perf_counter() - start)
     return result
 
 
-def _summary(result, seconds: float) -> None:
+def _summary(result, destination: Path, seconds: float) -> None:
     robot, bases = result.robot, result.bases
-    print(f"{robot.name}: {robot.dof} joints, {robot.convention} DH -> {result.folder}/ in {seconds:.1f} s")
+    print(f"{robot.name}: {robot.dof} joints, {robot.convention} DH -> {destination}/ in {seconds:.1f} s")
     print("  base coefficients: " + ", ".join(f"{k} {b.rank}" for k, b in bases.items())
           + f" (of {10 * robot.dof} standard parameters)")
     width = max(len(f.name) for f in result.emitted.functions)
     for f in result.emitted.functions:
         print(f"  {f.name:<{width}}  {f.ops}")
-    print(f"  coefficient expressions: {result.folder}/coefficients.md")
+    print(f"  coefficient expressions: {destination}/coefficients.md")
 
 
 def cmd_identify(argv, prog="dyngen identify") -> int:
@@ -241,25 +261,41 @@ COMMANDS = {"generate": cmd_generate, "extract": cmd_extract, "identify": cmd_id
 
 
 def main(argv=None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        return _dispatch(list(sys.argv[1:] if argv is None else argv))
+    except (InputError, Infeasible, DriverError) as err:
+        print(f"dyngen: error: {_one_line(err)}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # e.g. `dyngen ... | head`
+        return 0
+    except KeyboardInterrupt:
+        print("dyngen: interrupted", file=sys.stderr)
+        return 130
+    except OSError as err:  # e.g. an output folder that cannot be written
+        where = f"{err.filename}: " if err.filename else ""
+        print(f"dyngen: error: {_one_line(where)}{err.strerror or err}", file=sys.stderr)
+        return 2
+    except (RecursionError, MemoryError) as err:
+        print(f"dyngen: error: the input is too large or nested too deeply ({type(err).__name__})", file=sys.stderr)
+        return 2
+
+
+def _dispatch(argv) -> int:
     if not argv or argv[0] in ("-h", "--help"):
         print(MAIN_HELP, end="")
         return 0 if argv else 2
     if argv[0] == "--version":
         print(f"dyngen {__version__}")
         return 0
-    try:
-        if argv[0] in COMMANDS:
-            return COMMANDS[argv[0]](argv[1:], prog=f"dyngen {argv[0]}")
-        return cmd_main(argv, prog="dyngen")
-    except (InputError, Infeasible, DriverError) as err:
-        print(f"dyngen: error: {err}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:  # e.g. `dyngen ... | head`
-        return 0
-    except KeyboardInterrupt:
-        print("dyngen: interrupted; nothing was written", file=sys.stderr)
-        return 130
+    if argv[0] in COMMANDS:
+        return COMMANDS[argv[0]](argv[1:], prog=f"dyngen {argv[0]}")
+    return cmd_main(argv, prog="dyngen")
+
+
+def _one_line(err, limit: int = 2000) -> str:
+    """Errors quote user input; keep them one bounded line."""
+    text = " ".join(str(err).split("\n"))
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 if __name__ == "__main__":

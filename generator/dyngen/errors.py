@@ -1,4 +1,5 @@
-"""One error type for user input: says the file, the field and what was expected."""
+"""The errors the dyngen command reports in one line (a light module: the command imports it
+before anything heavy, so that even an early Ctrl-C or failure is one line)."""
 
 
 class InputError(Exception):
@@ -8,3 +9,11 @@ class InputError(Exception):
         self.source, self.field, self.message = source, field, message
         where = f"{source}: {field}" if field else source
         super().__init__(f"{where}: {message}")
+
+
+class Infeasible(Exception):
+    """The bounds and constraints admit no solution; the message names the conflicts."""
+
+
+class DriverError(RuntimeError):
+    """The extractor driver could not be built or failed."""

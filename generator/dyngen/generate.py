@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gc
+import hashlib
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,11 +67,28 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
 
 
 def generate(robot: Robot | str | Path, out_root="generated", progress: Progress | None = None) -> Generated:
-    """Generate into out_root/<robot name>/; nothing is written unless everything succeeded."""
+    """Generate into out_root/<robot name>/; nothing is written unless everything succeeded.
+    out_root None: into the per-user cache (see cached_folder) instead."""
     progress = progress or Progress(quiet=True)
     if not isinstance(robot, Robot):
         robot = load_robot(robot)
     bases, emitted = build(robot, progress)
+    if out_root is None:
+        return Generated(robot, bases, emitted, cached_folder(robot.name, emitted.files))
     folder = Path(out_root) / robot.name
     write_folder(folder, emitted.files)
     return Generated(robot, bases, emitted, folder)
+
+
+def cached_folder(name: str, files: dict[str, str]) -> Path:
+    """The generated files in the per-user cache, keyed by their content. Commands that need a
+    compiled model but no output folder (identify, diagnose, extract before it succeeds) use
+    it: nothing is left in the temporary directory or in the user's folders, and a second run
+    with the same model reuses the folder and its compiled library."""
+    from . import cache
+
+    digest = hashlib.sha256("".join(f"{k}\0{files[k]}\0" for k in sorted(files)).encode()).hexdigest()[:16]
+    folder = cache.folder("models") / digest / name  # the folder's name is the robot's, as everywhere
+    if not (folder / "manifest.json").exists():
+        write_folder(folder, files)  # atomic: the folder is there whole or not at all
+    return folder

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import tempfile
 import time
 from pathlib import Path
 
 from .errors import InputError
 from .progress import Progress
+
+MIN_DIAGNOSIS_SAMPLES = 50
 
 
 def _data_options(parser: argparse.ArgumentParser) -> None:
@@ -51,14 +52,11 @@ def _model(args, robot, progress):
             raise InputError(str(folder), "manifest.json", f"the folder is for {model.manifest['robot']}, "
                              f"not {robot.name} ({robot.dof} joints)")
         return model
-    from .atomic import write_folder
-    from .generate import build
+    from .generate import generate
 
-    bases, emitted = build(robot, progress)
-    folder = Path(tempfile.mkdtemp(prefix="dyngen-")) / robot.name
-    write_folder(folder, emitted.files)
+    generated = generate(robot, None, progress)  # into the per-user cache, not the user's folders
     with progress.step("compile the generated C"):
-        return load(folder)
+        return load(generated.folder)
 
 
 def _read(paths, robot, args, require_torques=True, required=()):
@@ -153,17 +151,25 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     start = time.perf_counter()
     fit = _read(args.data, robot, args)  # bad input fails before anything is announced or written
     held = _read(args.holdout, robot, args) if args.holdout else None
+    for path, recording in zip([*args.data, *(args.holdout or [])], [*fit, *(held or [])]):
+        if len(recording.t) < MIN_DIAGNOSIS_SAMPLES:
+            raise InputError(Path(path).name, "", f"{len(recording.t)} samples; a diagnosis needs at least "
+                             f"{MIN_DIAGNOSIS_SAMPLES} (seconds of motion at the recording's rate)")
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit and "
                  f"{len(args.holdout or [])} held-out recording(s)")
     model = _model(args, robot, progress)
     options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
                       sign_velocity=args.sign_velocity,
                       **({"min_gain": args.min_gain} if args.min_gain is not None else {}))
-    with progress.step("residual, effects, selection on held-out data"):
-        try:
-            result = diagnose(robot, model, p, fit, held, options)
+    if options.effects is not None:
+        from .diagnosis.effects import library
+
+        try:  # unknown names fail here, naming the option, before anything runs
+            library(options.effects)
         except ValueError as err:
             raise InputError("--effects", "", str(err)) from None
+    with progress.step("residual, effects, selection on held-out data"):
+        result = diagnose(robot, model, p, fit, held, options)
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
     sources = {"params": Path(args.params).name, "fit": [Path(x).name for x in args.data],
                "holdout": [Path(x).name for x in args.holdout or []], "conditioning": _conditioning_text(args)}

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import shutil
 import subprocess
 import tempfile
@@ -21,6 +20,8 @@ from pathlib import Path
 
 import cffi
 import numpy as np
+
+from . import cache
 
 
 REALS = {"double": np.float64, "float": np.float32}  # C type of <robot>_real -> numpy dtype
@@ -114,7 +115,9 @@ def library_sources(folder) -> list[Path]:
 
 
 def load(folder, cache_dir: Path | None = None, real: str = "double") -> Compiled:
-    """real: "double", or "float" for the build with <ROBOT>_USE_FLOAT defined."""
+    """real: "double", or "float" for the build with <ROBOT>_USE_FLOAT defined. The library is
+    built once into the per-user cache (dyngen.cache; `cache_dir` replaces its root) and loaded
+    only after its recorded hash is checked."""
     folder = Path(folder)
     sources = library_sources(folder)
     manifest = json.loads((folder / "manifest.json").read_text())
@@ -122,10 +125,9 @@ def load(folder, cache_dir: Path | None = None, real: str = "double") -> Compile
     batch = _batch_source(manifest, real)
     digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources + [folder / "manifest.json"])
                             + batch.encode()).hexdigest()[:16]
-    cache_dir = Path(cache_dir or Path(tempfile.gettempdir()) / "dyngen-libraries")
+    cache_dir = cache.folder("libraries", cache_dir)
     library = cache_dir / f"lib{folder.name}-{real}-{digest}.so"
-    if not library.exists():
-        cache_dir.mkdir(parents=True, exist_ok=True)
+    if not cache.verified(library):
         work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
         try:
             tmp = work / library.name
@@ -133,7 +135,7 @@ def load(folder, cache_dir: Path | None = None, real: str = "double") -> Compile
             subprocess.run(["cc", "-O2", "-std=c99", "-shared", "-fPIC", *flags, "-I", str(folder),
                             *map(str, sources), str(work / "dyngen_batch.c"), "-o", str(tmp), "-lm"],
                            check=True, capture_output=True, text=True)
-            os.replace(tmp, library)
+            cache.install(tmp, library)
         finally:
             shutil.rmtree(work, ignore_errors=True)
     return Compiled(folder, library, real)

@@ -7,20 +7,15 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from ..errors import InputError
+from ..untrusted import read_yaml
 
 
 def read_link_parameters(path, dof: int) -> np.ndarray:
     path = Path(path)
     name = path.name
-    try:
-        doc = yaml.safe_load(path.read_text())
-    except OSError as err:
-        raise InputError(str(path), "", f"cannot read the file ({err.strerror})") from None
-    except yaml.YAMLError as err:
-        raise InputError(name, "", f"malformed YAML: {getattr(err, 'problem', err)}") from None
+    doc = read_yaml(path)  # plain data only; duplicate keys, aliases, bad encodings refused
     if not isinstance(doc, dict):
         raise InputError(name, "", "expected a mapping with `links:`, `solution:` or `parameters.nominal`")
     for key in ("links", "solution"):
@@ -39,10 +34,22 @@ def read_link_parameters(path, dof: int) -> np.ndarray:
     for i, link in enumerate(links):
         where = f"{field}[{i}]"
         try:
-            row = [float(link["m"]), *map(float, link["c"]), *map(float, link["I"])]
+            if not isinstance(link, dict) or not all(isinstance(link[k], list) for k in ("c", "I")):
+                raise TypeError
+            row = [_number(link["m"]), *map(_number, link["c"]), *map(_number, link["I"])]
         except (KeyError, TypeError, ValueError):
             raise InputError(name, where, "expected {m: number, c: [3 numbers], I: [6 numbers]}") from None
-        if len(row) != 10 or not np.all(np.isfinite(row)):
-            raise InputError(name, where, "expected {m: number, c: [3 numbers], I: [6 numbers]}, all finite")
+        if len(row) != 10 or not np.all(np.isfinite(row)) or np.abs(row).max() > 1e5:
+            raise InputError(name, where, "expected {m: number, c: [3 numbers], I: [6 numbers]}, all finite "
+                             "and at most 1e5 in size")
+        if row[0] <= 0:
+            raise InputError(name, f"{where}.m", f"expected a positive mass, got {row[0]:g}")
         values += row
     return np.array(values)
+
+
+def _number(value) -> float:
+    """A YAML number; strings ("1e3", "nan") are not numbers here."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise TypeError
+    return float(value)

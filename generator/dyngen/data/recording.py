@@ -9,6 +9,7 @@ Every problem is an InputError naming the file, the line and the column, for exa
 from __future__ import annotations
 
 import csv
+import io
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,6 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..untrusted import MAX_CSV_BYTES, read_text
+
+# No robot's time [s], position [rad, m], velocity, acceleration or torque [Nm] comes near this;
+# larger values (1e308) would overflow the least squares instead of naming the cell.
+MAX_VALUE = 1e9
 
 _NUMBERED = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
 
@@ -38,14 +44,11 @@ def read_recording(path, dof: int, require_torques: bool = True, required: tuple
     (e.g. the stacked inertia entries) that must be present."""
     path = Path(path)
     name = path.name
-    try:
-        with open(path, newline="") as f:
-            header_line = f.readline()
-    except OSError as err:
-        raise InputError(str(path), "", f"cannot read the file ({err.strerror})") from None
+    text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
+    header_line, _, body = text.partition("\n")
     header = [h.strip() for h in next(csv.reader([header_line]), [])]
     columns = _check_header(name, header, dof, require_torques, required)
-    data = _numbers(path, name, header)
+    data = _numbers(body, name, header)
     _check_values(name, header, data)
     t = data[:, columns["t"]]
     _check_time(name, t)
@@ -69,7 +72,7 @@ def _check_header(name, header, dof, require_torques, required) -> dict:
         if not h:
             raise InputError(name, where, f"column {k + 1} has no name")
         if h in columns:
-            raise InputError(name, where, f"column {h} appears twice")
+            raise InputError(name, where, f"column {_short(h)} appears twice")
         columns[h] = k
     if "t" not in columns:
         raise InputError(name, where, "no time column t")
@@ -101,40 +104,48 @@ def _check_header(name, header, dof, require_torques, required) -> dict:
     return columns
 
 
-def _numbers(path, name, header) -> np.ndarray:
+def _numbers(body: str, name, header) -> np.ndarray:
     """Fast path with numpy; on failure, a slow pass that finds the exact line and column."""
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=float)
+        data = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, dtype=float)
     except ValueError:
         data = None
-    if data is not None and data.shape[1] == len(header) and data.shape[0] > 0:
+    if data is not None and data.ndim == 2 and data.shape[1] == len(header) and data.shape[0] > 0:
         return data
     rows = []
-    with open(path, newline="") as f:
-        reader = csv.reader(f)
-        next(reader)
-        for line, row in enumerate(reader, start=2):
-            if not row or all(not cell.strip() for cell in row):
-                continue
-            if len(row) != len(header):
-                raise InputError(name, f"line {line}", f"{len(row)} values, the header has {len(header)} columns")
-            values = []
-            for cell, column in zip(row, header):
-                try:
-                    values.append(float(cell))
-                except ValueError:
-                    raise InputError(name, f"line {line}, column {column}", f'not a number ("{cell.strip()}")') from None
-            rows.append(values)
+    for line, row in enumerate(csv.reader(io.StringIO(body)), start=2):
+        if not row or all(not cell.strip() for cell in row):
+            continue
+        if len(row) != len(header):
+            raise InputError(name, f"line {line}", f"{len(row)} values, the header has {len(header)} columns")
+        values = []
+        for cell, column in zip(row, header):
+            try:
+                values.append(float(cell))
+            except ValueError:
+                raise InputError(name, f"line {line}, column {_short(column)}",
+                                 f'not a number ("{_short(cell.strip())}")') from None
+        rows.append(values)
     if not rows:
         raise InputError(name, "line 2", "no data rows after the header")
     return np.array(rows, dtype=float)
+
+
+def _short(text: str, limit: int = 40) -> str:
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def _check_values(name, header, data) -> None:
     bad = np.argwhere(~np.isfinite(data))
     if bad.size:
         row, col = bad[0]
-        raise InputError(name, f"line {row + 2}, column {header[col]}", f"{float(data[row, col])} (NaN or infinite value)")
+        raise InputError(name, f"line {row + 2}, column {_short(header[col])}",
+                         f"{float(data[row, col])} (NaN or infinite value)")
+    bad = np.argwhere(np.abs(data) > MAX_VALUE)
+    if bad.size:
+        row, col = bad[0]
+        raise InputError(name, f"line {row + 2}, column {_short(header[col])}",
+                         f"{float(data[row, col]):g}: value out of range (|x| at most {MAX_VALUE:g})")
 
 
 def _check_time(name, t) -> None:

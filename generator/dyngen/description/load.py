@@ -10,10 +10,12 @@ import math
 import re
 from pathlib import Path
 
-import yaml
+import sympy as sp
 
 from ..errors import InputError
-from .expressions import ExpressionError, exact_number
+from ..parameters import dynamic_symbols, standard_symbols
+from ..untrusted import read_yaml
+from .expressions import ExpressionError, exact_number, parse_expression, shorten
 from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
 
 _TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
@@ -22,24 +24,26 @@ _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
 _IDENTIFIED_KINDS = ("gravity", "inertia", "full")
-_C_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+_C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_extract.cpp and the like
+MAX_JOINTS = 20
+# Ranges no real serial arm leaves (SI units); outside them a value is a typo or an attack, and
+# extreme magnitudes (1e308, 1e-320) would overflow or underflow the generated self-test.
+MAX_LENGTH = 100.0  # DH a, d and centres of mass [m]
+MIN_LENGTH = 1e-9  # a nonzero length below this is written 0
+MAX_ANGLE = 100.0  # DH alpha, theta [rad]
+MAX_GRAVITY = 1000.0  # [m/s^2]
+MAX_MASS = 1e5  # [kg]
+MAX_INERTIA = 1e5  # [kg m^2]
+MAX_COEFFICIENT = 1e9  # identified coefficient values
+# Names of symbols the derivation uses itself: a gravity symbol of the same name would be
+# taken for them (gravity [0, m1, 0] would multiply by the mass of link 1).
+_RESERVED = re.compile(r"(q|qd|qdd|s|c|x|a|b|p|m|mx|my|mz|XX|XY|XZ|YY|YZ|ZZ)\d+|c\d+[xyz]|I\d+(xx|xy|xz|yy|yz|zz)"
+                       r"|pi|E|I|oo|nan|zoo|gravity|tau|[A-Z][A-Z0-9_]*_K")
 
 
 def load_robot(path) -> Robot:
     path = Path(path)
-    source = path.name
-    try:
-        text = path.read_text()
-    except OSError as err:
-        raise InputError(str(path), "", f"cannot read the file ({err.strerror})") from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise InputError(source, where, f"malformed YAML: {problem}") from None
-    return _Reader(source).robot(doc)
+    return _Reader(path.name).robot(read_yaml(path))
 
 
 class _Reader:
@@ -54,7 +58,8 @@ class _Reader:
             self.fail(field or "(top level)", f"expected a mapping, got {_describe(value)}")
         for key in value:
             if key not in allowed:
-                self.fail(f"{field}.{key}" if field else str(key),
+                key = shorten(str(key))
+                self.fail(f"{field}.{key}" if field else key,
                           f"unknown field; expected one of {', '.join(sorted(allowed))}")
         return value
 
@@ -65,16 +70,24 @@ class _Reader:
             self.fail(field, f"expected {length} entries, got {len(value)}")
         return value
 
-    def number(self, value, field) -> float:
+    def number(self, value, field, limit: float | None = None) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             self.fail(field, f"expected a finite number, got {_describe(value)}")
+        if limit is not None and abs(value) > limit:
+            self.fail(field, f"value out of range: |{value:g}| > {limit:g}")
         return float(value)
 
-    def exact(self, value, field, what="a number", allow_symbols=False):
+    def exact(self, value, field, what="a number", allow_symbols=False, limit=None, smallest=0.0):
         try:
-            return exact_number(value, allow_symbols)
+            number = exact_number(value, allow_symbols, reserved=lambda name: bool(_RESERVED.fullmatch(name)))
         except ExpressionError as err:
             self.fail(field, f"expected {what}, {err}")
+        if limit is not None and not number.free_symbols:
+            size = abs(float(number))
+            if size > limit or 0 < size < smallest:
+                self.fail(field, f"value out of range: {size:g} (expected 0 or between {smallest:g} and {limit:g})"
+                          if smallest else f"value out of range: |{size:g}| > {limit:g}")
+        return number
 
     def robot(self, doc) -> Robot:
         doc = self.mapping(doc, "", _TOP_KEYS)
@@ -82,18 +95,23 @@ class _Reader:
             if key not in doc:
                 self.fail(key, "missing (required)")
         name = doc["name"]
-        if not isinstance(name, str) or not _C_NAME.match(name):
-            self.fail("name", f"expected a lowercase C identifier like lwr or ur5, got {_describe(name)}")
+        if not isinstance(name, str) or not _C_NAME.fullmatch(name):
+            self.fail("name", "expected a lowercase C identifier like lwr or ur5 (at most 40 characters), "
+                      f"got {_describe(name)}")
         convention = doc["dh"]
         if convention not in ("standard", "modified"):
             self.fail("dh", f'expected "standard" or "modified", got {_describe(convention)}')
         gravity = doc.get("gravity", [0, 0, -9.81])
         gravity = tuple(
-            self.exact(g, f"gravity[{k}]", "a number or a symbol name", allow_symbols=True)
+            self.exact(g, f"gravity[{k}]", "a number or a symbol name", allow_symbols=True,
+                       limit=MAX_GRAVITY, smallest=1e-9)
             for k, g in enumerate(self.sequence(gravity, "gravity", 3)))
-        joints = tuple(self.joint(j, f"joints[{i}]") for i, j in enumerate(self.sequence(doc["joints"], "joints")))
-        if not joints:
+        raw_joints = self.sequence(doc["joints"], "joints")
+        if not raw_joints:
             self.fail("joints", "expected at least one joint")
+        if len(raw_joints) > MAX_JOINTS:
+            self.fail("joints", f"{len(raw_joints)} joints; at most {MAX_JOINTS} are supported")
+        joints = tuple(self.joint(j, f"joints[{i}]") for i, j in enumerate(raw_joints))
         n = len(joints)
         params = self.mapping(doc.get("parameters") or {}, "parameters", _PARAMETER_KEYS)
         nominal = lower = upper = None
@@ -107,32 +125,41 @@ class _Reader:
             upper = tuple(hi for _, hi in pairs)
         total_mass = None
         if "total_mass" in params:
-            total_mass = self.interval(params["total_mass"], "parameters.total_mass")
+            total_mass = self.interval(params["total_mass"], "parameters.total_mass", MAX_MASS)
+            if total_mass[1] <= 0:
+                self.fail("parameters.total_mass", f"expected a positive upper bound, got {total_mass[1]:g}")
+        names = {sym.name: sym for sym in standard_symbols(n) + dynamic_symbols(n)}
         identified = {}
         ident = self.mapping(doc.get("identified") or {}, "identified", set(_IDENTIFIED_KINDS))
         for kind in _IDENTIFIED_KINDS:
             if kind in ident:
-                identified[kind] = tuple(self.coefficient(c, f"identified.{kind}[{k}]")
+                identified[kind] = tuple(self.coefficient(c, f"identified.{kind}[{k}]", names)
                                          for k, c in enumerate(self.sequence(ident[kind], f"identified.{kind}")))
-        extraction = self.extraction(doc.get("extraction") or {})
+        extraction = self.extraction(doc.get("extraction") or {}, names)
         return Robot(name=name, source=self.source, convention=convention, joints=joints, gravity=gravity,
                      nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified,
                      extraction=extraction)
 
-    def extraction(self, value) -> dict:
+    def extraction(self, value, names) -> dict:
         value = dict(self.mapping(value, "extraction", _EXTRACTION_KEYS))
         if "procedure" in value and value["procedure"] not in ("joint", "two-stage"):
             self.fail("extraction.procedure", f'expected "joint" or "two-stage", got {_describe(value["procedure"])}')
         for key in ("restarts", "seed"):
-            if key in value and (not isinstance(value[key], int) or isinstance(value[key], bool) or value[key] < 1):
-                self.fail(f"extraction.{key}", f"expected a positive whole number, got {_describe(value[key])}")
+            if key in value and (not isinstance(value[key], int) or isinstance(value[key], bool)
+                                 or not 1 <= value[key] <= 100000):
+                self.fail(f"extraction.{key}", f"expected a whole number from 1 to 100000, got {_describe(value[key])}")
         if "margin" in value:
-            value["margin"] = self.number(value["margin"], "extraction.margin")
+            value["margin"] = self.number(value["margin"], "extraction.margin", MAX_INERTIA)
+            if value["margin"] < 0:
+                self.fail("extraction.margin", f"expected a number >= 0, got {value['margin']:g}")
         if "identities" in value:
             ids = self.sequence(value["identities"], "extraction.identities")
             for k, text in enumerate(ids):
+                field = f"extraction.identities[{k}]"
                 if not isinstance(text, str) or text.count("=") != 1:
-                    self.fail(f"extraction.identities[{k}]", f'expected "expression = expression", got {_describe(text)}')
+                    self.fail(field, f'expected "expression = expression", got {_describe(text)}')
+                for side in text.split("="):
+                    self.expression(side, field, names)
             value["identities"] = tuple(ids)
         if "compare" in value and not isinstance(value["compare"], str):
             self.fail("extraction.compare", f"expected a file name, got {_describe(value['compare'])}")
@@ -145,12 +172,14 @@ class _Reader:
             self.fail(f"{field}.type", f'unknown joint type; expected "revolute" or "prismatic", got {_describe(kind)}')
         numbers = {}
         for key in ("a", "alpha", "d", "theta"):
-            what = "a number or an expression of pi" if key in ("alpha", "theta") else "a number"
-            numbers[key] = self.exact(value.get(key, 0), f"{field}.{key}", what)
+            angle = key in ("alpha", "theta")
+            what = "a number or an expression of pi" if angle else "a number"
+            numbers[key] = self.exact(value.get(key, 0), f"{field}.{key}", what,
+                                      limit=MAX_ANGLE if angle else MAX_LENGTH, smallest=0.0 if angle else MIN_LENGTH)
         limits = None
         if "limits" in value:
             raw = self.mapping(value["limits"], f"{field}.limits", _LIMIT_KEYS)
-            limits = Limits(**{k: self.number(v, f"{field}.limits.{k}") for k, v in raw.items()})
+            limits = Limits(**{k: self.number(v, f"{field}.limits.{k}", 1e6) for k, v in raw.items()})
             if limits.lower is not None and limits.upper is not None and limits.lower > limits.upper:
                 self.fail(f"{field}.limits", f"lower {limits.lower} > upper {limits.upper}")
         return Joint(type=kind, limits=limits, **numbers)
@@ -160,16 +189,19 @@ class _Reader:
         for key in ("m", "c", "I"):
             if key not in value:
                 self.fail(f"{field}.{key}", "missing (required)")
-        m = self.number(value["m"], f"{field}.m")
-        c = tuple(self.number(x, f"{field}.c[{k}]") for k, x in enumerate(self.sequence(value["c"], f"{field}.c", 3)))
-        inertia = tuple(self.number(x, f"{field}.I[{k}]")
+        m = self.number(value["m"], f"{field}.m", MAX_MASS)
+        if m <= 0:
+            self.fail(f"{field}.m", f"expected a positive mass, got {m:g}")
+        c = tuple(self.number(x, f"{field}.c[{k}]", MAX_LENGTH)
+                  for k, x in enumerate(self.sequence(value["c"], f"{field}.c", 3)))
+        inertia = tuple(self.number(x, f"{field}.I[{k}]", MAX_INERTIA)
                         for k, x in enumerate(self.sequence(value["I"], f"{field}.I", 6)))
         return LinkValues(m, c, inertia)
 
-    def interval(self, value, field) -> tuple[float, float]:
-        lo, hi = (self.number(x, f"{field}[{k}]") for k, x in enumerate(self.sequence(value, field, 2)))
+    def interval(self, value, field, limit) -> tuple[float, float]:
+        lo, hi = (self.number(x, f"{field}[{k}]", limit) for k, x in enumerate(self.sequence(value, field, 2)))
         if lo > hi:
-            self.fail(field, f"LB > UB ({lo} > {hi})")
+            self.fail(field, f"LB > UB ({lo!r} > {hi!r})")
         return lo, hi
 
     def link_bounds(self, value, field) -> tuple[LinkValues, LinkValues]:
@@ -177,24 +209,36 @@ class _Reader:
         for key in ("m", "c", "I"):
             if key not in value:
                 self.fail(f"{field}.{key}", "missing (required)")
-        m = self.interval(value["m"], f"{field}.m")
-        c = [self.interval(x, f"{field}.c[{k}]") for k, x in enumerate(self.sequence(value["c"], f"{field}.c", 3))]
-        inertia = [self.interval(x, f"{field}.I[{k}]")
+        m = self.interval(value["m"], f"{field}.m", MAX_MASS)
+        if m[0] < 0 or m[1] <= 0:
+            self.fail(f"{field}.m", f"a mass cannot be negative: expected 0 <= LB <= UB with UB > 0, got "
+                      f"[{m[0]:g}, {m[1]:g}]")
+        c = [self.interval(x, f"{field}.c[{k}]", MAX_LENGTH)
+             for k, x in enumerate(self.sequence(value["c"], f"{field}.c", 3))]
+        inertia = [self.interval(x, f"{field}.I[{k}]", MAX_INERTIA)
                    for k, x in enumerate(self.sequence(value["I"], f"{field}.I", 6))]
         pairs = [m, *c, *inertia]
         return LinkValues.from_tuple([lo for lo, _ in pairs]), LinkValues.from_tuple([hi for _, hi in pairs])
 
-    def coefficient(self, value, field) -> IdentifiedCoefficient:
+    def coefficient(self, value, field, names) -> IdentifiedCoefficient:
         value = self.mapping(value, field, {"coefficient", "value"})
         expr = value.get("coefficient")
         if not isinstance(expr, str) or not expr.strip():
             self.fail(f"{field}.coefficient", f"expected an expression string like \"c7y*m7\", got {_describe(expr)}")
-        return IdentifiedCoefficient(expr, self.number(value.get("value"), f"{field}.value"))
+        self.expression(expr, f"{field}.coefficient", names)
+        return IdentifiedCoefficient(expr, self.number(value.get("value"), f"{field}.value", MAX_COEFFICIENT))
+
+    def expression(self, text, field, names) -> sp.Expr:
+        """A parameter expression, checked by the whitelisting parser (nothing in it runs)."""
+        try:
+            return parse_expression(text, names)
+        except ExpressionError as err:
+            self.fail(field, f"expected an expression of parameter names, {err}")
 
 
 def _describe(value) -> str:
     if isinstance(value, str):
-        return f'"{value}"'
+        return f'"{shorten(value)}"'
     if value is None:
         return "nothing"
     if isinstance(value, (dict, list)):

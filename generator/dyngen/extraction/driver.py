@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import os
 import shutil
 import subprocess
 import tempfile
@@ -12,11 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import cache
+from ..errors import DriverError
 from .problem import Options, Problem, Stage
-
-
-class DriverError(RuntimeError):
-    pass
 
 
 def eigen_include() -> str:
@@ -31,16 +28,16 @@ def eigen_include() -> str:
 
 
 def build(folder: Path, cache_dir: Path | None = None) -> Path:
-    """Compile the driver once per source content; returns the executable."""
+    """Compile the driver once per source content into the per-user cache (dyngen.cache;
+    `cache_dir` replaces its root); returns the executable, its recorded hash checked."""
     folder = Path(folder)
     name = folder.name
     sources = [folder / f"{name}_extract.cpp", folder / f"{name}_parameters.c", folder / f"{name}.h"]
     digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:16]
-    cache_dir = Path(cache_dir or Path(tempfile.gettempdir()) / "dyngen-drivers")
+    cache_dir = cache.folder("drivers", cache_dir)
     exe = cache_dir / f"{name}_extract-{digest}"
-    if exe.exists():
+    if cache.verified(exe):
         return exe
-    cache_dir.mkdir(parents=True, exist_ok=True)
     work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
     try:
         obj = work / "parameters.o"
@@ -48,7 +45,7 @@ def build(folder: Path, cache_dir: Path | None = None) -> Path:
         tmp_exe = work / exe.name
         _run(["c++", "-O2", "-std=c++17", "-I", str(folder), "-I", eigen_include(), str(sources[0]), str(obj),
               "-o", str(tmp_exe), "-lnlopt", "-lpthread"])
-        os.replace(tmp_exe, exe)
+        cache.install(tmp_exe, exe)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return exe

@@ -13,13 +13,10 @@ import numpy as np
 import sympy as sp
 from scipy.optimize import linprog
 
-from ..errors import InputError
+from ..description.expressions import ExpressionError, parse_expression, shorten
+from ..errors import Infeasible, InputError
 from ..parameters import PER_LINK, dynamic_name, dynamic_symbols
 from .targets import Target
-
-
-class Infeasible(Exception):
-    """The bounds and constraints admit no solution; the message names the conflicts."""
 
 
 @dataclass
@@ -92,9 +89,12 @@ def identity_terms(text: str, robot) -> list:
     names = {s.name: s for s in p}
     try:
         lhs, rhs = text.split("=")
-        poly = sp.Poly(sp.sympify(lhs, locals=names) - sp.sympify(rhs, locals=names), *p)
-    except (ValueError, sp.SympifyError, sp.PolynomialError):
-        raise InputError(robot.source, "identities", f'expected "parameter expression = expression", got "{text}"')
+        poly = sp.Poly(parse_expression(lhs, names) - parse_expression(rhs, names), *p)  # nothing in it runs
+    except ExpressionError as err:
+        raise InputError(robot.source, "identities", f"expected a polynomial in parameter names, {err}") from None
+    except (ValueError, sp.PolynomialError):
+        raise InputError(robot.source, "identities",
+                         f'expected "parameter expression = expression", got "{shorten(text)}"') from None
     terms = []
     for monomial, coefficient in zip(poly.monoms(), poly.coeffs()):
         indices = [j for j, power in enumerate(monomial) for _ in range(power)]

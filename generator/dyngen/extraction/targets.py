@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from ..description.expressions import ExpressionError, parse_expression, shorten
 from ..errors import InputError
 from ..parameters import PER_LINK, dynamic_symbols, standard_symbols
 
@@ -29,10 +30,7 @@ def linear_form(text: str, n_links: int) -> list:
     s = standard_symbols(n_links)
     p = dynamic_symbols(n_links)
     names = {sym.name: sym for sym in s + p}
-    expr = sp.sympify(text, locals=names, rational=True)
-    unknown = expr.free_symbols - set(names.values())
-    if unknown:
-        raise ValueError(f"unknown parameter names {', '.join(sorted(map(str, unknown)))}")
+    expr = parse_expression(text, names)  # whitelisted: nothing in the text runs
     # dynamic -> standard: c = mc/m, I_c = J - m (c.c E - c c^T)
     subs = {}
     for i in range(n_links):
@@ -58,12 +56,12 @@ def target(robot, base, kind: str) -> Target | None:
         field = f"identified.{kind}[{k}].coefficient"
         try:
             u = linear_form(entry.coefficient, robot.dof)
-        except (ValueError, TypeError, sp.SympifyError) as err:
-            raise InputError(robot.source, field, f'cannot use "{entry.coefficient}": {err}') from None
+        except (ExpressionError, ValueError, TypeError, sp.PolynomialError) as err:
+            raise InputError(robot.source, field, f'cannot use "{shorten(entry.coefficient)}": {err}') from None
         w = [u[j] for j in base.pivots]
         rebuilt = [sum(w[r] * K[r][j] for r in range(len(K))) for j in range(len(u))]
         if any(a != b for a, b in zip(rebuilt, u)):
-            raise InputError(robot.source, field, f'"{entry.coefficient}" is not identifiable from the '
+            raise InputError(robot.source, field, f'"{shorten(entry.coefficient)}" is not identifiable from the '
                              f"{kind} dynamics (not a combination of its base coefficients)")
         W.append([float(x) for x in w])
         v.append(entry.value)

@@ -48,4 +48,13 @@ def stacked(model, signals: list, kind: str) -> tuple[np.ndarray, np.ndarray]:
 def identify(model, signals: list, kind: str) -> Estimate:
     A, b = stacked(model, signals, kind)
     names = [e["standard"] for e in model.manifest["coefficients"][kind]["expressions"]]
-    return fit(A, b, names)
+    files = ", ".join(s.name for s in signals)
+    if A.shape[0] <= A.shape[1]:
+        per_sample = A.shape[0] // max(sum(len(s.t) for s in signals), 1) or 1
+        raise InputError(files, "", f"under-determined: {A.shape[0]} equations for {A.shape[1]} {kind} "
+                         f"coefficients; record at least {A.shape[1] // per_sample + 1} samples (many more, "
+                         "on an exciting trajectory, for a usable estimate)")
+    try:
+        return fit(A, b, names)
+    except np.linalg.LinAlgError as err:
+        raise InputError(files, "", f"least squares failed ({err}); check the recordings for extreme values") from None
