@@ -45,44 +45,22 @@ def _generate_parser(prog: str) -> argparse.ArgumentParser:
 
 
 def _extract_options(parser: argparse.ArgumentParser) -> None:
+    from .extraction.options import Options
+    from .options import add_arguments
+
     group = parser.add_argument_group("extraction (defaults: the YAML's `extraction:` block, then these)")
     group.add_argument("--out", default="out", metavar="DIR",
                        help="parent folder of the extraction results OUT/<name>/ (default: out)")
-    group.add_argument("--procedure", choices=("joint", "two-stage"),
-                       help="one stage over all coefficients (default), or the paper's two stages: "
-                            "gravity (eq. 16), then inertia with the gravity parameters fixed (eq. 19)")
-    group.add_argument("--restarts", type=int, metavar="K", help="random starts, eq. 17 (default 16)")
-    group.add_argument("--seed", type=int, help="seed of the random starts (default 1: reproducible)")
-    group.add_argument("--threads", type=int, default=0, help="threads for the restarts (default: all cores)")
-    group.add_argument("--global", dest="global_algorithm", choices=("isres", "none"), default="isres",
-                       help="global NLopt stage before the local SLSQP refinement (default isres)")
-    group.add_argument("--global-maxeval", type=int, default=1500, metavar="N", help="budget of the global stage")
-    group.add_argument("--local-maxeval", type=int, default=1000, metavar="N", help="budget of the local stage")
-    group.add_argument("--hops", type=int, default=0, metavar="N",
-                       help="basin-hopping kicks of each restart's local minimum (default 0)")
-    group.add_argument("--margin", type=float,
-                       help="consistency margin: smallest eigenvalue of tr(I)/2 E - I [kg m^2] (default 1e-7)")
-    group.add_argument("--identity", action="append", default=None, metavar="EQ",
-                       help='an identity imposed on the parameters, e.g. "I7xz = c7x*c7z*m7" (eq. 15); repeatable')
+    add_arguments(group, Options)
     group.add_argument("--compare", metavar="FILE",
                        help="a solution (YAML list of links under `solution:`) to compare with, e.g. the paper's")
 
 
 def _options_from(args, robot):
-    from .extraction.problem import Options
+    from .extraction.options import Options
+    from .options import resolve
 
-    settings = dict(robot.extraction)
-    options = Options(threads=args.threads, global_algorithm=args.global_algorithm,
-                      global_maxeval=args.global_maxeval, local_maxeval=args.local_maxeval, hops=args.hops)
-    for key in ("procedure", "restarts", "seed", "margin"):
-        value = getattr(args, key)
-        if value is None:
-            value = settings.get(key)
-        if value is not None:
-            setattr(options, key, value)
-    identities = args.identity if args.identity is not None else settings.get("identities", ())
-    options.identities = tuple(identities)
-    return options
+    return resolve(Options, args, robot.extraction)
 
 
 def cmd_main(argv, prog="dyngen") -> int:
