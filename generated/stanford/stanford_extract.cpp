@@ -74,22 +74,33 @@ struct Term {  // coefficient * prod p[index]
 };
 
 struct Problem {
-    Eigen::VectorXd lower, upper, value, reference, weight;
-    Eigen::VectorXd center;  // strictly inside every constraint (the start of the barrier method)
-    std::vector<int> free;  // indices of the free parameters
-    bool has_total_mass = false;
-    double mass_lo = 0, mass_hi = 0, margin = 0;
-    std::vector<Block> blocks;
-    // The next stage's targets (two-stage procedure): among the parameters that give this stage's
-    // fitted coefficients, the driver returns those that fit these best (see hand_off).
-    std::vector<Block> next_blocks;
-    std::vector<std::vector<Term>> equalities;
-    int restarts = 64, threads = 0, global_maxeval = 3000, local_maxeval = 2000, hops = 0;
-    double hop_size = 0.1;
-    unsigned long seed = 1;
-    std::string global_algorithm = "isres";
+    // Read from the problem file, in the order of extraction/protocol.py (SCHEMA): no defaults here,
+    // the Python options (extraction/options.py) are the only ones.
+    Eigen::VectorXd lower{};
+    Eigen::VectorXd upper{};
+    Eigen::VectorXd value{};
+    Eigen::VectorXd reference{};
+    Eigen::VectorXd weight{};
+    Eigen::VectorXd center{};
+    std::vector<int> free{};
+    bool has_total_mass{};
+    double mass_lo{};
+    double mass_hi{};
+    std::vector<Block> blocks{};
+    std::vector<Block> next_blocks{};
+    std::vector<std::vector<Term>> equalities{};
+    double margin{};
+    int restarts{};
+    unsigned long seed{};
+    int threads{};
+    std::string global_algorithm{};
+    int global_maxeval{};
+    int local_maxeval{};
+    double tolerance{};
+    int hops{};
+    double hop_size{};
+    // Derived after reading.
     double cost_scale = 1;  // sum_b ||v_b||^2: the optimisers see the relative cost
-    double tolerance = 1e-9;
 };
 
 // ---- reading the problem -------------------------------------------------------------------
@@ -141,32 +152,8 @@ std::vector<Block> read_blocks(Reader &r) {
     return blocks;
 }
 
-Problem read_problem(const std::string &path) {
-    Reader r(path);
-    Problem P;
-    r.expect("dyngen-extraction");
-    r.expect("1");
-    r.expect("parameters");
-    if (r.integer() != kParameters) throw std::runtime_error("parameter count does not match this robot");
-    r.expect("lower"); P.lower = r.vector(kParameters);
-    r.expect("upper"); P.upper = r.vector(kParameters);
-    r.expect("value"); P.value = r.vector(kParameters);
-    r.expect("reference"); P.reference = r.vector(kParameters);
-    r.expect("weight"); P.weight = r.vector(kParameters);
-    r.expect("center"); P.center = r.vector(kParameters);
-    r.expect("free");
-    for (int k = 0; k < kParameters; ++k)
-        if (r.integer()) P.free.push_back(k);
-    r.expect("total_mass");
-    P.has_total_mass = r.integer() != 0;
-    P.mass_lo = r.number();
-    P.mass_hi = r.number();
-    r.expect("margin"); P.margin = r.number();
-    r.expect("blocks");
-    P.blocks = read_blocks(r);
-    r.expect("next_blocks");
-    P.next_blocks = read_blocks(r);
-    r.expect("equalities");
+std::vector<std::vector<Term>> read_terms(Reader &r) {
+    std::vector<std::vector<Term>> polys;
     for (long e = r.integer(); e > 0; --e) {
         std::vector<Term> poly;
         for (long t = r.integer(); t > 0; --t) {
@@ -175,22 +162,157 @@ Problem read_problem(const std::string &path) {
             for (long f = r.integer(); f > 0; --f) term.index.push_back(static_cast<int>(r.integer()));
             poly.push_back(term);
         }
-        P.equalities.push_back(poly);
+        polys.push_back(poly);
     }
-    r.expect("restarts"); P.restarts = static_cast<int>(r.integer());
-    r.expect("seed"); P.seed = static_cast<unsigned long>(r.integer());
-    r.expect("threads"); P.threads = static_cast<int>(r.integer());
-    r.expect("global_algorithm"); P.global_algorithm = r.word();
-    r.expect("global_maxeval"); P.global_maxeval = static_cast<int>(r.integer());
-    r.expect("local_maxeval"); P.local_maxeval = static_cast<int>(r.integer());
-    r.expect("tolerance"); P.tolerance = r.number();
-    r.expect("hops"); P.hops = static_cast<int>(r.integer());
+    return polys;
+}
+
+Problem read_problem(const std::string &path) {
+    Reader r(path);
+    Problem P;
+    r.expect("dyngen-extraction");
+    r.expect("2");
+    r.expect("parameters");
+    if (r.integer() != kParameters) throw std::runtime_error("parameter count does not match this robot");
+    r.expect("lower");
+    P.lower = r.vector(kParameters);
+    r.expect("upper");
+    P.upper = r.vector(kParameters);
+    r.expect("value");
+    P.value = r.vector(kParameters);
+    r.expect("reference");
+    P.reference = r.vector(kParameters);
+    r.expect("weight");
+    P.weight = r.vector(kParameters);
+    r.expect("center");
+    P.center = r.vector(kParameters);
+    r.expect("free");
+    for (int k = 0; k < kParameters; ++k)
+        if (r.integer()) P.free.push_back(k);
+    r.expect("has_total_mass");
+    P.has_total_mass = static_cast<bool>(r.integer());
+    r.expect("mass_lo");
+    P.mass_lo = r.number();
+    r.expect("mass_hi");
+    P.mass_hi = r.number();
+    r.expect("blocks");
+    P.blocks = read_blocks(r);
+    r.expect("next_blocks");
+    P.next_blocks = read_blocks(r);
+    r.expect("equalities");
+    P.equalities = read_terms(r);
+    r.expect("margin");
+    P.margin = r.number();
+    r.expect("restarts");
+    P.restarts = static_cast<int>(r.integer());
+    r.expect("seed");
+    P.seed = static_cast<unsigned long>(r.integer());
+    r.expect("threads");
+    P.threads = static_cast<int>(r.integer());
+    r.expect("global_algorithm");
+    P.global_algorithm = r.word();
+    r.expect("global_maxeval");
+    P.global_maxeval = static_cast<int>(r.integer());
+    r.expect("local_maxeval");
+    P.local_maxeval = static_cast<int>(r.integer());
+    r.expect("tolerance");
+    P.tolerance = r.number();
+    r.expect("hops");
+    P.hops = static_cast<int>(r.integer());
+    r.expect("hop_size");
     P.hop_size = r.number();
     r.expect("end");
     double norm = 0;
     for (const Block &b : P.blocks) norm += b.v.squaredNorm();
     if (norm > 0) P.cost_scale = norm;
     return P;
+}
+
+// The problem as read, in the same format (`--echo`: the protocol's round-trip test).
+void write_problem(const std::string &path, const Problem &P) {
+    std::ofstream out(path);
+    out << std::setprecision(17);
+    out << "dyngen-extraction 2\nparameters " << kParameters << '\n';
+    out << "lower";
+    for (int k = 0; k < kParameters; ++k) out << ' ' << P.lower[k];
+    out << '\n';
+    out << "upper";
+    for (int k = 0; k < kParameters; ++k) out << ' ' << P.upper[k];
+    out << '\n';
+    out << "value";
+    for (int k = 0; k < kParameters; ++k) out << ' ' << P.value[k];
+    out << '\n';
+    out << "reference";
+    for (int k = 0; k < kParameters; ++k) out << ' ' << P.reference[k];
+    out << '\n';
+    out << "weight";
+    for (int k = 0; k < kParameters; ++k) out << ' ' << P.weight[k];
+    out << '\n';
+    out << "center";
+    for (int k = 0; k < kParameters; ++k) out << ' ' << P.center[k];
+    out << '\n';
+    out << "free";
+    for (int k = 0, i = 0; k < kParameters; ++k) {
+        const bool set = i < static_cast<int>(P.free.size()) && P.free[i] == k;
+        i += set;
+        out << ' ' << set;
+    }
+    out << '\n';
+    out << "has_total_mass";
+    out << ' ' << P.has_total_mass << '\n';
+    out << "mass_lo";
+    out << ' ' << P.mass_lo << '\n';
+    out << "mass_hi";
+    out << ' ' << P.mass_hi << '\n';
+    out << "blocks";
+    out << ' ' << P.blocks.size() << '\n';
+    for (const Block &b : P.blocks) {
+        out << b.kind->name << ' ' << b.W.rows() << '\n';
+        for (int i = 0; i < b.W.rows(); ++i, out << '\n')
+            for (int j = 0; j < b.W.cols(); ++j) out << (j ? " " : "") << b.W(i, j);
+        for (int i = 0; i < b.v.size(); ++i) out << (i ? " " : "") << b.v[i];
+        out << '\n';
+    }
+    out << "next_blocks";
+    out << ' ' << P.next_blocks.size() << '\n';
+    for (const Block &b : P.next_blocks) {
+        out << b.kind->name << ' ' << b.W.rows() << '\n';
+        for (int i = 0; i < b.W.rows(); ++i, out << '\n')
+            for (int j = 0; j < b.W.cols(); ++j) out << (j ? " " : "") << b.W(i, j);
+        for (int i = 0; i < b.v.size(); ++i) out << (i ? " " : "") << b.v[i];
+        out << '\n';
+    }
+    out << "equalities";
+    out << ' ' << P.equalities.size() << '\n';
+    for (const std::vector<Term> &poly : P.equalities) {
+        out << poly.size();
+        for (const Term &t : poly) {
+            out << ' ' << t.coefficient << ' ' << t.index.size();
+            for (int i : t.index) out << ' ' << i;
+        }
+        out << '\n';
+    }
+    out << "margin";
+    out << ' ' << P.margin << '\n';
+    out << "restarts";
+    out << ' ' << P.restarts << '\n';
+    out << "seed";
+    out << ' ' << P.seed << '\n';
+    out << "threads";
+    out << ' ' << P.threads << '\n';
+    out << "global_algorithm";
+    out << ' ' << P.global_algorithm << '\n';
+    out << "global_maxeval";
+    out << ' ' << P.global_maxeval << '\n';
+    out << "local_maxeval";
+    out << ' ' << P.local_maxeval << '\n';
+    out << "tolerance";
+    out << ' ' << P.tolerance << '\n';
+    out << "hops";
+    out << ' ' << P.hops << '\n';
+    out << "hop_size";
+    out << ' ' << P.hop_size << '\n';
+    out << "end\n";
 }
 
 // ---- objective and constraints over the free parameters ------------------------------------
@@ -1104,16 +1226,21 @@ void write_vector(std::ostream &out, const char *key, const Eigen::VectorXd &x) 
 }  // namespace
 
 int main(int argc, char **argv) {
-    if (argc != 3) {
-        std::cerr << "usage: " << argv[0] << " PROBLEM_FILE RESULT_FILE\n";
+    const bool echo = argc == 4 && std::string(argv[1]) == "--echo";
+    if (argc != 3 && !echo) {
+        std::cerr << "usage: " << argv[0] << " [--echo] PROBLEM_FILE RESULT_FILE\n";
         return 2;
     }
     Problem P;
     try {
-        P = read_problem(argv[1]);
+        P = read_problem(argv[argc - 2]);
     } catch (const std::exception &e) {
-        std::cerr << argv[1] << ": " << e.what() << '\n';
+        std::cerr << argv[argc - 2] << ": " << e.what() << '\n';
         return 2;
+    }
+    if (echo) {  // write the problem back as read: the protocol's round-trip test
+        write_problem(argv[3], P);
+        return 0;
     }
     const int threads = P.threads > 0 ? P.threads : std::max(1u, std::thread::hardware_concurrency());
     const StandardBarrier barrier(P, P.blocks);

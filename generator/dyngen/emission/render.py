@@ -10,6 +10,7 @@ import jinja2
 
 from .. import __version__, catalogue
 from ..catalogue import FRICTION_PER_JOINT, KIND_LABELS, KINDS
+from ..extraction import protocol
 from ..derivation.models import base_regressor_outputs, coefficient_jacobian_model, coefficient_model
 from ..parameters import PER_LINK, dynamic_name, standard_name
 from ..reduction.identifiability import classify
@@ -69,7 +70,9 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
     files[f"{P}_friction.c"] = env.get_template("friction.c.j2").render(**common)
-    files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(**common)
+    files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(
+        protocol=[{"key": f.key, "kind": f.kind, "cpp_type": f.cpp_type} for f in protocol.SCHEMA],
+        protocol_magic=protocol.MAGIC, protocol_version=protocol.VERSION, **common)
     check = selftest_data(robot, programs)
     files[f"{P}_selftest.c"] = env.get_template("selftest.c.j2").render(
         data=check, checks=selftest_checks(P, dims, bool(gravity_symbols)), n_states=N_STATES,

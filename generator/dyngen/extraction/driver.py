@@ -14,6 +14,7 @@ import numpy as np
 from .. import cache
 from ..errors import DriverError
 from .problem import Options, Problem, Stage
+from .protocol import problem_text
 
 
 def eigen_include() -> str:
@@ -58,35 +59,6 @@ def _run(cmd):
         raise DriverError(f"{cmd[0]} not found: run scripts/setup.sh") from None
     except subprocess.CalledProcessError as err:
         raise DriverError(f"building the extractor failed:\n{err.stderr[-2000:]}") from None
-
-
-def problem_text(problem: Problem, stage: Stage, options: Options) -> str:
-    def vec(x):
-        return " ".join(repr(float(v)) for v in x)
-
-    lines = ["dyngen-extraction 1", f"parameters {problem.lower.size}",
-             f"lower {vec(problem.lower)}", f"upper {vec(problem.upper)}", f"value {vec(stage.value)}",
-             f"reference {vec(problem.reference)}", f"weight {vec(problem.weight)}",
-             f"center {vec(problem.center)}",
-             "free " + " ".join(str(int(f)) for f in stage.free)]
-    lo, hi = problem.total_mass if problem.total_mass else (0.0, 0.0)
-    lines.append(f"total_mass {int(problem.total_mass is not None)} {lo!r} {hi!r}")
-    lines.append(f"margin {options.margin!r}")
-    for key, blocks in (("blocks", stage.blocks), ("next_blocks", stage.next_blocks)):
-        lines.append(f"{key} {len(blocks)}")
-        for block in blocks:
-            lines.append(f"{block.kind} {block.W.shape[0]}")
-            lines.extend(vec(row) for row in block.W)
-            lines.append(vec(block.v))
-    lines.append(f"equalities {len(problem.equalities)}")
-    for terms in problem.equalities:
-        lines.append(str(len(terms)) + " " + " ".join(
-            f"{c!r} {len(idx)} " + " ".join(map(str, idx)) for c, idx in terms))
-    lines += [f"restarts {options.restarts}", f"seed {options.seed}", f"threads {options.threads}",
-              f"global_algorithm {options.global_algorithm}", f"global_maxeval {options.global_maxeval}",
-              f"local_maxeval {options.local_maxeval}", f"tolerance {options.tolerance!r}",
-              f"hops {options.hops} {options.hop_size!r}", "end"]
-    return "\n".join(lines) + "\n"
 
 
 @dataclass
