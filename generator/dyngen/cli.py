@@ -141,12 +141,14 @@ def _run_extraction(args, robot, bases, folder):
 
 
 def _write_extraction(args, robot, folder, extraction, options, seconds, compare) -> None:
-    from .atomic import write_file
+    from .atomic import write_file, write_folder
+    from .extraction.driver import standalone_files
     from .extraction import report
 
     progress = Progress(quiet=args.quiet)
     out = Path(args.out) / robot.name
     write_file(out / "extracted.yaml", report.extracted_yaml(robot, extraction, options, seconds))
+    write_folder(out / "extractor", standalone_files(folder))  # the driver as a program of its own
     columns = {"dyngen": extraction.p}
     if compare:
         columns = {compare[0]: compare[1], **columns}

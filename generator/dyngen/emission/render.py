@@ -10,7 +10,6 @@ import jinja2
 
 from .. import __version__, catalogue
 from ..catalogue import FRICTION_PER_JOINT, KIND_LABELS, KINDS
-from ..extraction import protocol
 from ..derivation.models import base_regressor_outputs, coefficient_jacobian_model, coefficient_model
 from ..parameters import PER_LINK, dynamic_name, standard_name
 from ..reduction.identifiability import classify
@@ -70,9 +69,10 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
     files[f"{P}_friction.c"] = env.get_template("friction.c.j2").render(**common)
-    files[f"{P}_extract.cpp"] = env.get_template("extract.cpp.j2").render(
-        protocol=[{"key": f.key, "kind": f.kind, "cpp_type": f.cpp_type} for f in protocol.SCHEMA],
-        protocol_magic=protocol.MAGIC, protocol_version=protocol.VERSION, **common)
+    files[f"{P}_kinds.h"] = env.get_template("kinds.h.j2").render(
+        standard_from_dynamic=catalogue.STANDARD_FROM_DYNAMIC.name,
+        kinds=[{"name": kind, "pi": catalogue.COEFFICIENTS[kind].name, "jacobian": catalogue.JACOBIANS[kind].name}
+               for kind in KINDS], **{k: v for k, v in common.items() if k != "kinds"})
     check = selftest_data(robot, programs)
     files[f"{P}_selftest.c"] = env.get_template("selftest.c.j2").render(
         data=check, checks=selftest_checks(P, dims, bool(gravity_symbols)), n_states=N_STATES,
@@ -84,7 +84,8 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     manifest = _manifest(robot, functions, kinds, std_names, n_stacked)
     manifest["functions"].append(_template_function_manifest(P, catalogue.FRICTION, dims))
     manifest["files"] = {"library": library, "header": f"{P}.h", "eigen_header": f"{P}.hpp",
-                         "selftest": f"{P}_selftest.c", "cmake": "CMakeLists.txt"}
+                         "selftest": f"{P}_selftest.c", "cmake": "CMakeLists.txt",
+                         "extractor_kinds": f"{P}_kinds.h"}
     manifest["selftest"] = check.as_dict() | {"tolerance": TOLERANCE}
     files["manifest.json"] = json.dumps(manifest, indent=1) + "\n"
     return Emitted(files, functions, manifest)

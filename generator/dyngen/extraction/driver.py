@@ -1,4 +1,4 @@
-"""Build the emitted NLopt driver (<robot>_extract.cpp) and run it on a problem file."""
+"""Build the static NLopt driver (extractor/driver.cpp) for one arm and run it on a problem file."""
 
 from __future__ import annotations
 
@@ -28,28 +28,74 @@ def eigen_include() -> str:
         raise DriverError("Eigen 3 not found: run scripts/setup.sh (apt package libeigen3-dev)") from None
 
 
+DRIVER = Path(__file__).resolve().parents[1] / "extractor"  # the static driver's sources (package data)
+CORE_SOURCES = ("driver.cpp", "protocol.hpp", "robot.h")
+
+
+def _digest(paths) -> str:
+    return hashlib.sha256(b"".join(Path(p).read_bytes() for p in paths)).hexdigest()[:16]
+
+
+def build_core(cache_dir: Path | None = None) -> Path:
+    """The static driver (driver.cpp, Eigen and NLopt: the slow part) compiled once per user and
+    source content into the per-user cache; every arm links this object."""
+    cache_dir = cache.folder("drivers", cache_dir)
+    obj = cache_dir / f"driver-{_digest(DRIVER / name for name in CORE_SOURCES)}.o"
+    if cache.verified(obj):
+        return obj
+    work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
+    try:
+        tmp = work / obj.name
+        _run(["c++", "-O2", "-std=c++17", "-I", str(DRIVER), "-I", eigen_include(), "-c", str(DRIVER / "driver.cpp"),
+              "-o", str(tmp)])
+        cache.install(tmp, obj)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return obj
+
+
 def build(folder: Path, cache_dir: Path | None = None) -> Path:
-    """Compile the driver once per source content into the per-user cache (dyngen.cache;
-    `cache_dir` replaces its root); returns the executable, its recorded hash checked."""
+    """The extractor of the arm generated in `folder`: the static driver (build_core) linked
+    with the arm's generated C (<robot>_parameters.c, <robot>_kinds.h) and robot.c, once per
+    content into the per-user cache (dyngen.cache; `cache_dir` replaces its root); returns the
+    executable, its recorded hash checked."""
     folder = Path(folder)
     name = folder.name
-    sources = [folder / f"{name}_extract.cpp", folder / f"{name}_parameters.c", folder / f"{name}.h"]
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:16]
+    core = build_core(cache_dir)
+    sources = [folder / f"{name}_parameters.c", folder / f"{name}.h", folder / f"{name}_kinds.h", DRIVER / "robot.c"]
     cache_dir = cache.folder("drivers", cache_dir)
-    exe = cache_dir / f"{name}_extract-{digest}"
+    exe = cache_dir / f"{name}_extract-{_digest([core, *sources])}"
     if cache.verified(exe):
         return exe
     work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
     try:
-        obj = work / "parameters.o"
-        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(sources[1]), "-o", str(obj)])
+        objects = [work / "parameters.o", work / "robot.o"]
+        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(sources[0]), "-o", str(objects[0])])
+        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-I", str(DRIVER), f'-DDYNGEN_KINDS_H="{name}_kinds.h"',
+              "-c", str(sources[3]), "-o", str(objects[1])])
         tmp_exe = work / exe.name
-        _run(["c++", "-O2", "-std=c++17", "-I", str(folder), "-I", eigen_include(), str(sources[0]), str(obj),
-              "-o", str(tmp_exe), "-lnlopt", "-lpthread"])
+        if not cache.verified(core):  # checked again right before it is linked in
+            raise DriverError(f"{core} changed after it was built; run again to rebuild it")
+        _run(["c++", str(core), *map(str, objects), "-o", str(tmp_exe), "-lnlopt", "-lpthread"])
         cache.install(tmp_exe, exe)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return exe
+
+
+def standalone_files(folder: Path) -> dict:
+    """The driver as a standalone program for the arm generated in `folder` (outside that
+    firmware folder: it needs NLopt and threads): file name -> text."""
+    name = Path(folder).name
+    files = {source.name: source.read_text() for source in sorted(DRIVER.iterdir()) if source.suffix in (".cpp", ".hpp", ".h", ".c")}
+    files["BUILD.txt"] = (
+        f"The extractor driver of {name} (dyngen extract builds the same program in its cache).\n"
+        f"With the generated folder of {name} as MODEL (it holds {name}.h, {name}_parameters.c, {name}_kinds.h):\n\n"
+        "  c++ -O2 -std=c++17 -I. -I/usr/include/eigen3 -c driver.cpp\n"
+        f"  cc -O2 -std=c99 -I. -IMODEL -DDYNGEN_KINDS_H='\"{name}_kinds.h\"' -c robot.c MODEL/{name}_parameters.c\n"
+        f"  c++ driver.o robot.o {name}_parameters.o -lnlopt -lpthread -o {name}_extract\n\n"
+        f"  ./{name}_extract PROBLEM_FILE RESULT_FILE   (the problem file: extraction/protocol.py)\n")
+    return files
 
 
 def _run(cmd):

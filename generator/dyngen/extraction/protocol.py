@@ -2,8 +2,9 @@
 
 One line per field, `key value...`, in the order of SCHEMA. The Python writer (`problem_text`)
 and reader (`read_problem_text`) below and the C++ reader, writer and the members of the
-driver's Problem (templates/extract/problem.cpp.j2, rendered from SCHEMA) all follow it, so an
-option is added by one line here (and its field in extraction/options.py).
+driver's Problem (generator/dyngen/extractor/protocol.hpp, rendered from SCHEMA by `cpp_header`
+through templates/protocol.hpp.j2) all follow it, so an option is added by one line here (and
+its field in extraction/options.py), then `python3 -m dyngen.extraction.protocol`.
 
 Kinds (C++ type, and the text after the key):
   integer   int, or the field's `cpp` type     one whole number
@@ -18,6 +19,7 @@ Kinds (C++ type, and the text after the key):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -165,3 +167,18 @@ def read_problem_text(text: str, ranks: dict) -> dict:
             out[field.key] = polys
     expect("end")
     return out
+
+
+def cpp_header() -> str:
+    """protocol.hpp of the static driver (generator/dyngen/extractor/), rendered from SCHEMA."""
+    from ..emission.render import environment
+
+    return environment().get_template("protocol.hpp.j2").render(
+        protocol=[{"key": f.key, "kind": f.kind, "cpp_type": f.cpp_type} for f in SCHEMA],
+        protocol_magic=MAGIC, protocol_version=VERSION)
+
+
+HEADER = Path(__file__).resolve().parents[1] / "extractor" / "protocol.hpp"
+
+if __name__ == "__main__":  # rewrite the checked-in header after a schema change
+    HEADER.write_text(cpp_header())
