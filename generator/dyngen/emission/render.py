@@ -19,7 +19,7 @@ from .eigen import eigen_interface
 from .inertia_regressor import render_inertia_regressor
 from .selftest import N_STATES, TOLERANCE, c_numbers, selftest_checks, selftest_data
 
-TEMPLATES = Path(__file__).resolve().parents[1] / "templates"  # a link to the top-level templates/, shipped in the wheel
+TEMPLATES = Path(__file__).resolve().parents[1] / "templates"  # package data, shipped in the wheel
 
 
 @dataclass
