@@ -81,6 +81,11 @@ def _out_of_bounds(value, bounds) -> str:
     return ""
 
 
+def _short(value) -> str:
+    text = repr(value)  # the value comes from an untrusted file: never echo much of it
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def yaml_keys(cls) -> set:
     return {f.name for f in fields(cls)}
 
@@ -99,9 +104,9 @@ def check_yaml(cls, block: dict, fail, prefix: str) -> dict:
             continue
         if m["choices"]:
             if value not in m["choices"]:
-                fail(where, "expected " + " or ".join(f'"{c}"' for c in m["choices"]) + f", got {value!r}"[:80])
+                fail(where, "expected " + " or ".join(f'"{c}"' for c in m["choices"]) + f", got {_short(value)}")
         elif isinstance(value, bool) or not isinstance(value, (int, float) if kind is float else kind):
-            fail(where, f"expected {_what(kind, m['bounds'])}, got {type(value).__name__}")
+            fail(where, f"expected {_what(kind, m['bounds'])}, got {_short(value)}")
         else:
             problem = _out_of_bounds(value, m["bounds"])
             if problem:

@@ -26,7 +26,7 @@ _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
 _IDENTIFIED_KINDS = ("gravity", "inertia", "full")
-_C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_extract.cpp and the like
+_C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_kinds.h and the like
 MAX_JOINTS = 20
 # Ranges no real serial arm leaves (SI units); outside them a value is a typo or an attack, and
 # extreme magnitudes (1e308, 1e-320) would overflow or underflow the generated self-test.
