@@ -6,6 +6,7 @@ import argparse
 import time
 from pathlib import Path
 
+from .arguments import real, whole
 from .errors import InputError
 from .progress import Progress
 
@@ -17,10 +18,10 @@ def _data_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--data", action="append", required=True, metavar="CSV",
                         help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
     group = parser.add_argument_group("signal conditioning (the paper: 4th order, 1 Hz)")
-    group.add_argument("--cutoff", type=float, metavar="HZ",
+    group.add_argument("--cutoff", type=real(0, 1e6, above=True), metavar="HZ",
                        help="zero-phase Butterworth low-pass on positions, velocities and torques alike "
                             "(default: none)")
-    group.add_argument("--order", type=int, default=4, metavar="N", help="Butterworth order (default 4)")
+    group.add_argument("--order", type=whole(1, 12), default=4, metavar="N", help="Butterworth order (default 4)")
     group.add_argument("--differentiate", action="store_true",
                        help="compute qd, qdd from q even when the file has them")
     parser.add_argument("--model", metavar="DIR",
@@ -134,9 +135,9 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     parser.add_argument("--effects", metavar="LIST",
                         help="comma-separated effects to try (default all: offset, coulomb, viscous, stribeck, "
                              "armature, gain, payload, tilt, time_shift, coefficients)")
-    parser.add_argument("--min-gain", type=float, default=None, metavar="G",
+    parser.add_argument("--min-gain", type=real(0, 1), default=None, metavar="G",
                         help="least held-out gain to select an effect (default 0.05: 5%% of a joint's mean square)")
-    parser.add_argument("--sign-velocity", type=float, default=0.002, metavar="V",
+    parser.add_argument("--sign-velocity", type=real(0, 1e3, above=True), default=0.002, metavar="V",
                         help="sign(qd) is smoothed as tanh(qd / V) (default 0.002 rad/s)")
     args = parser.parse_args(argv)
     from .description import load_robot

@@ -9,9 +9,10 @@ Flags default to None so that "not given" is visible; their help shows the datac
 
 from __future__ import annotations
 
-import argparse
 import math
 from dataclasses import MISSING, field, fields
+
+from .arguments import real, whole
 
 
 def option(default, help: str, *, flag: str = "", metavar: str = "", choices: tuple = (),
@@ -52,20 +53,9 @@ def add_arguments(group, cls) -> None:
 
 
 def _parser(f):
-    kind, bounds = type(default_of(f)), f.metadata["bounds"]
-
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {_what(kind, bounds)}, got {text!r}") from None
-        problem = _out_of_bounds(value, bounds)
-        if problem:
-            raise argparse.ArgumentTypeError(problem)
-        return value
-
-    parse.__name__ = kind.__name__  # argparse names the type in its messages
-    return parse
+    """The argparse type of a number option: arguments.whole or arguments.real over its bounds."""
+    kind, bounds = type(default_of(f)), f.metadata["bounds"] or (-math.inf, math.inf)
+    return whole(*bounds) if kind is int else real(*bounds)
 
 
 def _what(kind, bounds) -> str:

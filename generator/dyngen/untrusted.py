@@ -91,6 +91,8 @@ def read_yaml(path):
         mark = getattr(err, "problem_mark", None) or getattr(err, "context_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        if "could not determine a constructor" in problem:
+            problem = "tags such as !!python/... are not allowed (plain data only)"
         raise InputError(name, where, f"malformed YAML: {_short(problem)}") from None
     except RecursionError:
         raise InputError(name, "", "malformed YAML: nested too deeply") from None

@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -107,7 +108,9 @@ def _check_header(name, header, dof, require_torques, required) -> dict:
 def _numbers(body: str, name, header) -> np.ndarray:
     """Fast path with numpy; on failure, a slow pass that finds the exact line and column."""
     try:
-        data = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, dtype=float)
+        with warnings.catch_warnings():  # an empty body is reported below, with its line
+            warnings.simplefilter("ignore")
+            data = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2, dtype=float)
     except ValueError:
         data = None
     if data is not None and data.ndim == 2 and data.shape[1] == len(header) and data.shape[0] > 0:

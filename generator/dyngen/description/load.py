@@ -154,8 +154,13 @@ class _Reader:
                 for side in text.split("="):
                     self.expression(side, field, names)
             value["identities"] = tuple(ids)
-        if "compare" in value and not isinstance(value["compare"], str):
-            self.fail("extraction.compare", f"expected a file name, got {_describe(value['compare'])}")
+        if "compare" in value:
+            compare = value["compare"]
+            # A description from someone else must not make dyngen read files outside its folder.
+            if (not isinstance(compare, str) or not compare or len(compare) > 255 or Path(compare).is_absolute()
+                    or ".." in Path(compare).parts or "\0" in compare):
+                self.fail("extraction.compare", "expected the name of a file in the description's folder, got "
+                          f"{_describe(compare)}")
         return value
 
     def joint(self, value, field) -> Joint:
