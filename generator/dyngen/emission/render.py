@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -77,7 +78,8 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     files[f"{P}_selftest.c"] = env.get_template("selftest.c.j2").render(
         data=check, checks=selftest_checks(P, dims, bool(gravity_symbols)), n_states=N_STATES,
         tolerance=TOLERANCE, **common)
-    files[f"{P}.hpp"] = env.get_template("eigen.hpp.j2").render(eigen=eigen_interface(P, dims, {c.name: c.doc for c in functions}), **common)
+    eigen = eigen_interface(P, dims, {c.name: c.doc for c in functions})
+    files[f"{P}.hpp"] = env.get_template("eigen.hpp.j2").render(eigen=eigen, **common)
     library = sorted([*sources, f"{P}_friction.c"])
     files["CMakeLists.txt"] = env.get_template("CMakeLists.txt.j2").render(sources=library, **common)
     files["coefficients.md"] = env.get_template("coefficients.md.j2").render(**common)
@@ -134,17 +136,10 @@ def _c_function(robot, f, programs: dict, models: dict, bases: dict, dims: dict)
 def _template_function_manifest(P: str, f, dims: dict) -> dict:
     """A function written by its own template (not a straight-line program: a loop over joints)."""
     return {"name": f"{P}_{f.name}", "doc": f.doc,
-            "inputs": [{"name": a, "length": _length(catalogue.ARGUMENTS[a].shape, dims),
+            "inputs": [{"name": a, "length": math.prod(dims[d] for d in catalogue.ARGUMENTS[a].shape),
                         "meaning": catalogue.ARGUMENTS[a].meaning} for a in f.inputs],
             "output": {"name": f.output.name, "shape": [dims[d] for d in f.output.shape], "meaning": f.output.meaning},
             "ops": None}
-
-
-def _length(shape, dims) -> int:
-    length = 1
-    for d in shape:
-        length *= dims[d]
-    return length
 
 
 def _gravity_text(g) -> str:
