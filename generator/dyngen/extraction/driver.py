@@ -36,22 +36,31 @@ def _digest(paths) -> str:
     return hashlib.sha256(b"".join(Path(p).read_bytes() for p in paths)).hexdigest()[:16]
 
 
+def _cached(target: Path, make) -> Path:
+    """`target` from the cache while its recorded hash still matches; else make(work, built)
+    builds it in a private temporary folder beside it, and it is installed (dyngen.cache)."""
+    if cache.verified(target):
+        return target
+    work = Path(tempfile.mkdtemp(prefix="build-", dir=target.parent))
+    try:
+        built = work / target.name
+        make(work, built)
+        cache.install(built, target)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return target
+
+
 def build_core(cache_dir: Path | None = None) -> Path:
     """The static driver (driver.cpp, Eigen and NLopt: the slow part) compiled once per user and
     source content into the per-user cache; every arm links this object."""
-    cache_dir = cache.folder("drivers", cache_dir)
-    obj = cache_dir / f"driver-{_digest(DRIVER / name for name in CORE_SOURCES)}.o"
-    if cache.verified(obj):
-        return obj
-    work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
-    try:
-        tmp = work / obj.name
+    folder = cache.folder("drivers", cache_dir)
+
+    def make(work, built):
         _run(["c++", "-O2", "-std=c++17", "-I", str(DRIVER), "-I", eigen_include(), "-c", str(DRIVER / "driver.cpp"),
-              "-o", str(tmp)])
-        cache.install(tmp, obj)
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    return obj
+              "-o", str(built)])
+
+    return _cached(folder / f"driver-{_digest(DRIVER / name for name in CORE_SOURCES)}.o", make)
 
 
 def build(folder: Path, cache_dir: Path | None = None) -> Path:
@@ -62,32 +71,27 @@ def build(folder: Path, cache_dir: Path | None = None) -> Path:
     folder = Path(folder)
     name = folder.name
     core = build_core(cache_dir)
-    sources = [folder / f"{name}_parameters.c", folder / f"{name}.h", folder / f"{name}_kinds.h", DRIVER / "robot.c"]
-    cache_dir = cache.folder("drivers", cache_dir)
-    exe = cache_dir / f"{name}_extract-{_digest([core, *sources])}"
-    if cache.verified(exe):
-        return exe
-    work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
-    try:
+    parameters, robot_c = folder / f"{name}_parameters.c", DRIVER / "robot.c"
+    sources = [parameters, folder / f"{name}.h", folder / f"{name}_kinds.h", robot_c]
+
+    def make(work, built):
         objects = [work / "parameters.o", work / "robot.o"]
-        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(sources[0]), "-o", str(objects[0])])
+        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(parameters), "-o", str(objects[0])])
         _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-I", str(DRIVER), f'-DDYNGEN_KINDS_H="{name}_kinds.h"',
-              "-c", str(sources[3]), "-o", str(objects[1])])
-        tmp_exe = work / exe.name
+              "-c", str(robot_c), "-o", str(objects[1])])
         if not cache.verified(core):  # checked again right before it is linked in
             raise DriverError(f"{core} changed after it was built; run again to rebuild it")
-        _run(["c++", str(core), *map(str, objects), "-o", str(tmp_exe), "-lnlopt", "-lpthread"])
-        cache.install(tmp_exe, exe)
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    return exe
+        _run(["c++", str(core), *map(str, objects), "-o", str(built), "-lnlopt", "-lpthread"])
+
+    return _cached(cache.folder("drivers", cache_dir) / f"{name}_extract-{_digest([core, *sources])}", make)
 
 
 def standalone_files(folder: Path) -> dict:
     """The driver as a standalone program for the arm generated in `folder` (outside that
     firmware folder: it needs NLopt and threads): file name -> text."""
     name = Path(folder).name
-    files = {source.name: source.read_text() for source in sorted(DRIVER.iterdir()) if source.suffix in (".cpp", ".hpp", ".h", ".c")}
+    files = {source.name: source.read_text() for source in sorted(DRIVER.iterdir())
+             if source.suffix in (".cpp", ".hpp", ".h", ".c")}
     files["BUILD.txt"] = (
         f"The extractor driver of {name} (dyngen extract builds the same program in its cache).\n"
         f"With the generated folder of {name} as MODEL (it holds {name}.h, {name}_parameters.c, {name}_kinds.h):\n\n"
