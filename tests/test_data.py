@@ -103,3 +103,26 @@ def test_bad_cutoff_names_the_option(tmp_path):
     path = write(tmp_path, HEADER, good_rows(50))
     with pytest.raises(InputError, match="cutoff: 80 Hz must lie between 0 and half the sampling rate"):
         condition(read_recording(path, N), Conditioning(cutoff=80.0))
+
+
+@pytest.mark.parametrize("rate", [200.0, 500.0, 1000.0])
+def test_automatic_conditioning_of_encoder_positions(tmp_path, rate):
+    """Positions from a 20-bit encoder with 1e-5 rad noise, no velocity columns: the cutoff is
+    chosen from the recording, and the accelerations come out within 2 % of the motion's
+    (central differences of the raw positions would be noisy by tens of rad/s^2 here)."""
+    t = np.arange(0, 20, 1 / rate)
+    w = 2 * np.pi * np.array([0.1, 0.3, 0.5])
+    q = np.column_stack([0.8 * np.sin(w[0] * t) + 0.2 * np.sin(w[2] * t + 1), 0.5 * np.cos(w[1] * t)])
+    qdd = np.column_stack([-0.8 * w[0] ** 2 * np.sin(w[0] * t) - 0.2 * w[2] ** 2 * np.sin(w[2] * t + 1),
+                           -0.5 * w[1] ** 2 * np.cos(w[1] * t)])
+    step = 2 * np.pi / 2 ** 20
+    measured = np.round((q + 1e-5 * np.random.default_rng(1).standard_normal(q.shape)) / step) * step
+    path = write(tmp_path, HEADER, np.column_stack([t, measured, q]).tolist())
+    s = condition(read_recording(path, N))
+    assert 2.0 < s.cutoff < 0.2 * rate and s.trim > 0 and "chosen from the data" in s.note
+    inner = s.inner()
+    error = np.sqrt(np.mean((s.qdd[inner] - qdd[inner]) ** 2))
+    assert error < 0.02 * np.sqrt(np.mean(qdd ** 2))
+    raw = np.gradient(np.gradient(measured, t, axis=0), t, axis=0)
+    assert np.sqrt(np.mean((raw - qdd) ** 2)) > 50 * error
+    assert condition(read_recording(path, N), Conditioning(cutoff=3.0)).cutoff == 3.0  # the override

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # The real-arm example: three KUKA LWR4+ runs (FloBaRoID, LGPL-3.0; see README.md).
 # 1. identify the full base coefficients on measurement 1 (least squares, eq. 11);
-# 2. diagnose the paper's parameters: fit effects on measurement 1, select and judge them on
-#    measurement 3 (a different, faster trajectory), write report, JSON, figures, effects.
+# 2. diagnose the paper's parameters: fit effects on measurement 1 (selection on blocks of it),
+#    test on measurement 3 (a different, faster trajectory), write report, JSON, figures, effects.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 HERE=examples/lwr4-real
 python3 -m dyngen identify examples/lwr.yaml --data $HERE/measurement_1.csv -o $HERE/results/identified_full.yaml
 python3 -m dyngen diagnose examples/lwr.yaml --params examples/lwr_paper_solution.yaml \
-    --data $HERE/measurement_1.csv --holdout $HERE/measurement_3.csv --out $HERE/results
+    --data $HERE/measurement_1.csv --test $HERE/measurement_3.csv --out $HERE/results

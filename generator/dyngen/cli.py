@@ -21,7 +21,7 @@ dyngen: robot dynamic models as exact, standalone C from a DH table.
                                        coefficients, written to OUT/<name>/
   dyngen identify ROBOT.yaml --data a.csv [--kind full|gravity|inertia]
                                        base coefficients by least squares from recordings
-  dyngen diagnose ROBOT.yaml --params P.yaml --data a.csv [--holdout b.csv]
+  dyngen diagnose ROBOT.yaml --params P.yaml --data a.csv [--test b.csv]
                                        where the measured-model gap lies and which effect explains it
 
 Run `dyngen COMMAND --help` for a command's options. The YAML schema and the parameter

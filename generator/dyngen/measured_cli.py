@@ -17,16 +17,31 @@ def _data_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
     parser.add_argument("--data", action="append", required=True, metavar="CSV",
                         help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
-    group = parser.add_argument_group("signal conditioning (the paper: 4th order, 1 Hz)")
-    group.add_argument("--cutoff", type=real(0, 1e6, above=True), metavar="HZ",
-                       help="zero-phase Butterworth low-pass on positions, velocities and torques alike "
-                            "(default: none)")
+    group = parser.add_argument_group("signal conditioning")
+    group.add_argument("--cutoff", type=_cutoff, default="auto", metavar="HZ",
+                       help="override: zero-phase Butterworth low-pass on positions and torques alike, in Hz, or "
+                            "'none'. Default: recorded qd, qdd are used as they are; otherwise q is differentiated "
+                            "through a cutoff chosen from the recording (its position noise against the motion's "
+                            "acceleration), and the choice is reported")
     group.add_argument("--order", type=whole(1, 12), default=4, metavar="N", help="Butterworth order (default 4)")
     group.add_argument("--differentiate", action="store_true",
                        help="compute qd, qdd from q even when the file has them")
     parser.add_argument("--model", metavar="DIR",
                         help="an already generated folder of this robot (default: generate it first)")
-    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")
+
+
+def _cutoff(text: str):
+    """A cutoff in Hz, or "auto" (chosen from each recording) or "none" (no filter)."""
+    if text in ("auto", "none"):
+        return None if text == "none" else "auto"
+    return real(0, 1e6, above=True)(text)
+
+
+def _enough(name: str, t) -> None:
+    if len(t) < MIN_DIAGNOSIS_SAMPLES:
+        raise InputError(name, "", f"{len(t)} samples; a diagnosis needs at least {MIN_DIAGNOSIS_SAMPLES} "
+                         "(seconds of motion at the recording's rate)")
 
 
 def _conditioning(args):
@@ -35,9 +50,10 @@ def _conditioning(args):
     return Conditioning(cutoff=args.cutoff, order=args.order, differentiate=args.differentiate)
 
 
-def _conditioning_text(args) -> str:
-    text = "as recorded" if args.cutoff is None else f"Butterworth order {args.order}, {args.cutoff:g} Hz, zero phase"
-    return text + ("; qd, qdd differentiated from q" if args.differentiate else "")
+def _conditioning_text(signals) -> str:
+    """What conditioning did, per recording (the automatic choice differs between recordings)."""
+    notes = sorted({s.note for s in signals})
+    return notes[0] if len(notes) == 1 else "; ".join(f"{s.name}: {s.note}" for s in signals)
 
 
 def _model(args, robot, progress):
@@ -99,13 +115,13 @@ def cmd_identify(argv, prog="dyngen identify") -> int:
     from .atomic import write_file
 
     write_file(out, identified_yaml(robot.name, {args.kind: estimate}, [Path(p).name for p in args.data],
-                                    _conditioning_text(args)))
+                                    _conditioning_text(signals)))
     if not args.quiet:
         print(f"{robot.name}: {len(estimate.names)} {args.kind} coefficients from {estimate.rows} equations; "
               f"condition number {estimate.condition:.3g} (columns scaled {estimate.scaled_condition:.3g}); "
               f"residual RMS {estimate.residual_rms:.4g}")
         print("\n".join("  " + line for line in summary_table(args.kind, estimate).splitlines()))
-        for w in estimate.warnings():
+        for w in [*estimate.warnings(), *(w for s in signals for w in s.warnings)]:
             print(f"  warning: {w}")
         print(f"  written: {out}")
     return 0
@@ -120,26 +136,39 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     parser = argparse.ArgumentParser(prog=prog, description=(
         "Diagnose the gap between measured torques and the Newton-Euler model with given link parameters: "
         "where the residual lies (per joint, per phase of the motion), which unmodelled effects explain it "
-        "(Coulomb, viscous and Stribeck friction, rotor inertia, sensor offset and gain, payload, tilted "
-        "base, time shift, coefficient errors; chosen by their gain on held-out data) and how far it shrinks. "
-        "Writes report.md, diagnosis.json, effects.yaml, torques.png, residuals.png and, for consistent "
-        "parameters, URDF and MJCF with the selected friction."))
+        "(Coulomb friction with a fitted velocity scale, viscous, Stribeck and direction-dependent friction, "
+        "position ripple, rotor inertia, sensor offset and gain, payload, tilted base, gravity scale, time "
+        "shift) and how far it shrinks. Three roles for data: --data fits the effects' values, --select chooses "
+        "the effects, --test is used only for the residual reported as held out. A simple model (per joint "
+        "offset + Coulomb + viscous) is always reported beside the result. Writes report.md, diagnosis.json, "
+        "effects.yaml, torques.png, residuals.png and, for consistent parameters, URDF and MJCF with the "
+        "selected friction."))
     _data_options(parser)
     parser.add_argument("--params", required=True, metavar="P.yaml",
                         help="link parameters: extraction output (links:), a solution file (solution:) or a robot "
                              "YAML (parameters.nominal)")
-    parser.add_argument("--holdout", action="append", metavar="CSV",
-                        help="recording(s) held out from the fit to select and judge effects (default: every "
-                             "third block of 2 s of the --data recordings)")
+    parser.add_argument("--select", action="append", metavar="CSV",
+                        help="recording(s) that choose the effects (default: every third 2-s block of the --data "
+                             "recordings)")
+    parser.add_argument("--test", action="append", metavar="CSV",
+                        help="recording(s) used for nothing but the reported held-out residual; best a different "
+                             "trajectory (default: none, and the report says that nothing was held out)")
+    parser.add_argument("--holdout", action="append", metavar="CSV", help="the same as --test")
+    parser.add_argument("--split", metavar="F,S,T",
+                        help="cut every --data recording in time into fit, select and test pieces of these "
+                             "fractions (e.g. 0.6,0.2,0.2), each conditioned on its own")
     parser.add_argument("--out", default=None, metavar="DIR", help="output folder (default out/<robot>/diagnosis)")
     parser.add_argument("--effects", metavar="LIST",
-                        help="comma-separated effects to try (default all: offset, coulomb, viscous, stribeck, "
-                             "armature, gain, payload, tilt, time_shift, coefficients)")
+                        help="comma-separated effects to try (default: offset, coulomb, viscous, stribeck, direction, "
+                             "ripple, armature, gain, payload, tilt, gravity_scale, time_shift; also: coefficients)")
     parser.add_argument("--min-gain", type=real(0, 1), default=None, metavar="G",
-                        help="least held-out gain to select an effect (default 0.05: 5%% of a joint's mean square)")
+                        help="least selection gain to select an effect (default 0.05: 5%% of a joint's mean square)")
     parser.add_argument("--sign-velocity", type=real(0, 1e3, above=True), default=0.002, metavar="V",
-                        help="sign(qd) is smoothed as tanh(qd / V) (default 0.002 rad/s)")
+                        help="sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V) "
+                             "(default 0.002 rad/s; Coulomb's own scale is fitted)")
     args = parser.parse_args(argv)
+    from .data import condition, read_recording
+    from .data.split import parse_fractions, split_recording
     from .description import load_robot
     from .diagnosis import Options, diagnose
     from .diagnosis.outputs import write_outputs
@@ -150,14 +179,26 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     p = read_link_parameters(args.params, robot.dof)
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
-    fit = _read(args.data, robot, args)  # bad input fails before anything is announced or written
-    held = _read(args.holdout, robot, args) if args.holdout else None
-    for path, recording in zip([*args.data, *(args.holdout or [])], [*fit, *(held or [])]):
-        if len(recording.t) < MIN_DIAGNOSIS_SAMPLES:
-            raise InputError(Path(path).name, "", f"{len(recording.t)} samples; a diagnosis needs at least "
-                             f"{MIN_DIAGNOSIS_SAMPLES} (seconds of motion at the recording's rate)")
-    progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit and "
-                 f"{len(args.holdout or [])} held-out recording(s)")
+    tests = (args.test or []) + (args.holdout or [])
+    # bad input fails before anything is announced or written
+    if args.split:
+        if args.select or tests:
+            raise InputError("--split", "", "cuts the --data recordings into fit, select and test: give no "
+                             "--select, --test or --holdout with it")
+        fractions = parse_fractions(args.split)
+        pieces = [split_recording(read_recording(x, robot.dof), fractions) for x in args.data]
+        for recording in (r for rs in pieces for r in rs if r is not None):
+            _enough(recording.name, recording.t)
+        fit, select, test = ([condition(r[k], _conditioning(args)) for r in pieces if r[k] is not None]
+                             for k in range(3))
+    else:
+        fit = _read(args.data, robot, args)
+        select = _read(args.select, robot, args) if args.select else []
+        test = _read(tests, robot, args) if tests else []
+        for path, recording in zip([*args.data, *(args.select or []), *tests], [*fit, *select, *test]):
+            _enough(Path(path).name, recording.t)
+    progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
+                 f"select and {len(test)} test recording(s)")
     model = _model(args, robot, progress)
     options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
                       sign_velocity=args.sign_velocity,
@@ -169,11 +210,11 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
             library(options.effects)
         except ValueError as err:
             raise InputError("--effects", "", str(err)) from None
-    with progress.step("residual, effects, selection on held-out data"):
-        result = diagnose(robot, model, p, fit, held, options)
+    with progress.step("residual, effects, selection, test"):
+        result = diagnose(robot, model, p, fit, select or None, options, test=test)
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
-    sources = {"params": Path(args.params).name, "fit": [Path(x).name for x in args.data],
-               "holdout": [Path(x).name for x in args.holdout or []], "conditioning": _conditioning_text(args)}
+    sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
+               "test": [s.name for s in test], "conditioning": _conditioning_text(fit + select + test)}
     with progress.step("report, JSON, figures, updated model"):
         paths = write_outputs(result, robot, p, out, sources, args.sign_velocity)
     if not args.quiet:
@@ -183,4 +224,8 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
         print(f"  written: {', '.join(written)}")
         if "export skipped" in paths:
             print(f"  URDF/MJCF not written: {paths['export skipped']}")
+    elif result.warnings:
+        import sys
+
+        print("\n".join(f"warning: {w}" for w in result.warnings), file=sys.stderr)
     return 0

@@ -192,13 +192,32 @@ def measure(robot, p, trajectory: Trajectory, effects: Effects = Effects(), nois
     return Measurement(t, q, qd, qdd, tau)
 
 
-def csv_text(m: Measurement) -> str:
-    """Header t, q1..qN, qd1..qdN, qdd1..qddN, tau1..tauN; 12 significant digits."""
+@dataclass(frozen=True)
+class Encoder:
+    """How positions are recorded: true + N(0, noise), rounded to the step of a `bits` encoder
+    (2 pi / 2^bits rad), and no velocity or acceleration columns (as most arms log)."""
+
+    noise: float = 1e-5  # rad
+    bits: int = 20
+
+
+def encoded(m: Measurement, encoder: Encoder, seed) -> Measurement:
+    """m with positions as an encoder records them (qd, qdd kept only for checks; not written)."""
+    rng = np.random.default_rng(seed)
+    step = 2 * np.pi / 2 ** encoder.bits
+    q = np.round((m.q + encoder.noise * rng.standard_normal(m.q.shape)) / step) * step
+    return Measurement(m.t, q, m.qd, m.qdd, m.tau)
+
+
+def csv_text(m: Measurement, velocities: bool = True) -> str:
+    """Header t, q1..qN, qd1..qdN, qdd1..qddN, tau1..tauN (without qd, qdd unless
+    `velocities`); 12 significant digits."""
     n = m.q.shape[1]
-    names = ["t"] + [f"{k}{i}" for k in ("q", "qd", "qdd", "tau") for i in range(1, n + 1)]
+    kinds = ("q", "qd", "qdd", "tau") if velocities else ("q", "tau")
+    names = ["t"] + [f"{k}{i}" for k in kinds for i in range(1, n + 1)]
+    blocks = [m.t, m.q, m.qd, m.qdd, m.tau] if velocities else [m.t, m.q, m.tau]
     out = io.StringIO()
-    np.savetxt(out, np.column_stack([m.t, m.q, m.qd, m.qdd, m.tau]), fmt="%.12g", delimiter=",",
-               header=",".join(names), comments="")
+    np.savetxt(out, np.column_stack(blocks), fmt="%.12g", delimiter=",", header=",".join(names), comments="")
     return out.getvalue()
 
 

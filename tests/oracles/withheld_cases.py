@@ -35,7 +35,7 @@ from dyngen.extraction.report import links_yaml
 from dyngen.validation.excitation import robot_excitation
 from dyngen.validation.trajectory import TABLE_V_KNOTS, TABLE_V_TIMES
 
-from .mujoco_measurements import Effects, Trajectory, csv_text, measure, simulator_xml, tilted_gravity
+from .mujoco_measurements import Effects, Encoder, Trajectory, csv_text, encoded, measure, simulator_xml, tilted_gravity
 
 ROOT = Path(__file__).resolve().parents[2]
 ROBOT = ROOT / "examples" / "lwr.yaml"
@@ -74,6 +74,7 @@ class Case:
     name: str
     effects: Effects = field(default_factory=Effects)
     coefficient_error: float = 0.0  # relative error of the model's masses and inertias
+    tracked: bool = False  # forward simulation under a controller (sticky friction, mujoco_tracking.py)
 
 
 CASES = [
@@ -92,6 +93,15 @@ CASES = [
     Case("friction_offset", Effects(coulomb={1: 1.0}, viscous={1: 0.5}, offset={5: 0.8})),
     Case("payload_coulomb", Effects(payload=PAYLOAD, coulomb={6: 1.0})),
     Case("gain_viscous", Effects(gain={2: 0.05}, viscous={6: 0.5})),
+]
+
+# Friction as real joints have it: the arm tracks its reference in a forward simulation, and
+# friction (MuJoCo's stiff friction loss, a Stribeck excess through qfrc_applied) sticks at
+# reversals and rests (tests/oracles/mujoco_tracking.py).
+TRACKED_CASES = [
+    Case("sticky", Effects(coulomb={2: 0.9, 4: 0.5}, viscous={2: 0.4}), tracked=True),
+    Case("stribeck_sticky", Effects(coulomb={4: 0.6}, stribeck={4: (0.6, 0.08)}), tracked=True),
+    Case("sticky_offset", Effects(coulomb={6: 0.4}, offset={1: 0.3}), tracked=True),
 ]
 
 # Settings between the diagnosis's variants (Stribeck vs 0.03/0.1/0.3 rad/s, time shifts
@@ -225,17 +235,30 @@ def simulated_parameters(case: Case, p_model, seed: int) -> np.ndarray:
     return perturbed(p_model, case.coefficient_error, seed) if case.coefficient_error else p_model
 
 
-def case_files(case: Case, index: int, robot, p_true, trajs, noise: float, seed: int) -> dict[str, str]:
-    """The case's CSVs and MuJoCo model; noise seeded by (seed, case index, trajectory index)."""
+def case_files(case: Case, index: int, robot, p_true, trajs, noise: float, seed: int,
+               encoder: Encoder | None = None) -> dict[str, str]:
+    """The case's CSVs and MuJoCo model; noise seeded by (seed, case index, trajectory index).
+    With an encoder, positions carry its noise and steps and the files have no qd, qdd."""
     files = {f"{case.name}.mujoco.xml": simulator_xml(robot, p_true, case.effects)}
     for k, (kind, traj) in enumerate(trajs.items()):
-        m = measure(robot, p_true, traj, case.effects, noise, seed=[seed, index, k])
-        files[f"{case.name}.{kind}.csv"] = csv_text(m)
+        if case.tracked:
+            from .mujoco_tracking import track
+
+            m, _ = track(robot, p_true, p_model_of(robot), traj.t, traj.at, case.effects, noise, seed=[seed, index, k])
+        else:
+            m = measure(robot, p_true, traj, case.effects, noise, seed=[seed, index, k])
+        if encoder is not None:
+            m = encoded(m, encoder, seed=[seed, index, k, 1])
+        files[f"{case.name}.{kind}.csv"] = csv_text(m, velocities=encoder is None)
     return files
 
 
+def p_model_of(robot) -> np.ndarray:
+    return nominal_model(robot)
+
+
 def write_cases(folder, rate_hz: float = 1000.0, noise: float = NOISE, seed: int = 0, cases=CASES,
-                fit_seconds: float = FIT_SECONDS, pi_full=None, robot_path=ROBOT) -> dict:
+                fit_seconds: float = FIT_SECONDS, pi_full=None, robot_path=ROBOT, encoder: Encoder | None = None) -> dict:
     """Write every case (see the module doc) and return the truth document.
     pi_full: optional p -> base coefficients (e.g. dyngen.runtime's "pi_full"), recorded in the
     truth of the coefficients case."""
@@ -251,10 +274,12 @@ def write_cases(folder, rate_hz: float = 1000.0, noise: float = NOISE, seed: int
            "trajectories": {"fit": {"kind": "fourier", "seed": FIT_SEED, "seconds": fit_seconds,
                                     "base_hz": 0.1, "harmonics": 5},
                             "holdout": {"kind": "table_v", "seconds": float(TABLE_V_TIMES[-1])}},
-           "laws": LAWS, "cases": []}
+           "laws": LAWS, "cases": [],
+           "positions": "exact, with qd and qdd columns" if encoder is None else
+           {"noise": encoder.noise, "bits": encoder.bits, "columns": "t, q, tau (no qd, qdd)"}}
     for index, case in enumerate(cases):
         p_true = simulated_parameters(case, p_model, seed)
-        files.update(case_files(case, index, robot, p_true, trajs, noise, seed))
+        files.update(case_files(case, index, robot, p_true, trajs, noise, seed, encoder))
         doc["cases"].append({"name": case.name, "fit": f"{case.name}.fit.csv", "holdout": f"{case.name}.holdout.csv",
                              "noise_sigma": noise, "effects": truth(case, robot, p_model, p_true, pi_full)})
     files["truth.json"] = json.dumps(doc, indent=1) + "\n"

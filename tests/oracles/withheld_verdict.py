@@ -45,9 +45,11 @@ PER_JOINT = {"coulomb": ("fc", "Fc"), "viscous": ("fv", "Fv"), "armature": ("ia"
 STANDARD_NAMES = ("m", "mx", "my", "mz", "XX", "XY", "XZ", "YY", "YZ", "ZZ")
 
 
-def problems(truth: list[dict], d: dict, noise: float, p_model=None) -> list[str]:
-    """truth: a case's `effects` list; d: the diagnosis JSON document; p_model: the model's
-    dynamic parameters (needed only for the coefficients case)."""
+def problems(truth: list[dict], d: dict, noise, p_model=None) -> list[str]:
+    """truth: a case's `effects` list; d: the diagnosis JSON document; noise: the bound's unit
+    per joint (the torque noise sigma, or what a perfect model leaves on the same conditioned
+    data; a scalar for every joint); p_model: the model's dynamic parameters (needed only for
+    the coefficients case)."""
     out = []
     selected = d["selected"]
     per_joint = {(e["effect"], e["joints"][0]): e for e in selected if e["effect"] in (*PER_JOINT, "stribeck")}
@@ -88,9 +90,10 @@ def problems(truth: list[dict], d: dict, noise: float, p_model=None) -> list[str
         out.append(f"{name} claimed, not injected")
     # Where the nominal residual stood above this bound, the effects must bring it down to it
     # (joints already at the noise may move by a hair either way: fitted values carry noise).
+    bound = np.broadcast_to(np.asarray(noise, dtype=float), (len(d["rms_after"]),))
     for j, after in enumerate(d["rms_after"]):
-        if after > NOISE_FACTOR * noise:
-            out.append(f"joint {j + 1}: held-out RMS after {after:.3f} > {NOISE_FACTOR} x noise {noise:g}")
+        if after > NOISE_FACTOR * bound[j]:
+            out.append(f"joint {j + 1}: held-out RMS after {after:.3f} > {NOISE_FACTOR} x noise {bound[j]:.3g}")
     return out
 
 
@@ -107,8 +110,8 @@ def _arm_effect(name, values, e, p_model) -> list[str]:
         if abs(fitted["dt"] - values["dt"]) > TOLERANCE * abs(values["dt"]):
             out.append(f"time shift: fitted {fitted['dt']:g} s, truth {values['dt']:g} s")
     elif name == "tilt":
-        change = fitted_gravity_change(fitted, nominal_gravity(values))
-        true_change = np.asarray(values["gravity"]) - nominal_gravity(values)
+        change = fitted_gravity_change(fitted, nominal_gravity(values))[:2]
+        true_change = (np.asarray(values["gravity"]) - nominal_gravity(values))[:2]  # a rotation: across gravity
         if np.linalg.norm(change - true_change) > TOLERANCE * np.linalg.norm(true_change):
             out.append(f"tilt: gravity change {np.round(change, 4)}, truth {np.round(true_change, 4)}")
     elif name == "coefficients":
@@ -137,7 +140,7 @@ def fitted_gravity_change(fitted: dict, g0: np.ndarray) -> np.ndarray:
     u1 = seed - (seed @ n) * n
     u1 /= np.linalg.norm(u1)
     u2 = np.cross(n, u1)
-    return fitted["dg1"] * u1 + fitted["dg2"] * u2 + fitted["dgn"] * n
+    return fitted["dg1"] * u1 + fitted["dg2"] * u2 + fitted.get("dgn", 0.0) * n
 
 
 def coefficient_errors(expressions: list[str], p_true, p_model) -> dict:

@@ -1,7 +1,7 @@
 """Measured data in: CSV recordings (read and checked) and their signal conditioning.
 
     recordings = [read_recording(path, dof) for path in paths]
-    signals = [condition(r, Conditioning(cutoff=1.0, order=4)) for r in recordings]
+    signals = [condition(r) for r in recordings]   # cutoff decided from the data (Conditioning)
 """
 
 from .conditioning import Conditioning, Signals, condition

@@ -1,28 +1,40 @@
-"""Signal conditioning as in the paper (Sec. IV): velocities and accelerations by numerical
-differentiation of q, and a zero-phase Butterworth low-pass applied alike to positions and
-torques, so that no signal is shifted in time against another.
+"""Signal conditioning: what the models take from a recording.
 
-Choices: the filter runs forwards and backwards (scipy sosfiltfilt), so its order doubles in
-effect and its phase is zero; the sampling rate is the median rate (recordings with jitter
-are treated as uniformly sampled). When a file has its own qd (and qdd), they are used
-unless `differentiate` is set; if a cutoff is given they are filtered like the rest.
+Velocities and accelerations are the recording's own columns when it has them (the
+controller's estimates), otherwise central differences of the positions. How positions are
+filtered before differentiation is decided from the recording by default
+(data/automatic.py: position noise against the motion's acceleration), or set by the user
+(`cutoff` in Hz, or None for no filter at all).
+
+The low-pass is a zero-phase Butterworth (scipy sosfiltfilt), applied alike to positions and
+torques so that no signal is shifted or smoothed against another; it is kept on the Signals
+(`lowpass`) so that whatever is compared with the filtered torque (a model torque, an effect's
+columns) can be passed through the very same filter. The filter's start-up at both ends is
+not data: `trim` samples at each end are to be left out of every fit and every figure.
+The sampling rate is the median rate (recordings with jitter are treated as uniformly sampled).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from scipy import signal
 
 from ..errors import InputError
+from . import automatic
 from .recording import Recording
+
+AUTO = "auto"
+EDGE_PERIODS = 1.0  # trimmed at each end: this many periods of the cutoff (the filter's start-up)
+PAD_PERIODS = 2.0  # the recording is continued this many periods of the cutoff before filtering
 
 
 @dataclass(frozen=True)
 class Conditioning:
-    cutoff: float | None = None  # low-pass cutoff [Hz]; None: no filtering
-    order: int = 4  # Butterworth order (the paper: 4th order, 1 Hz)
+    cutoff: float | str | None = AUTO  # low-pass cutoff [Hz]; "auto": from the data; None: no filter
+    order: int = 4  # Butterworth order
     differentiate: bool = False  # recompute qd, qdd from q even when the file has them
 
 
@@ -37,41 +49,131 @@ class Signals:
     qdd: np.ndarray
     tau: np.ndarray | None  # (T, N)
     extra: dict  # other columns (filtered like the torques)
+    lowpass: Callable | None = None  # the filter applied to q and tau (None: none)
+    trim: int = 0  # samples at each end that are filter start-up, not data
+    cutoff: float | None = None
+    note: str = "as recorded"  # what was done, in words (for reports)
+    q_noise: np.ndarray | None = None  # per joint position noise sigma [rad], when differentiated
+    qdd_noise: np.ndarray | None = None  # per joint acceleration noise left after the filter [rad/s^2]
+    band: float | None = None  # Hz: the motion's band (99 % of velocity power)
+    warnings: list = field(default_factory=list)
 
     @property
     def rate(self) -> float:
         return 1.0 / float(np.median(np.diff(self.t)))
 
+    def filtered(self, x: np.ndarray) -> np.ndarray:
+        """x (T, ...) through the same filter as the torques (unchanged if there is none)."""
+        if self.lowpass is None:
+            return np.asarray(x, dtype=float)
+        shape = x.shape
+        return self.lowpass(np.asarray(x, dtype=float).reshape(shape[0], -1)).reshape(shape)
+
+    def inner(self) -> np.ndarray:
+        """Boolean (T,): the samples that are data (not the filter's start-up)."""
+        keep = np.ones(self.t.size, dtype=bool)
+        if self.trim:
+            keep[:self.trim] = keep[-self.trim:] = False
+        return keep
+
 
 def condition(recording: Recording, options: Conditioning = Conditioning()) -> Signals:
     r = recording
     rate = 1.0 / float(np.median(np.diff(r.t)))
-    lowpass = _lowpass(r.name, rate, options)
-    q = lowpass(r.q)
-    if r.qd is None or options.differentiate:
+    differentiate = r.qd is None or options.differentiate
+    decision = None
+    cutoff = options.cutoff
+    if isinstance(cutoff, str):
+        if cutoff != AUTO:
+            raise InputError(r.name, "cutoff", f"{cutoff!r}: expected a frequency in Hz or {AUTO!r}")
+        if differentiate:
+            decision = automatic.decide(r.t, r.q, lambda fc: _lowpass(r.name, rate, fc, options.order))
+            cutoff = decision.cutoff
+        else:
+            cutoff = None  # the recording's own velocities: nothing to differentiate, nothing to filter
+    lowpass = _lowpass(r.name, rate, cutoff, options.order) if cutoff is not None else None
+    same = lowpass or (lambda x: np.array(x, dtype=float))
+    q = same(r.q)
+    if differentiate:
         qd = np.gradient(q, r.t, axis=0)  # second-order central differences (non-uniform t allowed)
         qdd = np.gradient(qd, r.t, axis=0)
     else:
-        qd = lowpass(r.qd)
-        qdd = lowpass(r.qdd) if r.qdd is not None else np.gradient(qd, r.t, axis=0)
-    tau = lowpass(r.tau) if r.tau is not None else None
-    extra = {k: lowpass(v) for k, v in r.extra.items()}
-    return Signals(r.name, r.t, q, qd, qdd, tau, extra)
+        qd = same(r.qd)
+        qdd = same(r.qdd) if r.qdd is not None else np.gradient(qd, r.t, axis=0)
+    tau = same(r.tau) if r.tau is not None else None
+    extra = {k: same(v) for k, v in r.extra.items()}
+    trim = 0
+    if cutoff is not None:
+        trim = int(np.ceil(EDGE_PERIODS * rate / cutoff)) + 2
+    elif differentiate:
+        trim = 2  # one-sided differences at the ends
+    trim = min(trim, max((r.t.size - 4) // 4, 0))
+    out = Signals(r.name, r.t, q, qd, qdd, tau, extra, lowpass, trim, cutoff, _note(differentiate, cutoff, options,
+                                                                                      decision, r.qdd is None))
+    if decision is not None:
+        out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
+        if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
+            out.warnings.append(f"{r.name}: position noise ({_sigma(decision.q_noise)}) allows a cutoff of only "
+                                f"{cutoff:.3g} Hz, below twice the motion's band ({decision.band:.3g} Hz): "
+                                "accelerations are smoothed")
+    elif differentiate and cutoff is not None:
+        sigma = automatic.position_noise(r.q)
+        out.q_noise, out.qdd_noise = sigma, automatic.acceleration_noise(sigma, cutoff, rate)
+    elif differentiate:
+        sigma = automatic.position_noise(r.q)
+        out.q_noise = sigma
+        out.qdd_noise = sigma * np.sqrt(6.0) * rate ** 2  # central second difference of white noise
+    return out
 
 
-def _lowpass(name: str, rate: float, options: Conditioning):
-    if options.cutoff is None:
-        return lambda x: np.array(x, dtype=float)
-    if not 0 < options.cutoff < rate / 2:
-        raise InputError(name, "cutoff", f"{options.cutoff:g} Hz must lie between 0 and half the sampling rate "
+def _sigma(x) -> str:
+    return f"{float(np.max(x)):.2g} rad"
+
+
+def _note(differentiate, cutoff, options, decision, no_qdd) -> str:
+    how = "qd, qdd differentiated from q" if differentiate else \
+        ("qd as recorded, qdd differentiated" if no_qdd else "qd, qdd as recorded")
+    if cutoff is None:
+        return how + ", no filter"
+    text = f"{how}; zero-phase Butterworth order {options.order}, {cutoff:.3g} Hz on q and tau"
+    if decision is not None:
+        text += (f" (chosen from the data: position noise {_sigma(decision.q_noise)}, motion band "
+                 f"{decision.band:.3g} Hz)")
+    return text
+
+
+def _lowpass(name: str, rate: float, cutoff: float, order: int):
+    if not 0 < cutoff < rate / 2:
+        raise InputError(name, "cutoff", f"{cutoff:g} Hz must lie between 0 and half the sampling rate "
                          f"({rate / 2:g} Hz)")
-    if not 1 <= options.order <= 12:
-        raise InputError(name, "order", f"{options.order} must be between 1 and 12")
-    sos = signal.butter(options.order, options.cutoff, btype="low", fs=rate, output="sos")
+    if not 1 <= order <= 12:
+        raise InputError(name, "order", f"{order} must be between 1 and 12")
+    sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
+    reach = int(np.ceil(PAD_PERIODS * rate / cutoff))
 
     def apply(x):
         x = np.asarray(x, dtype=float)
-        pad = min(x.shape[0] - 1, 3 * (2 * len(sos) + 1))
-        return signal.sosfiltfilt(sos, x, axis=0, padlen=pad)
+        T = x.shape[0]
+        pad = min(reach, T - 1)
+        if pad < 8:
+            return signal.sosfiltfilt(sos, x, axis=0, padlen=min(T - 1, 3 * (2 * len(sos) + 1)))
+        # A recording rarely starts or ends at rest: continued by a quadratic in time (value,
+        # slope and curvature continuous), the filter's start-up does not bend the second
+        # derivative the way scipy's odd extension would (its curvature flips at the edge).
+        head = _continued(x[:pad][::-1], pad)[::-1]
+        tail = _continued(x[-pad:], pad)
+        # filtered along the last axis of a contiguous copy: several times faster than along axis 0
+        extended = np.ascontiguousarray(np.concatenate([head, x, tail]).reshape(T + 2 * pad, -1).T)
+        out = signal.sosfiltfilt(sos, extended, axis=-1, padlen=0)[:, pad:pad + T]
+        return np.ascontiguousarray(out.T).reshape(x.shape)
 
     return apply
+
+
+def _continued(y: np.ndarray, n: int) -> np.ndarray:
+    """n samples after y (time along axis 0), from a quadratic fitted to y."""
+    k = np.arange(y.shape[0], dtype=float)
+    coefficients = np.polyfit(k, y.reshape(y.shape[0], -1), 2)
+    ahead = np.arange(y.shape[0], y.shape[0] + n, dtype=float)
+    out = np.vander(ahead, 3) @ coefficients
+    return out.reshape((n,) + y.shape[1:])

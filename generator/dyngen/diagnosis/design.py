@@ -67,7 +67,20 @@ def candidates_of(effects, n_joints: int, sizes: dict) -> list[Candidate]:
 
 def effect_columns(effects, context, segment) -> dict:
     """effect key -> (T, N, k) columns on one segment."""
-    return {e.key: np.asarray(e.columns(context, segment.signals, segment.tau_model), dtype=float) for e in effects}
+    return {e.key: columns_of(e, context, segment) for e in effects}
+
+
+def columns_of(effect, context, segment) -> np.ndarray:
+    """An effect's columns on one segment, computed once per segment and effect setting (the
+    selection and the pruning ask again). Laws that switch with the sign of the velocity
+    (Effect.switching: Coulomb, Stribeck, direction) are passed through the recording's filter,
+    like the torque they explain: a filtered friction step is then compared with a filtered
+    step, not a sharp one. Smooth functions of the filtered motion are filtered already."""
+    def compute():
+        x = np.asarray(effect.columns(context, segment.signals, segment.tau_model), float)
+        return segment.signals.filtered(x) if effect.switching else x
+
+    return context.memo(("columns", id(segment), effect.key), compute)
 
 
 def joint_matrix(candidates, columns: dict, joint: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,5 +1,5 @@
 """Figures like the paper's Figs. 4 and 5 (PNG, matplotlib Agg): measured against model torque
-per joint, and the residual before and after the selected effects, on held-out data, with
+per joint, and the residual before and after the selected effects, on test data, with
 the phases where the residual stands out shaded."""
 
 from __future__ import annotations
@@ -49,9 +49,12 @@ def _save(fig, path, title) -> Path:
 
 
 def figures(d, out_dir, robot_name: str) -> dict:
-    """torques.png (Fig. 4 style) and residuals.png (Fig. 5 style) of the first held-out segment."""
-    seg = next(s for s in d.segments if s.held.any())
-    m = np.flatnonzero(seg.held)
+    """torques.png (Fig. 4 style) and residuals.png (Fig. 5 style) of the first judged segment
+    (test data, or selection data when there are none)."""
+    role = "test" if d.judged_on == "test" else "select"
+    seg = next(s for s in d.segments if getattr(s, role).any())
+    m = np.flatnonzero(getattr(seg, role))
+    label = "test data" if role == "test" else "selection data (no test data given)"
     m = m[::max(1, m.size // MAX_POINTS)]
     t = seg.signals.t[m]
     measured, model = seg.signals.tau[m], seg.tau_model[m]
@@ -74,7 +77,7 @@ def figures(d, out_dir, robot_name: str) -> dict:
         ax.grid(True, alpha=0.3)
     _legend(fig, axes[0])
     paths = {"torques": _save(fig, out / "torques.png", f"{robot_name}: measured and model torques on "
-                                                          f"held-out data ({seg.signals.name})")}
+                                                          f"{label} ({seg.signals.name})")}
 
     fig, axes = _grid(n)
     for j in range(n):
@@ -91,7 +94,7 @@ def figures(d, out_dir, robot_name: str) -> dict:
         ax.grid(True, alpha=0.3)
     _legend(fig, axes[0])
     paths["residuals"] = _save(fig, out / "residuals.png", f"{robot_name}: residual tau_measured - tau_model "
-                                                             f"on held-out data ({seg.signals.name})")
+                                                             f"on {label} ({seg.signals.name})")
     return paths
 
 

@@ -28,6 +28,7 @@ def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
         j = e["joints"][0] - 1
         if e["effect"] == "coulomb":
             f[j, 0] = e["values"]["Fc"]
+            f[j, 4] = e["variant"]["vc"]  # the fitted velocity scale (the Stribeck term shares it)
         elif e["effect"] == "viscous":
             f[j, 1] = e["values"]["Fv"]
         else:
@@ -52,8 +53,10 @@ def with_payload(diagnosis, p: np.ndarray) -> np.ndarray:
     payload = next((e for e in diagnosis.selected if e["effect"] == "payload"), None)
     if payload is None or None in payload["values"].values():
         return np.asarray(p, dtype=float)
+    from .effects.body import standard_of_payload
+
     s = standard_from_dynamic(p)
-    s[-PER_LINK:] += np.array(list(payload["values"].values()))
+    s[-PER_LINK:] += standard_of_payload(payload["values"])
     return dynamic_from_standard(s)
 
 
@@ -61,6 +64,8 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
     import yaml
 
     f = friction_vector(diagnosis, sign_velocity).reshape(diagnosis.joints, -1)
+    from .baseline import NAMES, VELOCITY
+
     doc = {
         "robot": diagnosis.robot,
         "parameters": sources.get("params"),
@@ -69,6 +74,10 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
         "friction": {"layout": "per joint: " + ", ".join(FRICTION_FIELDS) + " (generated <robot>_friction)",
                      "f": [[float(x) for x in row] for row in f]},
     }
-    head = (f"# Unmodelled effects of {diagnosis.robot} selected by `dyngen diagnose` (held-out data).\n"
+    if diagnosis.simple_wins:
+        doc["simple_model"] = {
+            "law": f"b + Fc tanh(qd / {VELOCITY:g}) + Fv qd, on the joints where it did better than the effects",
+            "joints": {j: dict(zip(NAMES, map(float, diagnosis.simple_values[j - 1]))) for j in diagnosis.simple_wins}}
+    head = (f"# Unmodelled effects of {diagnosis.robot} selected by `dyngen diagnose` (on selection data).\n"
             "# tau = rnea(q, qd, qdd, s) + friction(qd, f) + the other effects listed here.\n")
     return head + yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=120)

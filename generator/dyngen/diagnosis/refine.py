@@ -5,10 +5,11 @@ vs, and the time shift, whose exact form tau_model(t - dt) - tau_model(t) is lin
 Selection works with a few variants of vs and with the time shift to first order (the
 derivative of tau_model), which is wrong wherever tau_model jumps (acceleration steps, e.g.
 rest-to-rest trajectories). Once such an effect is selected, its setting is refined on the
-fit samples, every other selected effect refitted each time (held-out data stay unused):
+fit samples, every other selected effect refitted each time (selection and test data stay unused):
 
   - a setting the fitted values imply (Effect.implied_setting: the time shift, whose exact
-    column at dt0 gives the fitted value dt = dt0 when the model holds) by fixed-point
+    column at dt0 gives the fitted value dt = dt0 when the model holds; the tilt, whose
+    second-order change along gravity follows from the angles) by fixed-point
     iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE;
   - a setting independent of the values (Effect.search_interval: the Stribeck velocity) by a
     bounded scalar search for the smallest weighted fit residual.
@@ -27,7 +28,8 @@ from scipy.optimize import minimize_scalar
 from . import design as dz
 from .selection import solve
 
-REFINE_TOLERANCE = 1e-3  # relative (fixed point) or of the search interval's width
+REFINE_TOLERANCE = 1e-3  # relative (fixed point)
+SEARCH_TOLERANCE = 0.01  # in the logarithm of a searched setting: 1 %
 MAX_ITERATIONS = 30
 
 
@@ -38,6 +40,13 @@ def refine(context, segments, design, chosen):
     for index, cand in enumerate(state.chosen):
         if cand.effect.refinable:
             _refine_one(state, index)
+    return state.design, state.chosen
+
+
+def restricted(context, segments, design, chosen):
+    """The design of the chosen candidates alone on the segments' current masks (e.g. after
+    the fit masks were widened), weighted as `design`; and the candidates renumbered."""
+    state = _State(context, segments, design, _renumbered(chosen))
     return state.design, state.chosen
 
 
@@ -63,9 +72,37 @@ class _State:
         old = self.chosen[index]
         effect = old.effect.at(setting)
         chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
-        columns = [{**cols, effect.key: np.asarray(effect.columns(self.context, seg.signals, seg.tau_model), float)}
+        columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg)}
                    for cols, seg in zip(self.columns, self.segments)]
-        return chosen, columns, self.restricted(chosen, columns)
+        return chosen, columns, self.updated(chosen, columns, index)
+
+    def updated(self, chosen, columns, index):
+        """self.design with the rows and columns of candidate `index` recomputed (the others'
+        moments do not change when one candidate's setting does)."""
+        cand = chosen[index]
+        new = cand.slots
+        design = self.design
+        moments = [dz.Moments(m.G.copy(), m.b.copy(), m.c.copy(), m.count)
+                   for m in (design.fit, design.select, design.test)]
+        joints = range(self.weights.size) if cand.joint is None else [cand.joint]
+        for m in moments:
+            for j in joints:
+                m.G[j][new, :] = 0.0
+                m.G[j][:, new] = 0.0
+                m.b[j][new] = 0.0
+        for seg, cols in zip(self.segments, columns):
+            for j in joints:
+                acting = [c for c in chosen if c.joint is None or c.joint == j]
+                A, slots = dz.joint_matrix(acting, cols, j)
+                B = cols[cand.effect.key][:, j, :]
+                for m, mask in zip(moments, (seg.fit, seg.select, seg.test)):
+                    if mask.any():
+                        cross = A[mask].T @ B[mask]
+                        m.G[j][np.ix_(slots, new)] += cross
+                        m.G[j][np.ix_(new, slots)] += cross.T
+                        m.G[j][np.ix_(new, new)] -= B[mask].T @ B[mask]  # counted twice above
+                        m.b[j][new] += B[mask].T @ seg.residual[mask, j]
+        return type(self.template)(chosen, *moments, self.weights)
 
     def accept(self, trial):
         self.chosen, self.columns, self.design = trial
@@ -74,7 +111,7 @@ class _State:
         """Moments of the chosen candidates only, weighted as the selection's design."""
         n = self.weights.size
         size = sum(c.size for c in chosen)
-        fit, held = dz.empty(n, size), dz.empty(n, size)
+        fit, select, test = dz.empty(n, size), dz.empty(n, size), dz.empty(n, size)
         for seg, cols in zip(self.segments, columns):
             for j in range(n):
                 acting = [c for c in chosen if c.joint is None or c.joint == j]
@@ -82,12 +119,13 @@ class _State:
                     A, slots = dz.joint_matrix(acting, cols, j)
                 else:
                     A, slots = np.zeros((seg.residual.shape[0], 0)), np.zeros(0, dtype=int)
-                for moments, mask in ((fit, seg.fit), (held, seg.held)):
+                for moments, mask in ((fit, seg.fit), (select, seg.select), (test, seg.test)):
                     if mask.any():
                         dz.accumulate(moments, A[mask], slots, seg.residual[mask, j], j)
             fit.count += int(seg.fit.sum())
-            held.count += int(seg.held.sum())
-        return type(self.template)(chosen, fit, held, self.weights)
+            select.count += int(seg.select.sum())
+            test.count += int(seg.test.sum())
+        return type(self.template)(chosen, fit, select, test, self.weights)
 
 
 def _refine_one(state, index) -> None:
@@ -99,7 +137,8 @@ def _refine_one(state, index) -> None:
             if setting is None:
                 return
             state.accept(state.trial(index, setting))
-            if abs(setting - current.setting) <= REFINE_TOLERANCE * abs(setting):
+            step = np.linalg.norm(np.subtract(setting, current.setting))
+            if step <= REFINE_TOLERANCE * max(np.linalg.norm(setting), 1e-12):
                 return
         return
     interval = effect.search_interval(state.values(index))
@@ -110,9 +149,11 @@ def _refine_one(state, index) -> None:
         chosen, _, design = state.trial(index, setting)
         return _weighted_sse(design, solve(design, chosen))
 
-    lo, hi = interval
-    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"xatol": REFINE_TOLERANCE * (hi - lo)})
-    state.accept(state.trial(index, float(best.x)))
+    # Searched in the logarithm of the setting (a velocity scale matters by its ratio).
+    lo, hi = np.log(interval[0]), np.log(interval[1])
+    best = minimize_scalar(lambda u: cost(float(np.exp(u))), bounds=(lo, hi), method="bounded",
+                           options={"xatol": SEARCH_TOLERANCE})
+    state.accept(state.trial(index, float(np.exp(best.x))))
 
 
 def _renumbered(chosen) -> list:

@@ -7,17 +7,21 @@ import json
 
 import numpy as np
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 def to_json(d, sources: dict) -> str:
-    """sources: {"params": file, "fit": [files], "holdout": [files], "conditioning": text}."""
+    """sources: {"params": file, "fit": [files], "select": [files], "test": [files], "conditioning": text}."""
     doc = {
         "schema": SCHEMA_VERSION, "robot": d.robot, "joints": d.joints, "split": d.split, **sources,
-        "rms_before": d.rms_before, "rms_after": d.rms_after, "peak_before": d.peak_before,
-        "noise_rms": d.noise_rms, "correlation_samples": d.correlation_samples,
-        "selected": d.selected, "where": d.where, "candidates": d.candidates, "steps": d.steps,
-        "dropped": d.dropped,
+        "judged_on": d.judged_on, "rms_before": d.rms_before, "rms_after": d.rms_after,
+        "rms_effects": d.rms_effects, "rms_simple": d.rms_simple,
+        "selection_rms_before": d.selection_before, "selection_rms_after": d.selection_after,
+        "selection_rms_simple": d.selection_simple, "simple_wins": d.simple_wins, "simple_values": d.simple_values,
+        "peak_before": d.peak_before, "noise_rms": d.noise_rms, "correlation_samples": d.correlation_samples,
+        "selected": d.selected, "superseded": d.superseded, "refused": d.refused, "where": d.where,
+        "candidates": d.candidates, "steps": d.steps, "dropped": d.dropped, "warnings": d.warnings,
+        "recordings": d.conditioning,
     }
     return json.dumps(_plain(doc), indent=1) + "\n"
 
@@ -43,39 +47,70 @@ def _value_text(e) -> str:
         else:
             parts.append(f"{name} = {value:.4g} +- {e['std'][name]:.2g} {unit}")
     text = ", ".join(parts)
-    if len(parts) > 4:  # the 43 coefficient errors or the payload: the largest ones only
+    if len(parts) > 4:  # the coefficient errors, the payload, the ripple: the largest ones only
         shown = sorted(((abs(v / e["std"][n]) if e["std"][n] else 0, n) for n, v in e["values"].items()
                         if v is not None), reverse=True)[:3]
         text = f"{len(parts)} values; most significant: " + ", ".join(
             f"{n} = {e['values'][n]:.3g} +- {e['std'][n]:.2g}" for _, n in shown)
     for key, value in e.get("variant", {}).items():
-        text += f" (at {key} = {value:g})"
+        shown = f"({', '.join(f'{x:.3g}' for x in value)})" if isinstance(value, (list, tuple)) else f"{value:.3g}"
+        text += f" (at {key} = {shown})"
     derived = e.get("derived") or {}
     if "tilt_deg" in derived:
-        text += " (tilt {:.2f} +- {:.2f} deg, {:.2f} +- {:.2f} deg)".format(
-            derived["tilt_deg"][0], derived["tilt_std_deg"][0], derived["tilt_deg"][1], derived["tilt_std_deg"][1])
+        (a1, a2), (s1, s2), (u1, u2) = derived["tilt_deg"], derived["tilt_std_deg"], derived["tilt_towards"]
+        text += f" (gravity turned {a1:.2f} +- {s1:.2f} deg towards {u1} and {a2:.2f} +- {s2:.2f} deg towards {u2})"
+    if "relative" in derived:
+        text += f" (gravity torques scaled by {1 + derived['relative']:.4f})"
+    if "amplitude_Nm" in derived and derived.get("separable", True):
+        text += " (amplitudes of harmonics 1, 2, 3 of the joint position: " + \
+                ", ".join(f"{a:.3g}" for a in derived["amplitude_Nm"]) + " Nm)"
+    elif "amplitude_Nm" in derived:
+        text = (f"a torque of {derived['torque_rms_Nm']:.3g} Nm RMS depending on the joint's position; its harmonics "
+                "are not separable over the positions covered (values flagged, not findings)")
     if "dt_ms" in derived:
         text += f" ({derived['dt_ms']:.2f} +- {derived['dt_std_ms']:.2f} ms)"
     if "mass_kg" in derived:
-        text += f" (payload mass {derived['mass_kg']:.3g} kg)"
+        com = ", ".join("?" if c is None else f"{c:.3g}" for c in derived["com_m"])
+        text += f" (payload mass {derived['mass_kg']:.3g} kg, centre of mass ({com}) m in the last link's frame)"
+    if e.get("suspect"):
+        text += " **suspect**"
     return text
+
+
+def _row(label, values) -> str:
+    return f"| {label} | " + " | ".join(f"{x:.3f}" for x in values) + " |"
 
 
 def markdown(d, sources: dict) -> str:
     n = d.joints
     head = " | ".join(f"J{j + 1}" for j in range(n))
     rule = "|---|" + "---:|" * n
+    test = d.judged_on == "test"
     lines = [f"# Diagnosis of {d.robot}", "",
              f"Model parameters: {sources.get('params')}. Fit on: {', '.join(sources.get('fit', []))}. "
-             f"Held out: {', '.join(sources.get('holdout') or []) or d.split}. "
-             f"Conditioning: {sources.get('conditioning')}.", "",
-             "## Held-out residual (measured - model) per joint [Nm or N]", "",
-             f"| | {head} |", rule,
-             "| RMS, nominal model | " + " | ".join(f"{x:.3f}" for x in d.rms_before) + " |",
-             "| RMS, with the selected effects | " + " | ".join(f"{x:.3f}" for x in d.rms_after) + " |",
-             "| peak, nominal model | " + " | ".join(f"{x:.3f}" for x in d.peak_before) + " |",
-             "| white-noise estimate | " + " | ".join(f"{x:.3f}" for x in d.noise_rms) + " |", ""]
-    lines += ["## Where (nominal model, held-out data)", "",
+             f"Selection: {', '.join(sources.get('select') or []) or d.split}. "
+             f"Test (held out, used for nothing else): {', '.join(sources.get('test') or []) or 'none'}.", ""]
+    lines += ["Conditioning:", ""] + [f"- {c['recording']} ({c['role']}): {c['note']}; {c['trimmed_samples']} samples "
+                                      "trimmed at each end" for c in d.conditioning] + [""]
+    if d.warnings:
+        lines += ["## Warnings", ""] + [f"- {w}" for w in d.warnings] + [""]
+    simple = "simple model b + Fc tanh(qd/0.02) + Fv qd (fit data)"
+    lines += [f"## {'Test' if test else 'Selection'} residual (measured - model) per joint [Nm or N]", "",
+              ("On the test recordings, which played no part in fitting or choosing the effects." if test else
+               "**No test data**: these are the selection data, which chose the effects. Not a held-out figure."),
+              "", f"| | {head} |", rule,
+              _row("RMS, nominal model", d.rms_before),
+              _row("RMS, final model (effects; simple model where it won)", d.rms_after),
+              _row("RMS, selected effects alone", d.rms_effects),
+              _row(f"RMS, {simple}", d.rms_simple),
+              _row("peak, nominal model", d.peak_before),
+              _row("white-noise estimate", d.noise_rms), ""]
+    if test:
+        lines += ["Selection data (they chose the effects; not held out):", "", f"| | {head} |", rule,
+                  _row("RMS, nominal model", d.selection_before),
+                  _row("RMS, selected effects", d.selection_after),
+                  _row("RMS, simple model", d.selection_simple), ""]
+    lines += [f"## Where ({'test' if test else 'selection'} data, nominal model)", "",
               "| joint | RMS | mean | where it stands out | RMS there | share of samples | RMS after |",
               "|---|---:|---:|---|---:|---:|---:|"]
     for w in d.where:
@@ -84,34 +119,43 @@ def markdown(d, sources: dict) -> str:
         lines.append(f"| {w['joint']} | {w['rms']:.3f} | {w['mean']:+.3f} | {worst or '-'} "
                      f"({w['worst_ratio']:.2f}x) | {there.get('rms', float('nan')):.3f} | "
                      f"{there.get('share', float('nan')):.0%} | {there.get('rms_after', float('nan')):.3f} |")
-    lines += ["", "## Which effects (selected on held-out data)", ""]
+    lines += ["", "## Which effects (fitted on fit data, chosen on selection data)", ""]
     if not d.selected:
-        lines += ["No effect improves the held-out residual significantly: nothing is claimed.", ""]
+        lines += ["No effect improves the selection residual significantly: nothing is claimed.", ""]
     else:
-        lines += ["| effect | joints | fitted values (+- std) | held-out gain | held-out RMS without -> with, "
+        lines += ["| effect | joints | fitted values (+- std) | selection gain | selection RMS without -> with, "
                   "on its joints |", "|---|---|---|---:|---|"]
         for e in d.selected:
             joints = ", ".join(map(str, e["joints"])) or "-"
             change = ", ".join(f"J{j}: {e['rms_before'][j - 1]:.3f} -> {e['rms_after'][j - 1]:.3f}" for j in e["joints"])
-            lines.append(f"| {e['effect']} | {joints} | {_value_text(e)} | {e['heldout_gain']:.3f} | {change} |")
-        lines += ["", "Held-out gain: the decrease of the held-out mean square residual relative to its value without "
-                  "this effect (all other selected effects kept), on its joint (per-joint effects) or summed over "
-                  "joints (arm-wide effects). Standard deviations "
+            lines.append(f"| {e['effect']} | {joints} | {_value_text(e)} | {e['selection_gain']:.3f} | {change} |")
+        lines += ["", "Selection gain: the decrease of the selection data's mean square residual relative to its value "
+                  "without this effect (all other selected effects kept), on its joint (per-joint effects) or summed "
+                  "over joints (arm-wide effects). Standard deviations "
                   f"are scaled for the residual's correlation in time ({d.correlation_samples:.0f} samples).", ""]
+    if d.superseded:
+        lines += ["Not kept (the simple model did better on these joints' selection data): "
+                  + ", ".join(f"{e['effect']} on joint {e['joints'][0]}" for e in d.superseded) + ".", ""]
+    if d.refused:
+        lines += ["Refused as physically impossible once fitted: " + ", ".join(r["candidate"] for r in d.refused)
+                  + ".", ""]
     if d.dropped:
         lines += [f"Selected at first, then dropped as not significant: {', '.join(d.dropped)}.", ""]
-    lines += ["## Candidates tried alone (held-out gain)", "",
-              ", ".join(f"{c['candidate']} {c['heldout_gain']:+.3f}" for c in d.candidates[:15]), ""]
+    lines += ["## Candidates tried alone (selection gain)", "",
+              ", ".join(f"{c['candidate']} {c['selection_gain']:+.3f}" for c in d.candidates[:15]), ""]
     return "\n".join(lines)
 
 
 def summary_lines(d) -> list[str]:
     """A short table for the terminal."""
-    out = [f"  held-out RMS per joint: nominal {' '.join(f'{x:.3f}' for x in d.rms_before)}",
-           f"                         after   {' '.join(f'{x:.3f}' for x in d.rms_after)}"]
+    where = "test" if d.judged_on == "test" else "selection (no test data)"
+    out = [f"  {where} RMS per joint: nominal {' '.join(f'{x:.3f}' for x in d.rms_before)}",
+           f"  {' ' * len(where)}               after   {' '.join(f'{x:.3f}' for x in d.rms_after)}",
+           f"  {' ' * len(where)}        simple model   {' '.join(f'{x:.3f}' for x in d.rms_simple)}"]
     if not d.selected:
         out.append("  no significant unmodelled effect")
     for e in d.selected:
         joints = ",".join(map(str, e["joints"])) or "-"
-        out.append(f"  {e['effect']:<12} joints {joints:<14} gain {e['heldout_gain']:.3f}  {_value_text(e)}")
+        out.append(f"  {e['effect']:<12} joints {joints:<14} gain {e['selection_gain']:.3f}  {_value_text(e)}")
+    out += [f"  warning: {w}" for w in d.warnings]
     return out

@@ -1,7 +1,10 @@
-"""The diagnosis: residual, forward selection of effects on held-out data, refinement of
-their nonlinear settings, final fit.
+"""The diagnosis: residual, forward selection of effects on selection data, refinement of
+their nonlinear settings, final fit, the simple model beside it, and the test.
 
-    result = diagnose(robot, model, p, fit_signals, holdout_signals)   # or holdout None: blocks
+    result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
+
+fit_signals set the values, select_signals (default: blocks of the fit data) choose the
+effects, test_signals are used for nothing but the reported held-out residual (roles.py).
 """
 
 from __future__ import annotations
@@ -10,79 +13,68 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..catalogue import RNEA
+from ..catalogue import STANDARD_FROM_DYNAMIC
+from . import baseline as simple_model
 from . import design as dz
-from . import phases
+from . import joints, phases, roles
 from .correlation import integrated_time
 from .effects import Context, library
-from .refine import refine
-from .selection import ALPHA, MIN_GAIN, forward, heldout_gain, prune, solve
+from .refine import refine, restricted
+from .selection import ALPHA, MIN_GAIN, forward, prune, selection_gain, solve
+
+RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable
+EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
+DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
 
 
 @dataclass(frozen=True)
 class Options:
-    effects: tuple | None = None  # effect names to try (default: all)
+    effects: tuple | None = None  # effect names to try (default: all but the coefficient errors)
     min_gain: float = MIN_GAIN
     alpha: float = ALPHA
-    sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd)
-    block_seconds: float = 2.0  # without held-out files: blocks of this length, every third held out
-
-
-@dataclass
-class Segment:
-    """One recording with the model's torques, its residual and which samples fit / test."""
-
-    signals: object
-    tau_model: np.ndarray
-    residual: np.ndarray
-    fit: np.ndarray  # bool (T,)
-    held: np.ndarray  # bool (T,)
-    correction: np.ndarray | None = None  # the selected effects' torques, after the diagnosis
+    sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd) (Stribeck, direction)
+    block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
 
 
 @dataclass
 class Diagnosis:
     robot: str
     joints: int
-    split: str  # "held-out recordings" or "blocks"
+    split: str  # how selection data were obtained
+    judged_on: str  # "test" (recordings used for nothing else) or "selection" (no test data given)
     selected: list  # per chosen candidate: dict (see docs/conventions.md, diagnosis JSON)
-    rms_before: list  # per joint, held-out, nominal model
-    rms_after: list  # per joint, held-out, with every selected effect
+    rms_before: list  # per joint, on the judged data, nominal model
+    rms_after: list  # per joint, on the judged data, with the final model (effects; simple model where it won)
+    rms_effects: list  # per joint, on the judged data, with the selected effects alone
+    rms_simple: list  # per joint, on the judged data, the simple model (baseline.py)
+    selection_before: list  # per joint, selection data
+    selection_after: list
+    selection_simple: list
+    simple_wins: list  # 1-based joints where the simple model beat the effects on selection data
+    # (joint_models below: per joint "effects", "simple" or "effects + simple", joints.py)
+    simple_values: list  # per joint b, Fc, Fv
     peak_before: list
-    noise_rms: list  # per joint estimate of the white part of the final held-out residual
-    where: list  # per joint: phases of the nominal held-out residual (phases.by_phase), with rms_after
-    candidates: list  # every candidate: its held-out gain when tried alone
+    noise_rms: list  # per joint estimate of the white part of the final judged residual
+    where: list  # per joint: phases of the nominal judged residual (phases.by_phase), with rms_after
+    candidates: list  # every candidate: its selection gain when tried alone
     steps: list
     dropped: list  # selected forward, then dropped as not significant (correlated residual)
+    refused: list  # selected, then refused: implausible values once fitted with the others
+    superseded: list  # per-joint effects on joints the simple model won
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
-    segments: list = field(default_factory=list)  # Segment, for figures
-
-
-def _segments(model, s, fit_signals, holdout_signals, options) -> tuple[list, str]:
-    out = []
-
-    def segment(sig, fit, held):
-        tau_model = model.batch(RNEA.name, sig.q, sig.qd, sig.qdd, s)
-        return Segment(sig, tau_model, sig.tau - tau_model, fit, held)
-
-    if holdout_signals:
-        for sig in fit_signals:
-            out.append(segment(sig, np.ones(sig.t.size, bool), np.zeros(sig.t.size, bool)))
-        for sig in holdout_signals:
-            out.append(segment(sig, np.zeros(sig.t.size, bool), np.ones(sig.t.size, bool)))
-        return out, "held-out recordings"
-    for sig in fit_signals:
-        block = np.floor((sig.t - sig.t[0]) / options.block_seconds).astype(int)
-        held = block % 3 == 2
-        out.append(segment(sig, ~held, held))
-    return out, f"blocks of {options.block_seconds:g} s, every third held out"
+    warnings: list = field(default_factory=list)
+    joint_models: list = field(default_factory=list)
+    completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
+    conditioning: list = field(default_factory=list)  # per recording: what was done to it
+    segments: list = field(default_factory=list)  # roles.Segment, for figures
 
 
 @dataclass
 class Design:
     candidates: list
     fit: dz.Moments
-    held: dz.Moments
+    select: dz.Moments
+    test: dz.Moments
     weights: np.ndarray  # per joint: 1 / RMS of the nominal fit residual
     H: np.ndarray = None  # weighted normal matrix of every slot: sum_j w_j^2 G_j (fit samples)
     g: np.ndarray = None  # sum_j w_j^2 b_j
@@ -94,23 +86,26 @@ class Design:
 
 
 def _design(context, effects, segments, n) -> Design:
-    candidates, fit, held = None, None, None
+    candidates, moments = None, None
     for seg in segments:
         columns = dz.effect_columns(effects, context, seg)
         if candidates is None:
             candidates = dz.candidates_of(effects, n, {k: v.shape[2] for k, v in columns.items()})
             size = candidates[-1].start + candidates[-1].size
-            fit, held = dz.empty(n, size), dz.empty(n, size)
+            moments = [dz.empty(n, size) for _ in range(3)]
+        masks = (seg.fit, seg.select, seg.test)
         for j in range(n):
             A, slots = dz.joint_matrix(candidates, columns, j)
-            for moments, mask in ((fit, seg.fit), (held, seg.held)):
+            for m, mask in zip(moments, masks):
                 if mask.any():
-                    dz.accumulate(moments, A[mask], slots, seg.residual[mask, j], j)
-        fit.count += int(seg.fit.sum())
-        held.count += int(seg.held.sum())
-    rms = np.sqrt(fit.c / max(fit.count, 1))
+                    dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
+        for m, mask in zip(moments, masks):
+            m.count += int(mask.sum())
+    if moments[0].count == 0:
+        raise ValueError("no fit samples (recordings too short for the filter's start-up?)")
+    rms = np.sqrt(moments[0].c / max(moments[0].count, 1))
     weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
-    return Design(candidates, fit, held, weights)
+    return Design(candidates, *moments, weights)
 
 
 def predict(context, chosen, x, segment) -> np.ndarray:
@@ -130,13 +125,18 @@ def predict(context, chosen, x, segment) -> np.ndarray:
     return out
 
 
-def diagnose(robot, model, p, fit_signals, holdout_signals=None, options: Options = Options()) -> Diagnosis:
+def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options = Options(),
+             test=None) -> Diagnosis:
     p = np.asarray(p, dtype=float)
-    s = model("standard_from_dynamic", p)
+    s = model(STANDARD_FROM_DYNAMIC.name, p)
     n = robot.dof
-    context = Context(model, robot, p, s, options.sign_velocity)
+    segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
+    # Position- and velocity-dependent laws are known only over what the fit data cover.
+    fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
+    fit_qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
+    context = Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)),
+                      (fit_qd.min(axis=0), fit_qd.max(axis=0)))
     effects = library(options.effects)
-    segments, split = _segments(model, s, fit_signals, holdout_signals, options)
     design = _design(context, effects, segments, n)
 
     def correlation(chosen, fit):
@@ -145,31 +145,188 @@ def diagnose(robot, model, p, fit_signals, holdout_signals=None, options: Option
         return _correlation(segments, design.weights)
 
     selection = forward(design, options.min_gain, options.alpha)
-    chosen, tau_corr, dropped = prune(design, selection.chosen, correlation, options.alpha)
-    design, chosen = refine(context, segments, design, chosen)  # Stribeck velocity, exact time shift
-    final = solve(design, chosen)
-    if chosen:  # also leaves each segment's correction at the final fit
-        tau_corr = correlation(chosen, final)
-    before = np.sqrt(design.held.c / max(design.held.count, 1))
-    after = np.sqrt(design.held.mse(final.slots, final.x)) if chosen else before.copy()
-    held_before = np.vstack([seg.residual[seg.held] for seg in segments])
-    held_after = np.vstack([(seg.residual - seg.correction)[seg.held] for seg in segments])
-    masks = [phases.labels(seg.signals.t[seg.held], seg.signals.q[seg.held], seg.signals.qd[seg.held],
-                           seg.signals.qdd[seg.held]) for seg in segments if seg.held.any()]
+    # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
+    # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
+    design, chosen = refine(context, segments, design, selection.chosen)
+    chosen, tau_corr, dropped = prune(design, chosen, correlation, options.alpha)
+    narrow = _narrow_stribeck(chosen)
+    chosen = [c for c in chosen if c not in narrow]
+    dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
+    if dropped:
+        design, chosen = refine(context, segments, design, chosen)
+    chosen, final, refused = _plausible(design, chosen)
+    design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
+    correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
+    # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
+    # compared on the selection samples (joints.py).
+    simple = simple_model.fit(segments)
+    sel_before = design.select.c / max(design.select.count, 1)
+    sel_effects = design.select.mse(final.slots, final.x) if chosen else sel_before.copy()
+    sel_simple = _simple_mse(segments, simple, "select", n)
+    modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain) if design.select.count \
+        else [joints.EFFECTS] * n
+    wins = [j for j in range(n) if modes[j] == joints.SIMPLE]
+    described = [_describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
+    # The choice made, every sample of the fit recordings sets the values (selection blocks
+    # included; separate selection recordings stay out of it, as test recordings do).
+    if not select_signals:
+        for seg in segments:
+            seg.fit = seg.fit | seg.select
+        simple = simple_model.fit(segments)
+        if chosen:
+            design, chosen = restricted(context, segments, design, chosen)
+            final = solve(design, chosen)
+    tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
+    _values(described, design, chosen, final, tau_corr, robot)
+    judged = "test" if design.test.count else "selection"
+    judged_moments = design.test if judged == "test" else design.select
+    before = judged_moments.c / max(judged_moments.count, 1)
+    effects_mse = judged_moments.mse(final.slots, final.x) if chosen else before.copy()
+    simple_mse = _simple_mse(segments, simple, judged, n)
+    completed = joints.apply(context, segments, chosen, final.x, simple, modes)
+    mask = (lambda seg: seg.test) if judged == "test" else (lambda seg: seg.select)
+    used = [seg for seg in segments if mask(seg).any()]
+    held_before = np.vstack([seg.residual[mask(seg)] for seg in used])
+    held_after = np.vstack([(seg.residual - seg.correction)[mask(seg)] for seg in used])
+    after = np.mean(held_after ** 2, axis=0)
+    masks = [phases.labels(seg.signals.t[mask(seg)], seg.signals.q[mask(seg)], seg.signals.qd[mask(seg)],
+                           seg.signals.qdd[mask(seg)]) for seg in used]
     masks = {name: np.vstack([m[name] for m in masks]) for name in phases.PHASES}
     where = phases.by_phase(held_before, masks)
-    after_phases = phases.by_phase(held_after, masks)
-    for w, a in zip(where, after_phases):
+    for w, a in zip(where, phases.by_phase(held_after, masks)):
         w["rms_after"] = a["rms"]
         for name, v in w["phases"].items():
             v["rms_after"] = a["phases"][name]["rms"]
     noise = np.std(np.diff(held_after, axis=0), axis=0) / np.sqrt(2)
-    selected = [_describe(robot, design, chosen, final, c, tau_corr, options.min_gain) for c in chosen]
-    candidates = [{"candidate": k, "heldout_gain": g} for k, g in
+    selected, superseded = [], []
+    for c, e in zip(chosen, described):
+        if c.joint is not None and c.joint in wins:
+            superseded.append(e)
+            continue
+        e["joints"] = [j for j in e["joints"] if j - 1 not in wins]
+        selected.append(e)
+    candidates = [{"candidate": k, "selection_gain": g} for k, g in
                   sorted(selection.first_gains.items(), key=lambda kv: -kv[1])]
-    return Diagnosis(robot.name, n, split, selected, before.tolist(), after.tolist(),
-                     np.abs(held_before).max(axis=0).tolist(), noise.tolist(), where, candidates, selection.steps,
-                     dropped, tau_corr, segments)
+    result = Diagnosis(
+        robot.name, n, split, judged, selected, *(np.sqrt(x).tolist() for x in (before, after, effects_mse, simple_mse)),
+        *(np.sqrt(x).tolist() for x in (sel_before, sel_effects, sel_simple)), [j + 1 for j in wins],
+        simple.values.tolist(), np.abs(held_before).max(axis=0).tolist(), noise.tolist(), where, candidates,
+        selection.steps, dropped, refused, superseded, tau_corr, segments=segments)
+    result.joint_models = modes
+    result.completed = completed
+    result.conditioning = [{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
+                           for role, group in (("fit", fit_signals), ("select", select_signals or []),
+                                               ("test", test or [])) for sig in group]
+    result.warnings = _warnings(result, model, s, fit_signals, select_signals or [], test or [], used)
+    return result
+
+
+def _plausible(design, chosen):
+    """The final fit, after refusing (one at a time, the worst first) effects whose values,
+    fitted together, are no longer physically possible (e.g. a payload of negative mass)."""
+    refused = []
+    while True:
+        final = solve(design, chosen)
+        bad = []
+        offset = 0
+        for c in chosen:
+            if not c.effect.plausible(final.x[offset: offset + c.size]):
+                bad.append(c)
+            offset += c.size
+        if not bad:
+            return chosen, final, refused
+        worst = bad[0]
+        offset = sum(c.size for c in chosen[:chosen.index(worst)])
+        refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
+        chosen = [c for c in chosen if c is not worst]
+
+
+def _consistent_payload(context, segments, design, chosen, final, refused):
+    """A payload whose fitted inertia is no body's (a negative principal moment about its centre
+    of mass) is replaced by a point mass at its fitted centre, and everything refitted: the data
+    determine m and m c, not that inertia, and an impossible inertia mispredicts other motions."""
+    from .effects.body import PointPayload, consistent_inertia
+
+    offset = 0
+    for i, c in enumerate(chosen):
+        values = final.x[offset: offset + c.size]
+        offset += c.size
+        if c.effect.name != "payload" or c.size != 10 or consistent_inertia(values):
+            continue
+        refused.append({"candidate": "the payload's inertia about its centre of mass (a negative principal moment; "
+                                     "the payload is kept as a point mass at its fitted centre)",
+                        "values": values[4:].tolist()})
+        replaced = chosen[:i] + [dz.Candidate(PointPayload(values[1:4] / values[0]), None, 0, 4)] + chosen[i + 1:]
+        design, chosen = restricted(context, segments, design, replaced)
+        return design, chosen, solve(design, chosen)
+    return design, chosen, final
+
+
+def _narrow_stribeck(chosen) -> list:
+    """Stribeck terms whose velocity is less than twice the Coulomb velocity scale on their
+    joint: there the two laws trade shape with each other, and no static friction is shown."""
+    scale = {c.joint: c.effect.velocity for c in chosen if c.effect.name == "coulomb"}
+    return [c for c in chosen if c.effect.name == "stribeck" and c.joint in scale
+            and c.effect.velocity < 2 * scale[c.joint]]
+
+
+def _simple_mse(segments, simple, role, n) -> np.ndarray:
+    sse, count = np.zeros(n), 0
+    for seg in segments:
+        m = getattr(seg, role)
+        if m.any():
+            r = seg.residual[m] - simple_model.predict(simple, seg)[m]
+            sse += (r ** 2).sum(axis=0)
+            count += int(m.sum())
+    return sse / max(count, 1)
+
+
+def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> list[str]:
+    out = []
+    for sig in [*fit_signals, *select_signals, *test_signals]:
+        out += sig.warnings
+    if d.judged_on == "selection":
+        out.append("no test recording (--test): the residual 'after' is measured on the selection data, which chose "
+                   "the effects; it is not a held-out figure")
+    # Laws fitted on one range of motion and judged beyond it (friction at higher speeds).
+    if test_signals:
+        fast_fit = np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in fit_signals]), axis=0)
+        fast_test = np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in test_signals]), axis=0)
+        beyond = [j for j in range(d.joints) if fast_test[j] > EXTRAPOLATION * fast_fit[j]]
+        if beyond:
+            out.append("the test data move joint(s) " + ", ".join(
+                f"{j + 1} ({fast_test[j]:.2g} vs {fast_fit[j]:.2g} rad/s)" for j in beyond)
+                + " faster than any fit data: velocity-dependent laws are extrapolated there")
+    for fit, test, diff in roles.repeated(fit_signals, test_signals):
+        out.append(f"{test} repeats the trajectory of {fit} (RMS position difference {diff:.3g} rad): the test shows "
+                   "that the effects repeat, not that they generalise to other motions")
+    # Differentiation noise carried into the model torque: M(q) times the acceleration noise.
+    for seg in used:
+        sig = seg.signals
+        if sig.qdd_noise is None:
+            continue
+        M = model("mass_matrix", np.median(sig.q, axis=0), s).reshape(d.joints, d.joints)
+        predicted = np.sqrt((M ** 2) @ (np.asarray(sig.qdd_noise) ** 2))
+        bad = [j for j in range(d.joints) if predicted[j] ** 2 > DIFFERENTIATION_SHARE * d.rms_after[j] ** 2]
+        if bad:
+            out.append(f"{sig.name}: noise of the differentiated positions makes up most of the residual on joint(s) "
+                       f"{', '.join(str(j + 1) for j in bad)} (about "
+                       f"{', '.join(f'{predicted[j]:.3g}' for j in bad)} Nm of {', '.join(f'{d.rms_after[j]:.3g}' for j in bad)}"
+                       " Nm): recorded velocities, or a lower --cutoff, would lower it")
+    for e in d.selected:
+        if e["effect"] == "ripple" and not e["derived"].get("separable", True):
+            out.append(f"ripple on joint {e['joints'][0]}: its harmonics are not separable over the positions the fit "
+                       f"data cover (amplitudes {', '.join(f'{a:.3g}' for a in e['derived']['amplitude_Nm'])} Nm for "
+                       f"a torque of {e['derived']['torque_rms_Nm']:.3g} Nm RMS): only their sum is a finding")
+        if e.get("suspect"):
+            out.append(f"{e['effect']} is a symptom, not a cause: {e['suspect']}")
+    for r in d.refused:
+        out.append(f"{r['candidate']}: refused, its fitted values are not physically possible "
+                   f"({', '.join(f'{v:.3g}' for v in r['values'][:4])})")
+    if d.simple_wins:
+        out.append("on joint(s) " + ", ".join(map(str, d.simple_wins)) + " the simple model (offset + Coulomb + viscous) "
+                   "did better than the selected effects on selection data and is kept there")
+    return out
 
 
 def _correlation(segments, weights) -> float:
@@ -181,32 +338,57 @@ def _correlation(segments, weights) -> float:
     return float(np.median(times))
 
 
-def _describe(robot, design, chosen, final, cand, tau_corr, min_gain) -> dict:
+SUSPECT = {"gravity_scale": "no tilt changes gravity's size; every link's gravity torque scaled alike points at "
+                            "masses and centres of mass wrong by one factor, or at a torque-sensor gain"}
+
+
+def _values(described, design, chosen, final, tau_corr, robot) -> None:
+    """The final values of every chosen effect, with deviations scaled for the residual's
+    correlation in time, and what follows from them (values.derived)."""
     from .values import derived
 
-    offset = sum(c.size for c in chosen[:chosen.index(cand)])
-    k = slice(offset, offset + cand.size)
-    x = final.x[k]
-    std = np.sqrt(np.maximum(np.diag(final.covariance)[k], 0.0) * tau_corr)
-    identifiable = _identifiable(design, chosen, k)
+    offset = 0
+    for cand, e in zip(chosen, described):
+        k = slice(offset, offset + cand.size)
+        offset += cand.size
+        std = np.sqrt(np.maximum(np.diag(final.covariance)[k], 0.0) * tau_corr)
+        identifiable = _identifiable(design, chosen, k)
+        names = list(cand.effect.parameters)
+        e["values"] = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], identifiable)}
+        e["std"] = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
+        e["variant"] = cand.effect.fixed()
+        e["derived"] = derived(robot, cand.effect.name, e["values"], e["std"])
+        if cand.effect.name == "ripple" and "amplitude_Nm" in e["derived"]:
+            # Low harmonics over a short range of positions are nearly collinear: large values
+            # of opposite sign whose sum is small. Then only the sum is a finding.
+            j, x = cand.joint, final.x[k]
+            G = design.fit.G[j][np.ix_(cand.slots, cand.slots)]
+            rms = float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
+            e["derived"]["torque_rms_Nm"] = rms
+            e["derived"]["separable"] = bool(sum(e["derived"]["amplitude_Nm"]) <= RIPPLE_SEPARABLE * np.sqrt(2) * rms)
+
+
+def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
+    """What an effect does on the selection data (its gain, the joints it helps); its values
+    are filled in by _values once the final fit is made."""
     others = [c for c in chosen if c is not cand]
     rest = solve(design, others)
-    mse_without = design.held.mse(rest.slots, rest.x) if others else design.held.c / max(design.held.count, 1)
-    mse_with = design.held.mse(final.slots, final.x)
+    mse_without = design.select.mse(rest.slots, rest.x) if others else design.select.c / max(design.select.count, 1)
+    mse_with = design.select.mse(final.slots, final.x)
     gain_per_joint = (mse_without - mse_with) / np.maximum(mse_without, 1e-300)
-    gain = heldout_gain(cand, mse_without, mse_with)
+    gain = selection_gain(cand, mse_without, mse_with)
     joints = [cand.joint + 1] if cand.joint is not None else \
         [j + 1 for j in range(len(gain_per_joint)) if gain_per_joint[j] >= min_gain]
     names = list(cand.effect.parameters)
-    values = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, x, identifiable)}
-    stds = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
-    return {
+    out = {
         "effect": cand.effect.name, "joints": joints, "variant": cand.effect.fixed(),
-        "values": values, "std": stds, "units": dict(zip(names, cand.effect.units)),
-        "derived": derived(robot, cand.effect.name, values, stds),
-        "heldout_gain": gain,
+        "values": {}, "std": {}, "units": dict(zip(names, cand.effect.units)), "derived": {},
+        "selection_gain": gain,
         "rms_before": np.sqrt(mse_without).tolist(), "rms_after": np.sqrt(mse_with).tolist(),
     }
+    if cand.effect.suspect:
+        out["suspect"] = SUSPECT.get(cand.effect.name, "reported as a symptom")
+    return out
 
 
 def _identifiable(design, chosen, k) -> np.ndarray:

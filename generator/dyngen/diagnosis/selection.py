@@ -1,13 +1,14 @@
-"""Forward selection of effects by what they do on held-out data.
+"""Forward selection of effects by what they do on selection data (not the fit's samples).
 
 Fit: weighted least squares on the fit samples, every joint's rows divided by the RMS of
 its nominal residual there (so a joint with a large residual does not drown the others).
-Gain: on the held-out samples, the decrease of the residual's mean square relative to its
+Gain: on the selection samples, the decrease of the residual's mean square relative to its
 value before the step, on the candidate's own joint (per-joint effects) or summed over joints
-(arm-wide effects). A step adds the candidate with the largest held-out gain if
+(arm-wide effects). A step adds the candidate with the largest selection gain if
 
-  - the gain is at least `min_gain` (default 0.05: 5 % of one joint's current held-out mean
-    square), so an effect must generalise, not merely fit, and
+  - the gain is at least `min_gain` per fitted value (default 0.05: 5 % of one joint's current
+    selection mean square for a one-value effect, 30 % for the six values of a position
+    ripple), so an effect must generalise, not merely fit, and pay for its values, and
   - its fitted values are significant on the fit data (chi-square test of x_c^T Cov_cc^-1 x_c,
     p < `alpha`), so noise alone does not qualify, and
   - they are physically plausible (friction opposes motion, a rotor inertia is positive, a
@@ -18,7 +19,9 @@ Then prune() drops, one by one, selected effects whose values are not significan
 deviations are scaled for the correlation in time of the residual they leave.
 
 Among candidates within 10 % of the best gain, the one with fewest values wins (a payload is
-preferred to the 43 coefficient errors that could also express it). Selection stops when no
+preferred to the 43 coefficient errors that could also express it), and a secondary effect
+(Effect.secondary: direction-dependent Coulomb, which on a joint that never stops is a
+sensor offset; the gravity scale, a symptom) only if no plainer one is near. Selection stops when no
 candidate qualifies: with data that hold no unmodelled effect, nothing is selected.
 """
 
@@ -38,8 +41,15 @@ NEAR_BEST = 0.9
 class Fit:
     x: np.ndarray  # values at the chosen slots
     slots: np.ndarray
-    covariance: np.ndarray  # white-residual covariance (scaled later for correlation)
-    sigma2: float
+    covariance: np.ndarray | None  # white-residual covariance (scaled later for correlation), or only
+    sigma2: float                  # the block of `block` (see solve)
+    block: slice | None = None
+
+    def covariance_of(self, k: slice) -> np.ndarray:
+        if self.block is None:
+            return self.covariance[k, k]
+        assert k == self.block, "covariance computed for another block"
+        return self.covariance
 
 
 @dataclass
@@ -49,26 +59,47 @@ class Selection:
     first_gains: dict = field(default_factory=dict)  # candidate key -> gain when tried alone
 
 
-def solve(design, chosen) -> Fit:
+def solve(design, chosen, block: slice | None = None, covariance: bool = True) -> Fit:
     """Weighted least squares of the chosen candidates on the fit samples (moments only).
 
     The covariance is the sandwich H^-1 (sum_j w_j^4 s_j^2 G_j) H^-1 with s_j^2 joint j's own
     residual variance: joints differ in noise, and the weights (from the nominal residual,
-    which contains the very effects sought) are not their noise levels."""
+    which contains the very effects sought) are not their noise levels. With `block`, only
+    that block of it is computed (the forward selection tests one candidate at a time); with
+    covariance False, none."""
     slots = np.concatenate([c.slots for c in chosen]) if chosen else np.zeros(0, dtype=int)
     H = design.H[np.ix_(slots, slots)]
     g = design.g[slots]
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    inverse = _inverse(H / np.outer(d, d)) / np.outer(d, d)
-    x = inverse @ g
+    apply = _solver(H / np.outer(d, d))
+    x = apply(g / d) / d
+    if not covariance:
+        return Fit(x, slots, None, float("nan"), block)
     fit = design.fit
     w2 = design.weights ** 2
     G = fit.G[:, slots][:, :, slots]
     sse = np.maximum(fit.c - 2 * fit.b[:, slots] @ x + np.einsum("k,jkl,l->j", x, G, x), 0.0)
     s2 = sse / max(fit.count - len(slots), 1)  # per joint
     middle = np.einsum("j,jkl->kl", w2 ** 2 * s2, G)
-    covariance = inverse @ middle @ inverse
-    return Fit(x, slots, covariance, float(w2 @ s2) / len(s2))
+    unit = np.eye(len(slots))[:, block if block is not None else slice(None)]
+    columns = apply(unit / d[:, None]) / d[:, None]  # the needed columns of H^-1
+    return Fit(x, slots, columns.T @ middle @ columns, float(w2 @ s2) / len(s2), block)
+
+
+def _solver(Hs: np.ndarray):
+    """b -> Hs^-1 b for a unit-diagonal normal matrix: Cholesky, or a pseudo-inverse when
+    columns are dependent (dependent columns then share no value instead of taking arbitrary
+    large ones)."""
+    if Hs.size == 0:
+        return lambda b: np.zeros_like(b)
+    try:
+        factor = linalg.cho_factor(Hs, check_finite=False)
+        if np.min(np.abs(np.diag(factor[0]))) > 1e-5:  # condition below about 1e10
+            return lambda b: linalg.cho_solve(factor, b, check_finite=False)
+    except linalg.LinAlgError:
+        pass
+    inverse = _inverse(Hs)
+    return lambda b: inverse @ b
 
 
 def _inverse(Hs: np.ndarray) -> np.ndarray:
@@ -96,7 +127,7 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     the residual's correlation time in samples (see correlation.py)."""
     offset = sum(c.size for c in chosen[:chosen.index(candidate)])
     k = slice(offset, offset + candidate.size)
-    x, C = fit.x[k], fit.covariance[k, k] * correlation
+    x, C = fit.x[k], fit.covariance_of(k) * correlation
     vals, vecs = np.linalg.eigh(C)
     keep = vals > 1e-12 * max(vals.max(initial=0.0), 1e-300)
     if not keep.any():
@@ -106,13 +137,13 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     return float(stats.chi2.sf(chi2, int(keep.sum())))
 
 
-def heldout_mse(design, chosen) -> np.ndarray:
+def selection_mse(design, chosen) -> np.ndarray:
     fit = solve(design, chosen)
-    return design.held.mse(fit.slots, fit.x) if chosen else design.held.c / max(design.held.count, 1)
+    return design.select.mse(fit.slots, fit.x) if chosen else design.select.c / max(design.select.count, 1)
 
 
-def heldout_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
-    """Relative decrease of the held-out mean square: on the candidate's own joint for a
+def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
+    """Relative decrease of the selection mean square: on the candidate's own joint for a
     per-joint effect (a refit of arm-wide effects must not lend it credit from other joints),
     summed over joints for an arm-wide effect."""
     relative = (before - after) / np.maximum(before, 1e-300)
@@ -123,7 +154,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
     """Forward steps; the significance test here assumes uncorrelated residuals (prune() then
     applies the honest, correlation-scaled test to what was selected)."""
     selection = Selection([])
-    current = heldout_mse(design, [])
+    current = selection_mse(design, [])
     tau = 1.0
     while len(selection.chosen) < max_steps:
         families = {c.family for c in selection.chosen}
@@ -132,27 +163,31 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             if cand.family in families:
                 continue
             chosen = selection.chosen + [cand]
-            fit = solve(design, chosen)
-            mse = design.held.mse(fit.slots, fit.x)
-            gain = heldout_gain(cand, current, mse)
+            fit = solve(design, chosen, covariance=False)
+            mse = design.select.mse(fit.slots, fit.x)
+            gain = selection_gain(cand, current, mse)
             if not selection.chosen:
                 selection.first_gains[cand.key] = gain
-            if gain >= min_gain and cand.effect.plausible(fit.x[-cand.size:]):
+            if gain >= min_gain * np.sqrt(cand.size) and cand.effect.plausible(fit.x[-cand.size:]):
+                size = len(fit.x)
+                fit = solve(design, chosen, block=slice(size - cand.size, size))
                 trials.append((gain, cand, mse, fit, chosen))
         qualified = [t for t in trials if significant(t[3], t[1], t[4], alpha, tau)]
         if not qualified:
             break
         best = max(t[0] for t in qualified)
         near = [t for t in qualified if t[0] >= NEAR_BEST * best]
+        if any(not t[1].effect.secondary for t in near):  # a tie goes to the plainer explanation
+            near = [t for t in near if not t[1].effect.secondary]
         gain, cand, mse, _, _ = min(near, key=lambda t: (t[1].size, -t[0]))
         selection.chosen.append(cand)
-        selection.steps.append({"candidate": cand.key, "gain": gain, "heldout_rms": np.sqrt(mse).tolist()})
+        selection.steps.append({"candidate": cand.key, "gain": gain, "selection_rms": np.sqrt(mse).tolist()})
         current = mse
     return selection
 
 
 def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list, float, list]:
-    """Backward elimination: drop an effect whose held-out gain, with all the others kept, is
+    """Backward elimination: drop an effect whose selection gain, with all the others kept, is
     not positive; then, with deviations scaled by the correlation time of the residual the
     chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
     effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
@@ -162,9 +197,9 @@ def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list
         tau = correlation(chosen, fit)
         if not chosen:
             return chosen, tau, dropped
-        with_all = design.held.mse(fit.slots, fit.x)
-        # An effect that no longer helps on held-out data once the others are in goes first.
-        gains = [heldout_gain(c, heldout_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
+        with_all = design.select.mse(fit.slots, fit.x)
+        # An effect that no longer helps on selection data once the others are in goes first.
+        gains = [selection_gain(c, selection_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
         if min(gains) <= 0:
             dropped.append(chosen.pop(int(np.argmin(gains))).key)
             continue

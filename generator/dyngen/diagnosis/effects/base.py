@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -17,6 +17,15 @@ class Context:
     p: np.ndarray
     s: np.ndarray
     sign_velocity: float = 0.002  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
+    q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
+    qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
+    cache: dict = field(default_factory=dict)  # columns and shared intermediates, per recording (memo)
+
+    def memo(self, key, compute):
+        """compute() once per key for the life of one diagnosis (its recordings do not change)."""
+        if key not in self.cache:
+            self.cache[key] = compute()
+        return self.cache[key]
 
     def sign(self, qd: np.ndarray) -> np.ndarray:
         return np.tanh(qd / self.sign_velocity)
@@ -32,6 +41,9 @@ class Effect:
     units: tuple = ()
     label = ""  # a variant's setting, e.g. "vs = 0.1 rad/s"
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
+    suspect = False  # a symptom rather than a cause: always reported with a warning
+    secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
+    switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
 
     def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the

@@ -21,14 +21,79 @@ class Payload(Effect):
     parameters = STANDARD_NAMES_PER_LINK
     units = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
 
+    max_mass = np.inf  # kg: the arm's own mass (set in columns); a heavier "payload" is refused
+
+    def plausible(self, values):
+        """A body has a positive mass, not more than the arm's, and its centre of mass
+        within a metre of the flange frame."""
+        m = values[0]
+        return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
+
     def columns(self, context, signals, tau_model):
         n = signals.q.shape[1]
+        self.max_mass = float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0]))
         out = np.empty(signals.q.shape + (PER_LINK,))
         for k in range(PER_LINK):
             unit = np.zeros(PER_LINK * n)
             unit[PER_LINK * (n - 1) + k] = 1.0
             out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, unit)
         return out
+
+
+class PointPayload(Payload):
+    """A payload as a point mass at c0 (the centre of mass of a fitted Payload whose inertia
+    about its centre came out physically impossible: the data do not determine it). Values m
+    and m c; the inertia about the frame origin is m (|c0|^2 1 - c0 c0^T), always consistent."""
+
+    parameters = ("m", "mx", "my", "mz")
+    units = ("kg", "kg m", "kg m", "kg m")
+
+    def __init__(self, centre):
+        self.centre = np.asarray(centre, dtype=float)
+        self.label = "point mass at c0=(" + ",".join(f"{x:.4g}" for x in self.centre) + ")"
+
+    def fixed(self):
+        return {"point_mass_at": [float(x) for x in self.centre]}
+
+    def plausible(self, values):
+        m = values[0]
+        return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
+
+    def columns(self, context, signals, tau_model):
+        n = signals.q.shape[1]
+        self.max_mass = float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0]))
+        c = self.centre
+        I = c @ c * np.eye(3) - np.outer(c, c)  # unit mass
+        units = [np.array([1.0, 0, 0, 0, I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]]),
+                 *np.eye(PER_LINK)[1:4]]
+        out = np.empty(signals.q.shape + (4,))
+        for k, unit in enumerate(units):
+            s = np.zeros(PER_LINK * n)
+            s[PER_LINK * (n - 1):] = unit
+            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, s)
+        return out
+
+
+def consistent_inertia(values, tolerance: float = 0.0) -> bool:
+    """Whether a fitted payload's 10 standard values (m, m c, inertia about the frame origin)
+    describe a body: inertia about its centre of mass with non-negative principal moments that
+    satisfy the triangle inequalities."""
+    m, mc = values[0], np.asarray(values[1:4])
+    XX, XY, XZ, YY, YZ, ZZ = values[4:10]
+    c = mc / m
+    Ic = np.array([[XX, XY, XZ], [XY, YY, YZ], [XZ, YZ, ZZ]]) - m * (c @ c * np.eye(3) - np.outer(c, c))
+    e = np.linalg.eigvalsh(Ic)
+    return bool(e[0] >= -tolerance and e[0] + e[1] >= e[2] - tolerance)
+
+
+def standard_of_payload(values: dict) -> np.ndarray:
+    """The 10 standard parameters of a selected payload (10 values, or a point mass's 4)."""
+    v = [values[k] for k in ("m", "mx", "my", "mz")]
+    if "XX" in values:
+        return np.array(list(values.values()), dtype=float)
+    m, c = v[0], np.array(v[1:4]) / v[0]
+    I = m * (c @ c * np.eye(3) - np.outer(c, c))
+    return np.array([m, *v[1:4], I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]])
 
 
 class Coefficients(Effect):

@@ -1,12 +1,20 @@
 """Joint friction and rotor inertia: per joint, linear in their values.
 
-    Coulomb:   Fc * sign(qd)                      [Nm]
+    Coulomb:   Fc * tanh(qd / vc)                 [Nm] at a velocity scale vc (variants; refined once selected)
     viscous:   Fv * qd                            [Nm s/rad]
     Stribeck:  Fs * sign(qd) * exp(-(qd/vs)^2)    [Nm] at a fixed vs (variants; vs refined once selected)
+    direction: dFc * |sign(qd)|                   [Nm]: Coulomb levels Fc + dFc moving forwards and
+                                                  Fc - dFc backwards (gears and seals are not symmetric)
+    ripple:    sum_k a_k cos(k q) + b_k sin(k q)  [Nm], k = 1..3: a torque that depends on the joint's
+                                                  own position (gear and cogging harmonics); known only
+                                                  where the fit data went, so q is clipped to that
+                                                  range (harmonics extrapolated beyond it are guesses)
     armature:  Ia * qdd                           [kg m^2] (reflected rotor inertia)
 
-sign(qd) is smoothed (Context.sign) so that standstill noise does not flip it.
-(Units for a prismatic joint: N, N s/m, kg.)
+The Coulomb velocity scale vc is fitted because real joints do not switch sharply: in stick
+phases and reversals friction takes any value in [-Fc, Fc], which a smooth law with a wider
+vc follows better than a sharp sign. sign(qd) elsewhere is smoothed (Context.sign) so that
+standstill noise does not flip it. (Units for a prismatic joint: N, N s/m, kg.)
 """
 
 from __future__ import annotations
@@ -25,9 +33,52 @@ class _Dissipative(Effect):
 
 class Coulomb(_Dissipative):
     name, parameters, units = "coulomb", ("Fc",), ("Nm",)
+    refinable = switching = True
+
+    def __init__(self, velocity: float):
+        self.velocity = float(velocity)
+        self.label = f"vc={self.velocity:g}"
+
+    def fixed(self):
+        return {"vc": self.velocity}
+
+    @property
+    def setting(self):
+        return self.velocity
+
+    def search_interval(self, values):
+        return self.velocity / 4, self.velocity * 4  # reaches the neighbouring variants
+
+    def at(self, setting):
+        return Coulomb(setting)
 
     def columns(self, context, signals, tau_model):
-        return context.sign(signals.qd)[:, :, None]
+        return np.tanh(signals.qd / self.velocity)[:, :, None]
+
+
+class Direction(Effect):
+    name, parameters, units = "direction", ("dFc",), ("Nm",)
+    secondary = switching = True
+
+    def columns(self, context, signals, tau_model):
+        return np.abs(context.sign(signals.qd))[:, :, None]
+
+
+class Ripple(Effect):
+    HARMONICS = (1, 2, 3)
+    name = "ripple"
+    parameters = tuple(f"{ab}{k}" for k in HARMONICS for ab in ("a", "b"))
+    units = ("Nm",) * (2 * len(HARMONICS))
+
+    def columns(self, context, signals, tau_model):
+        q = signals.q
+        if context.q_range is not None:
+            q = np.clip(q, *context.q_range)
+        out = np.stack([f(k * q) for k in self.HARMONICS for f in (np.cos, np.sin)], axis=-1)
+        for j, joint in enumerate(context.robot.joints):
+            if not joint.revolute:  # harmonics of a position in metres mean nothing
+                out[:, j, :] = 0.0
+        return out
 
 
 class Viscous(_Dissipative):
@@ -39,7 +90,7 @@ class Viscous(_Dissipative):
 
 class Stribeck(_Dissipative):
     name, parameters, units = "stribeck", ("Fs",), ("Nm",)
-    refinable = True
+    refinable = switching = True
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)

@@ -23,6 +23,8 @@ import numpy as np
 
 from .base import Effect
 
+MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor's time shift
+
 
 class Offset(Effect):
     name, parameters, units = "offset", ("b",), ("Nm",)
@@ -63,6 +65,9 @@ class TimeShift(Effect):
 
     def implied_setting(self, values):
         return float(values[0]) or None
+
+    def plausible(self, values):
+        return bool(abs(values[0]) < MAX_SHIFT)
 
     def at(self, setting):
         return TimeShift(setting)

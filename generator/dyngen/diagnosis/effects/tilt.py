@@ -1,12 +1,21 @@
-"""A tilted base: gravity in the base frame is not the model's direction.
+"""A tilted base, and a gravity of the wrong size.
 
 The gravity torque is linear in the gravity vector: g(q) = G(q) gvec, with column k of G the
-joint torques that a unit gravity along base axis k would cause. A tilt by small angles turns
-gvec by d gvec, perpendicular to it, so the residual is G(q) d gvec: three columns, G(q) u1, G(q) u2 and
-G(q) n, with u1, u2 unit vectors perpendicular to the model's gravity and n along it. The
-fitted values are the components of d gvec [m/s^2]; the third takes the second-order change
-along gravity (|gvec| (1 - cos angle)), so the tilt is exact, not only to first order. The
-tilt angles follow from the rotated vector gvec + d gvec.
+joint torques that a unit gravity along base axis k would cause.
+
+tilt: a rotation of the base turns gvec by d gvec, so the residual is G(q) d gvec. Across
+  gravity, d gvec = dg1 u1 + dg2 u2 (u1, u2 unit vectors perpendicular to the model's gravity):
+  two fitted values. Along gravity a rotation shortens the component by exactly what keeps
+  |gvec| unchanged, -(dg1^2 + dg2^2) / (2 |g|) to second order (0.013 m/s^2 for 3 deg: small,
+  but a diagnosis that left it out would report it as a gravity scale). It is not a third
+  value: column k is G u_k - G n dg_k0 / (2 |g|) at the current estimate dg_k0, refined by
+  fixed-point iteration once the tilt is selected (refine.py), so a tilt cannot change
+  gravity's magnitude. The angles follow from the rotated vector, and are named by the
+  base axes they turn gravity towards (tilt_axes). Tilts beyond MAX_TILT_DEG are not a
+  mounting error and are refused.
+gravity_scale: G(q) n dg, n along gravity: the gravity torque of every link scaled alike. No
+  tilt does this; masses and centres of mass all wrong by one factor, or a torque gain, do.
+  It is always reported as suspect (a symptom, not a cause).
 
 G(q) comes from the joint models' forward kinematics (numpy, vectorised over samples):
 for joint i with axis z through o, and every link k it carries, with centre of mass p_k,
@@ -22,16 +31,63 @@ from ...description.joint_model import forward_kinematics
 from .base import Effect
 
 
+MAX_TILT_DEG = 10.0
+MAX_GRAVITY_SCALE = 0.1  # relative: a larger change of gravity's size is refused
+
+
 class Tilt(Effect):
     name, scope = "tilt", "arm"
-    parameters = ("dg1", "dg2", "dgn")
-    units = ("m/s^2", "m/s^2", "m/s^2")
+    parameters = ("dg1", "dg2")
+    units = ("m/s^2", "m/s^2")
+    g = 9.81  # set from the robot in columns()
+    refinable = True
+
+    def __init__(self, estimate=(0.0, 0.0)):
+        self.estimate = tuple(float(x) for x in estimate)  # dg1, dg2 of the second-order term
+        self.label = "" if not any(self.estimate) else f"dg0=({self.estimate[0]:.6g},{self.estimate[1]:.6g})"
+
+    @property
+    def setting(self):
+        return np.array(self.estimate)
+
+    def implied_setting(self, values):
+        return np.array(values[:2], dtype=float) if np.any(values[:2]) else None
+
+    def at(self, setting):
+        return Tilt(setting)
 
     def columns(self, context, signals, tau_model):
-        G = gravity_matrix(context.robot, context.p, signals.q)  # (T, N, 3)
+        self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
+        G = _gravity(context, signals)  # (T, N, 3)
         u1, u2 = tilt_directions(context.robot)
-        n = np.cross(u1, u2)
-        return np.stack([G @ u1, G @ u2, G @ n], axis=-1)
+        along = G @ np.cross(u1, u2)
+        return np.stack([G @ u1 - along * self.estimate[0] / (2 * self.g),
+                         G @ u2 - along * self.estimate[1] / (2 * self.g)], axis=-1)
+
+    def plausible(self, values):
+        return bool(np.hypot(*values[:2]) < self.g * np.sin(np.radians(MAX_TILT_DEG)))
+
+
+class GravityScale(Effect):
+    name, scope = "gravity_scale", "arm"
+    parameters = ("dg",)
+    units = ("m/s^2",)
+    suspect = secondary = True
+    g = 9.81
+
+    def columns(self, context, signals, tau_model):
+        self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
+        G = _gravity(context, signals)
+        u1, u2 = tilt_directions(context.robot)
+        return (G @ np.cross(u1, u2))[:, :, None]
+
+    def plausible(self, values):
+        return bool(abs(values[0]) < MAX_GRAVITY_SCALE * self.g)
+
+
+def _gravity(context, signals) -> np.ndarray:
+    """G(q) of a recording, computed once for the tilt and the gravity scale."""
+    return context.memo(("gravity_matrix", id(signals)), lambda: gravity_matrix(context.robot, context.p, signals.q))
 
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
@@ -47,11 +103,21 @@ def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
 
 def tilt_angles_deg(robot, dg) -> tuple[float, float]:
     """Rotation angles [deg] of gravity towards u1 and u2 for the fitted components (dg1,
-    dg2, dgn): the angles of the rotated vector's u1 and u2 components against its component
-    along the model's gravity."""
+    dg2): the angles of the rotated vector's u1 and u2 components against gravity."""
     g = np.linalg.norm([float(x) for x in robot.gravity])
-    along = g + dg[2]
-    return float(np.degrees(np.arctan2(dg[0], along))), float(np.degrees(np.arctan2(dg[1], along)))
+    return float(np.degrees(np.arctan2(dg[0], g))), float(np.degrees(np.arctan2(dg[1], g)))
+
+
+def tilt_axes(robot) -> tuple[str, str]:
+    """Names of u1 and u2 in the base frame, e.g. ("base +x", "base -y") for gravity along -z."""
+    names = []
+    for u in tilt_directions(robot):
+        k = int(np.argmax(np.abs(u)))
+        if abs(abs(u[k]) - 1.0) < 1e-9:
+            names.append(f"base {'+' if u[k] > 0 else '-'}{'xyz'[k]}")
+        else:
+            names.append("base (" + ", ".join(f"{x:.3g}" for x in u) + ")")
+    return names[0], names[1]
 
 
 def gravity_matrix(robot, p, q) -> np.ndarray:

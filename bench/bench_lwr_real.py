@@ -1,0 +1,73 @@
+"""The diagnosis on the real KUKA LWR4+ recordings (examples/lwr4-real), with three roles:
+fit on measurement 1, 2 or both (selection on blocks of them), test on measurement 3 (a
+different, faster trajectory), and fit 1 -> test 2 (the same trajectory repeated: must be
+flagged). Per joint, the test RMS of the nominal model, of the final model, and of the simple
+model (offset + Coulomb + viscous per joint, fitted on the same fit data).
+
+    python bench/bench_lwr_real.py        # writes bench/results/lwr_real.md
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "generator"))
+
+from dyngen import blas  # noqa: E402
+
+blas.use_one_thread()
+
+import numpy as np  # noqa: E402
+
+from dyngen.atomic import write_file  # noqa: E402
+from dyngen.data import condition, read_recording  # noqa: E402
+from dyngen.data.parameters_file import read_link_parameters  # noqa: E402
+from dyngen.description import load_robot  # noqa: E402
+from dyngen.diagnosis import diagnose  # noqa: E402
+from dyngen.runtime import load  # noqa: E402
+
+HERE = ROOT / "examples" / "lwr4-real"
+RUNS = (([1], [3]), ([2], [3]), ([1, 2], [3]), ([1], [2]))
+
+
+def main() -> int:
+    robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(ROOT / "generated" / "lwr")
+    p = read_link_parameters(ROOT / "examples" / "lwr_paper_solution.yaml", 7)
+
+    def recording(k):
+        return condition(read_recording(HERE / f"measurement_{k}.csv", 7))
+
+    lines = ["# Diagnosis of the real LWR4+ (bench/bench_lwr_real.py)", "",
+             "`python bench/bench_lwr_real.py`: paper's parameters (examples/lwr_paper_solution.yaml), default "
+             "options; fit on the named measurement(s) with selection on blocks of them, test on another that "
+             "plays no other part. Test RMS per joint [Nm]; 'simple' is b + Fc tanh(qd/0.02) + Fv qd per joint "
+             "fitted on the same fit data.", ""]
+    for fit, test in RUNS:
+        start = time.perf_counter()
+        d = diagnose(robot, model, p, [recording(k) for k in fit], None, test=[recording(k) for k in test])
+        seconds = time.perf_counter() - start
+        after, simple = np.array(d.rms_after), np.array(d.rms_simple)
+        worse = [j + 1 for j in range(7) if after[j] > simple[j] + 1e-9]
+        name = f"fit m{'+m'.join(map(str, fit))} -> test m{test[0]}"
+        lines += [f"## {name} ({seconds:.1f} s)", "",
+                  "| | " + " | ".join(f"J{j}" for j in range(1, 8)) + " | mean |", "|---|" + "---:|" * 8,
+                  "| nominal | " + " | ".join(f"{x:.3f}" for x in d.rms_before) + f" | {np.mean(d.rms_before):.3f} |",
+                  "| **final model** | " + " | ".join(f"{x:.3f}" for x in after) + f" | {after.mean():.3f} |",
+                  "| selected effects alone | " + " | ".join(f"{x:.3f}" for x in d.rms_effects)
+                  + f" | {np.mean(d.rms_effects):.3f} |",
+                  "| simple model | " + " | ".join(f"{x:.3f}" for x in simple) + f" | {simple.mean():.3f} |", "",
+                  f"Joints where the final model is worse than the simple model: {worse or 'none'}. Per joint "
+                  f"model: {', '.join(f'J{j + 1} {m}' for j, m in enumerate(d.joint_models))}.", "",
+                  "Selected: " + "; ".join(f"{e['effect']} {e['joints']}" for e in d.selected) + ".", ""]
+        lines += [f"- warning: {w}" for w in d.warnings] + [""]
+        print(f"{name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple {np.round(simple, 3)}; "
+              f"worse on {worse}", flush=True)
+    write_file(ROOT / "bench" / "results" / "lwr_real.md", "\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,119 @@
+"""Per joint, the final model: the selected effects, the simple model, or both together.
+
+The simple model (baseline.py) is what every diagnosis must beat. On each joint three models
+are fitted on the fit samples and compared on the selection samples:
+
+  effects    the selected effects as fitted together (the diagnosis's findings);
+  simple     b + Fc tanh(qd/0.02) + Fv qd alone;
+  completed  the effects acting on the joint plus the simple model's three columns, refitted on
+             that joint (the arm-wide effects' torque kept as it is): a joint whose effects
+             were each chosen for a large gain may still lack an offset or a plain friction
+             term that none of them covers.
+
+The effects stay unless another model does better on the selection data, where the model with
+more values on the joint must gain `min_gain` of the mean square per extra value (what an
+effect must gain to be selected at all), so that three numbers fitting noise do not replace a
+one-value finding, and six ripple harmonics do not displace the simple model on a whim. The decision is made with the values fitted on the fit samples only;
+`apply` then sets each joint's correction with the final values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import baseline
+from . import design as dz
+
+EFFECTS, SIMPLE, COMPLETED = "effects", "simple", "effects + simple"
+
+
+def _split(chosen, x):
+    out, offset = [], 0
+    for c in chosen:
+        out.append(x[offset: offset + c.size])
+        offset += c.size
+    return out
+
+
+def _parts(context, chosen, x, seg, j):
+    """(arm-wide effects' torque on joint j, columns of the per-joint effects on joint j)."""
+    arm = np.zeros(seg.residual.shape[0])
+    columns = []
+    for c, v in zip(chosen, _split(chosen, x)):
+        cols = dz.columns_of(c.effect, context, seg)[:, j, :]
+        if c.joint is None:
+            arm += cols @ v
+        elif c.joint == j:
+            columns.append(cols)
+    return arm, columns
+
+
+def _completed_fit(context, chosen, x, segments, j):
+    """Least squares of [per-joint effects on j, simple columns] to the residual left by the
+    arm-wide effects, on the fit samples; returns the values."""
+    rows, targets = [], []
+    for seg in segments:
+        if not seg.fit.any():
+            continue
+        arm, columns = _parts(context, chosen, x, seg, j)
+        A = np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]])
+        rows.append(A[seg.fit])
+        targets.append((seg.residual[:, j] - arm)[seg.fit])
+    return np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]
+
+
+def _completed_predict(context, chosen, x, values, seg, j):
+    arm, columns = _parts(context, chosen, x, seg, j)
+    return arm + np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]]) @ values
+
+
+def decide(context, segments, chosen, x, simple, min_gain: float) -> list[str]:
+    """Per joint EFFECTS, SIMPLE or COMPLETED; seg.correction holds the effects' torques."""
+    n = segments[0].residual.shape[1]
+    modes = []
+    for j in range(n):
+        acting = any(c.joint is None or c.joint == j for c in chosen)
+        values = _completed_fit(context, chosen, x, segments, j) if acting else None
+        sse = {EFFECTS: 0.0, SIMPLE: 0.0, COMPLETED: 0.0}
+        for seg in segments:
+            m = seg.select
+            if not m.any():
+                continue
+            r = seg.residual[m, j]
+            sse[EFFECTS] += float(np.sum((r - seg.correction[m, j]) ** 2))
+            sse[SIMPLE] += float(np.sum((r - baseline.predict(simple, seg)[m, j]) ** 2))
+            if acting:
+                sse[COMPLETED] += float(np.sum((r - _completed_predict(context, chosen, x, values, seg, j)[m]) ** 2))
+        own = sum(c.size for c in chosen if c.joint == j)  # values of the effects on this joint
+        size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES)}
+        best = EFFECTS
+        for other in (SIMPLE, COMPLETED) if acting else (SIMPLE,):
+            if _better(sse[other], size[other], sse[best], size[best], min_gain):
+                best = other
+        modes.append(best)
+    return modes
+
+
+def _better(sse, size, best_sse, best_size, min_gain) -> bool:
+    """Whether a model beats the current best on selection data, the one with more values
+    having to gain `min_gain` of the mean square per extra value (as an effect must to be
+    selected), the one with fewer values winning ties."""
+    if size > best_size:
+        return sse < (1 - min_gain) ** (size - best_size) * best_sse
+    return sse <= best_sse / (1 - min_gain) ** (best_size - size)
+
+
+def apply(context, segments, chosen, x, simple, modes) -> dict:
+    """Set seg.correction per joint by its mode (the effects' torques already there);
+    returns {joint (1-based): values of the completed model} for the report."""
+    completed = {}
+    for j, mode in enumerate(modes):
+        if mode == SIMPLE:
+            for seg in segments:
+                seg.correction[:, j] = baseline.predict(simple, seg)[:, j]
+        elif mode == COMPLETED:
+            values = _completed_fit(context, chosen, x, segments, j)
+            completed[j + 1] = values.tolist()
+            for seg in segments:
+                seg.correction[:, j] = _completed_predict(context, chosen, x, values, seg, j)
+    return completed

@@ -1,0 +1,99 @@
+"""Three roles for data, never mixed (docs: README, "From measured data"):
+
+  fit     sets the effects' values (and the simple model's);
+  select  chooses which effects are kept (their gain on these samples, never fitted to them);
+  test    is used for nothing but the residual reported as held out.
+
+Without select recordings, selection uses blocks of the fit recordings (every third block of
+`block_seconds`), with a guard of the filter's length around every block boundary that belongs
+to neither role (a zero-phase filter spreads each sample over its neighbours). Without test
+recordings nothing is reported as held out: the report then labels its figures as selection
+figures.
+
+A test recording that repeats a fit recording's trajectory (positions nearly equal sample by
+sample) is not evidence that the effects generalise, only that they repeat: `repeated` finds
+such pairs, and the report says so.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..catalogue import RNEA
+
+REPEATED_SHARE = 0.02  # RMS position difference below this share of the motion's range: same trajectory
+
+
+@dataclass
+class Segment:
+    """One recording with the model's torques, its residual and its samples' roles."""
+
+    signals: object
+    tau_model: np.ndarray
+    residual: np.ndarray
+    fit: np.ndarray  # bool (T,)
+    select: np.ndarray
+    test: np.ndarray
+    correction: np.ndarray | None = None  # the final model's correction (effects, or the simple model per joint)
+
+
+def segments(model, s, fit_signals, select_signals, test_signals, block_seconds: float) -> tuple[list, str]:
+    out = []
+
+    def segment(sig, fit, select, test):
+        # The filtered motion's torque is the filtered torque's model (filtering it again
+        # would smooth twice what the recording smoothed once).
+        tau_model = model.batch(RNEA.name, sig.q, sig.qd, sig.qdd, s)
+        return Segment(sig, tau_model, sig.tau - tau_model, fit, select, test)
+
+    none = lambda sig: np.zeros(sig.t.size, dtype=bool)  # noqa: E731
+    if select_signals:
+        for sig in fit_signals:
+            out.append(segment(sig, sig.inner(), none(sig), none(sig)))
+        for sig in select_signals:
+            out.append(segment(sig, none(sig), sig.inner(), none(sig)))
+        split = "selection on separate recordings"
+    else:
+        for sig in fit_signals:
+            fit, select = _blocks(sig, block_seconds)
+            out.append(segment(sig, fit, select, none(sig)))
+        split = f"selection on blocks of {block_seconds:g} s of the fit data (every third)"
+    for sig in test_signals or []:
+        out.append(segment(sig, none(sig), none(sig), sig.inner()))
+    return out, split
+
+
+def _blocks(sig, block_seconds: float) -> tuple[np.ndarray, np.ndarray]:
+    inner = sig.inner()
+    block = np.floor((sig.t - sig.t[0]) / block_seconds).astype(int)
+    select = block % 3 == 2
+    guard = max(sig.trim - 2, 0)  # the filter's reach in samples (conditioning.EDGE_PERIODS)
+    if guard:
+        edges = np.flatnonzero(np.diff(select.astype(int))) + 0.5
+        k = np.arange(sig.t.size)
+        near = np.zeros(sig.t.size, dtype=bool)
+        for e in edges:
+            near |= np.abs(k - e) <= guard
+        inner = inner & ~near
+    return inner & ~select, inner & select
+
+
+def repeated(fit_signals, test_signals) -> list[tuple[str, str, float]]:
+    """(fit name, test name, RMS position difference [rad]) for every test recording whose
+    positions follow a fit recording's, sample time by sample time from their starts."""
+    out = []
+    for test in test_signals or []:
+        for fit in fit_signals:
+            tf, tt = fit.t - fit.t[0], test.t - test.t[0]
+            span = min(tf[-1], tt[-1])
+            if span <= 0 or span < 0.5 * max(tf[-1], tt[-1]):
+                continue
+            k = tf <= span
+            q_test = np.column_stack([np.interp(tf[k], tt, test.q[:, j]) for j in range(test.q.shape[1])])
+            diff = float(np.sqrt(np.mean((fit.q[k] - q_test) ** 2)))
+            motion = float(np.mean(np.ptp(fit.q, axis=0)))
+            if motion > 0 and diff < REPEATED_SHARE * motion:
+                out.append((fit.name, test.name, diff))
+    return out
