@@ -179,7 +179,7 @@ def speed(lines):
         best = np.inf
         for _ in range(2):
             start = time.perf_counter()
-            c = identify_consistent(robot, model, FOLDER, [s], options)
+            identify_consistent(robot, model, FOLDER, [s], options)
             best = min(best, time.perf_counter() - start)
         times[label] = best
     lines += ["| identify_consistent | best of 2 [s] |", "|---|---:|"]

@@ -64,7 +64,7 @@ def measure(yaml_path: Path, tmp: Path) -> list:
     env = dict(os.environ, DYNGEN_CACHE_DIR=str(tmp / "cache"))  # an empty cache: the first run compiles the driver
     (tmp / "drivers").mkdir()
     cmd = [sys.executable, "-m", "dyngen", "extract", yaml_path, "-o", tmp / "gen2", "--out", tmp / "out", "-q"]
-    for label in ("driver compiled (g++) in the run", "driver cached"):
+    for label in ("static driver and arm compiled (g++) in the run", "driver cached"):
         log(f"extraction ({label}) ...")
         ext = checked(run_measured(cmd, env=env), "dyngen extract")
         rows.append(("extraction", f"`dyngen extract {yaml_path.name}` (generates first), {label}",

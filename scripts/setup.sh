@@ -34,3 +34,8 @@ if ! $PY -m pip install -q --disable-pip-version-check -e ".[test]" 2>/tmp/dynge
     cat /tmp/dyngen-pip.err >&2; exit 1
   fi
 fi
+
+# The extractor driver is a static program, compiled once per user into the per-user cache
+# (about a minute); each arm then only links its generated C to it (extraction/driver.py).
+echo "setup: compiling the extractor driver once"
+$PY -c "from dyngen.extraction.driver import build_core; build_core()"

@@ -7,13 +7,11 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-import sympy as sp
 from conftest import ROOT, build_arm
 from oracles import lagrangian as lag
 from oracles.arm import Arm, nominal_parameters
 from oracles.random_params import random_parameters, random_rotation
 
-from dyngen.derivation.kinematics import transform
 from dyngen.description import load_robot
 from dyngen.export import to_mjcf, to_urdf, write_all
 from dyngen.export.frames import quaternion, rpy
@@ -56,10 +54,12 @@ def mujoco_inverse(model, data, q, qd, qdd):
 
 
 def dh_poses(robot, q) -> list[np.ndarray]:
-    """Base-frame poses of DH frames 1..N from the derivation's own transform."""
+    """Base-frame poses of DH frames 1..N from the DH formulas of the Lagrangian oracle."""
     T, out = np.eye(4), []
     for joint, qi in zip(robot.joints, q):
-        T = T @ np.array(transform(robot.convention, joint, sp.Float(qi, 30)).evalf(30), dtype=float)
+        a, alpha, d, theta = (float(x) for x in (joint.a, joint.alpha, joint.d, joint.theta))
+        T = T @ lag.dh_transform(robot.convention, a, alpha, d + (0.0 if joint.revolute else qi),
+                                 theta + (qi if joint.revolute else 0.0))
         out.append(T)
     return out
 
@@ -205,7 +205,7 @@ def test_exported_dh_frames_match_dh_kinematics(built, exported):
 
 def check_dh_frames(robot, paths):
     """DH frames 1..N of both files (URDF links, MJCF sites) at random q equal the product
-    of dyngen.derivation.kinematics.transform; the URDF base is frame 0."""
+    of the DH transforms; the URDF base is frame 0."""
     pmodel, pdata = load_pinocchio(paths[".urdf"], robot)
     mmodel, mdata = load_mujoco(paths[".xml"])
     rng = np.random.default_rng(9)

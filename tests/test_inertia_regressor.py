@@ -125,7 +125,7 @@ def test_operation_count_is_the_loop_trips_times_the_body_plus_the_motions():
     robot = load_robot(ARMS["lwr"])
     bases, emitted = build(robot)
     motions = Derivation(robot).unit_accelerations()
-    straight = straight_line(robot.name, robot.joints, motions, motions.outputs).ops + count_all(motions.outputs)
+    straight = straight_line(robot.name, robot.joint_models, motions, motions.outputs).ops + count_all(motions.outputs)
     n = robot.dof
     Counter.mul = Counter.add = 0
     stacked_regressor([[Counter() for _ in range(6)] for _ in range(n * (n + 1) // 2)], bases["inertia"].pivots, n)

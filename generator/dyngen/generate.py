@@ -9,14 +9,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .atomic import write_folder
+from .catalogue import KINDS
 from .derivation.models import Derivation
 from .description import Robot, load_robot
 from .emission.render import Emitted, emit
 from .progress import Progress
 from .errors import InputError
 from .reduction.base import BaseSet, reduce_model
-
-KINDS = ("gravity", "inertia", "full")
 
 
 @dataclass

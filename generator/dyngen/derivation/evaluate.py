@@ -13,8 +13,8 @@ import sympy as sp
 DIGITS = 40
 
 
-def evaluate(model, joints, inputs: dict) -> list[float]:
-    """model: a derivation Model; joints: the robot's joints (for the angle offsets);
+def evaluate(model, joint_models, inputs: dict) -> list[float]:
+    """model: a derivation Model; joint_models: the robot's (for the angle offsets);
     inputs: argument name -> flat list of numbers. Returns the flat outputs as floats."""
     with mpmath.workdps(DIGITS):
         env = {}
@@ -23,8 +23,8 @@ def evaluate(model, joints, inputs: dict) -> list[float]:
             if len(values) != len(inp.symbols):
                 raise ValueError(f"{model.name}: {inp.name} needs {len(inp.symbols)} values, got {len(values)}")
             env.update({sym: mpmath.mpf(v) for sym, v in zip(inp.symbols, values)})
-        for sym, (joint, fn) in model.trig.items():  # sin/cos of q + theta, as the emitted C computes them
-            angle = mpmath.mpf(inputs["q"][joint]) + _value(sp.sympify(joints[joint].theta), env)
+        for sym, (joint, fn) in model.trig.items():  # sin/cos of q + offset, as the emitted C computes them
+            angle = mpmath.mpf(inputs["q"][joint]) + _value(sp.sympify(joint_models[joint].offset), env)
             env[sym] = mpmath.sin(angle) if fn == "sin" else mpmath.cos(angle)
         for a in model.assignments:
             env[a.symbol] = _value(a.expr, env)

@@ -1,8 +1,11 @@
-"""Denavit-Hartenberg geometry of one joint, in the form the recursion needs.
+"""Each joint model (description/joint_model.py) in the form the recursion needs.
 
-standard (classical): T(i-1,i) = Rz(theta) Tz(d) Tx(a) Rx(alpha); joint i turns about z(i-1).
-modified (Craig):     T(i-1,i) = Rx(alpha) Tx(a) Rz(theta) Tz(d); joint i turns about z(i).
-A revolute joint adds q to theta, a prismatic one adds q to d.
+The recursion crosses joint i at a point X fixed in link i-1 (for a revolute joint on its axis,
+so that X moves with link i-1 and with link i alike): it moves link i-1's acceleration from
+O(i-1) to X (`before`, in frame i-1), turns into frame i, adds the joint's motion and moves on
+from X to O(i) (`after`, in frame i). X is the joint frame's origin. A prismatic joint's slide
+is carried on the side that already has a translation (the link frame's when the placement has
+none, as in standard DH), so that at most one of the two moves is not zero.
 """
 
 from __future__ import annotations
@@ -11,43 +14,38 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..description import Joint
+from ..description.joint_model import JointModel, rot_z
+from .program import add, mat_t_vec, mat_vec
+
+ZERO = [sp.Integer(0)] * 3
 
 
 @dataclass(frozen=True)
 class JointGeometry:
-    R: sp.Matrix  # rotation of frame i in frame i-1
-    offset: list  # standard: O(i-1)->O(i) in frame i; modified: O(i-1)->O(i) in frame i-1
-    axis: list  # joint axis in frame i (unit vector)
+    R: sp.Matrix  # rotation of link frame i in frame i-1
+    before: list  # O(i-1) -> X, in frame i-1
+    after: list  # X -> O(i), in frame i
+    spin: list  # joint axis in frame i for a revolute joint, else zero
+    slide: list  # joint axis in frame i for a prismatic joint, else zero
+
+    @property
+    def revolute(self) -> bool:
+        return any(x != 0 for x in self.spin)
 
 
-def rot_x(cos_a, sin_a) -> sp.Matrix:
-    return sp.Matrix([[1, 0, 0], [0, cos_a, -sin_a], [0, sin_a, cos_a]])
-
-
-def rot_z(cos_t, sin_t) -> sp.Matrix:
-    return sp.Matrix([[cos_t, -sin_t, 0], [sin_t, cos_t, 0], [0, 0, 1]])
-
-
-def joint_geometry(convention: str, joint: Joint, cos_t, sin_t, d) -> JointGeometry:
-    """cos_t, sin_t: of the full angle theta (q + offset for revolute); d: full offset."""
-    ca, sa = sp.cos(joint.alpha), sp.sin(joint.alpha)
-    a = joint.a
-    if convention == "standard":
-        return JointGeometry(R=rot_z(cos_t, sin_t) * rot_x(ca, sa), offset=[a, d * sa, d * ca], axis=[0, sa, ca])
-    return JointGeometry(R=rot_x(ca, sa) * rot_z(cos_t, sin_t), offset=[a, -d * sa, d * ca], axis=[0, 0, 1])
-
-
-def transform(convention: str, joint: Joint, q) -> sp.Matrix:
-    """The 4x4 homogeneous T(i-1,i) for a numeric or symbolic q (used by tests and export)."""
-    theta = joint.theta + q if joint.revolute else joint.theta
-    d = joint.d if joint.revolute else joint.d + q
-    g = joint_geometry(convention, joint, sp.cos(theta), sp.sin(theta), d)
-    if convention == "standard":
-        position = g.R * sp.Matrix(g.offset)
+def joint_geometry(model: JointModel, cos_t, sin_t, coordinate) -> JointGeometry:
+    """cos_t, sin_t: of a revolute joint's full angle (q + offset); coordinate: a prismatic
+    joint's full length (q + offset), else unused."""
+    place, frame = model.placement, model.frame
+    axis = list(frame.R.row(2))  # z of J_i in frame i: the third row of frame.R
+    if model.revolute:
+        R = place.R * rot_z(cos_t, sin_t) * frame.R
+        slide, spin, moved = ZERO, axis, ZERO
     else:
-        position = sp.Matrix(g.offset)
-    T = sp.eye(4)
-    T[:3, :3] = g.R
-    T[:3, 3] = position
-    return T
+        R = place.R * frame.R
+        slide, spin, moved = axis, ZERO, [0, 0, coordinate]
+    if place.moves:
+        before, after = add(list(place.p), mat_vec(place.R, moved)), mat_t_vec(frame.R, list(frame.p))
+    else:
+        before, after = ZERO, mat_t_vec(frame.R, add(moved, list(frame.p)))
+    return JointGeometry(R=R, before=before, after=after, spin=spin, slide=slide)

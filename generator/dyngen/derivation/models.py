@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from ..catalogue import ARGUMENTS
 from ..description import Robot
 from ..parameters import PER_LINK, dynamic_symbols, standard_from_dynamic_link, standard_symbols
 from .newton_euler import Chain, joint_symbols, link_wrench
@@ -52,15 +53,14 @@ class Derivation:
     # ---- inputs -------------------------------------------------------------------------
 
     def _joint_inputs(self, sym, *which):
-        docs = {"q": "joint positions [rad or m]", "qd": "joint velocities", "qdd": "joint accelerations"}
-        return [Input(w, getattr(sym, w), docs[w]) for w in which]
+        return [Input(w, getattr(sym, w), ARGUMENTS[w].meaning) for w in which]
 
     def _gravity_inputs(self):
         g = list(self.robot.gravity_symbols)
-        return [Input("gravity", g, "gravity symbols " + ", ".join(map(str, g)))] if g else []
+        return [Input("gravity", g, ARGUMENTS["gravity"].meaning + " " + ", ".join(map(str, g)))] if g else []
 
     def _params_input(self):
-        return Input("s", self.s, "standard parameters, 10 per link (docs/conventions.md)")
+        return Input("s", self.s, ARGUMENTS["s"].meaning)
 
     def _start(self):
         program = Program()
@@ -143,7 +143,7 @@ class Derivation:
         for i in range(self.n):
             program.section = f"link {i + 1}"
             out += program.let_vector(standard_from_dynamic_link(self.p[PER_LINK * i: PER_LINK * (i + 1)]))
-        return Model("standard_from_dynamic", [Input("p", self.p, "dynamic parameters, 10 per link")], out,
+        return Model("standard_from_dynamic", [Input("p", self.p, ARGUMENTS["p"].meaning)], out,
                      (PER_LINK * self.n,), "standard parameters s from dynamic parameters p", program)
 
 
@@ -156,7 +156,7 @@ def coefficient_model(derivation: Derivation, base, kind: str) -> Model:
         s_exprs += program.let_vector(standard_from_dynamic_link(derivation.p[PER_LINK * i: PER_LINK * (i + 1)]))
     program.section = "coefficients"
     outputs = [program.let(sp.Add(*(k * s for k, s in zip(row, s_exprs) if k != 0))) for row in base.K]
-    return Model(f"pi_{kind}", [Input("p", derivation.p, "dynamic parameters, 10 per link")], outputs,
+    return Model(f"pi_{kind}", [Input("p", derivation.p, ARGUMENTS["p"].meaning)], outputs,
                  (len(outputs),), f"{kind} base coefficients", program)
 
 
@@ -181,5 +181,5 @@ def coefficient_jacobian_model(derivation: Derivation, base, kind: str) -> Model
                 J[r][PER_LINK * i + l] = program.let(
                     sp.Add(*(row[PER_LINK * i + j] * ds[j][l] for j in range(PER_LINK) if row[PER_LINK * i + j] != 0)))
     outputs = [x for row in J for x in row]
-    return Model(f"pi_{kind}_jacobian", [Input("p", derivation.p, "dynamic parameters, 10 per link")], outputs,
+    return Model(f"pi_{kind}_jacobian", [Input("p", derivation.p, ARGUMENTS["p"].meaning)], outputs,
                  (len(base.K), n_params), f"Jacobian of pi_{kind} with respect to p", program)

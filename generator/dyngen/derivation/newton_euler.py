@@ -56,23 +56,19 @@ def joint_symbols(robot: Robot) -> Symbols:
 
 
 class Chain:
-    """The arm's geometry inside one Program: trig variables and per-joint geometry."""
+    """The arm's joint models inside one Program: trig variables and per-joint geometry."""
 
     def __init__(self, robot: Robot, program: Program, symbols: Symbols):
         self.robot, self.program, self.symbols = robot, program, symbols
-        self.standard = robot.convention == "standard"
         self.geometry: list[JointGeometry] = []
         program.section = "joint angles"
-        for i, joint in enumerate(robot.joints):
-            q = symbols.q[i]
-            if joint.revolute:
+        for i, model in enumerate(robot.joint_models):
+            if model.revolute:
                 s, c = sp.Symbol(f"s{i + 1}", real=True), sp.Symbol(f"c{i + 1}", real=True)
                 symbols.trig[s], symbols.trig[c] = (i, "sin"), (i, "cos")
-                d = joint.d
+                self.geometry.append(joint_geometry(model, c, s, None))
             else:
-                s, c = sp.sin(joint.theta), sp.cos(joint.theta)
-                d = program.let(joint.d + q)
-            self.geometry.append(joint_geometry(robot.convention, joint, c, s, d))
+                self.geometry.append(joint_geometry(model, None, None, program.let(model.offset + symbols.q[i])))
 
     # ---- forward ---------------------------------------------------------------------
 
@@ -99,24 +95,16 @@ class Chain:
     def step(self, i, parent: Motion, qd_i, qdd_i) -> Motion:
         """Link i's motion from its parent's (link i-1's, or the base's) and joint i's rate and acceleration."""
         let, lets = self.program.let, self.program.let_vector
-        joint, geo = self.robot.joints[i], self.geometry[i]
-        a = parent.a
-        if not self.standard:  # modified DH: O_i is fixed in link i-1
-            a = add(a, mat_vec(parent.U, geo.offset))
+        geo = self.geometry[i]
+        a = add(parent.a, mat_vec(parent.U, geo.before))  # at X, fixed in link i-1
         w_in, wd_in, a_in = lets(mat_t_vec(geo.R, parent.w)), lets(mat_t_vec(geo.R, parent.wd)), lets(mat_t_vec(geo.R, a))
-        if joint.revolute:
-            spin = scale(qd_i, geo.axis)
-            w = lets(add(w_in, spin))
-            wd = lets(add(wd_in, scale(qdd_i, geo.axis), cross(w_in, spin)))
-        else:
-            w, wd = w_in, wd_in
+        spin = scale(qd_i, geo.spin)
+        w = lets(add(w_in, spin))
+        wd = lets(add(wd_in, scale(qdd_i, geo.spin), cross(w_in, spin)))
         ww = {(r, c): let(w[r] * w[c]) for r in range(3) for c in range(r, 3)}
         U = _u_matrix(let, ww, wd)
-        if self.standard:  # O_(i-1) lies on joint i's axis, fixed in link i
-            a_in = add(a_in, mat_vec(U, geo.offset))
-        if not joint.revolute:
-            slide = scale(qd_i, geo.axis)
-            a_in = add(a_in, scale(qdd_i, geo.axis), scale(2, cross(w, slide)))
+        slide = scale(qd_i, geo.slide)
+        a_in = add(a_in, mat_vec(U, geo.after), scale(qdd_i, geo.slide), scale(2, cross(w, slide)))
         return Motion(w, wd, lets(a_in), U, ww)
 
     # ---- backward --------------------------------------------------------------------
@@ -124,20 +112,17 @@ class Chain:
     def to_parent(self, i, f, n):
         """Wrench (f, n about O_i, frame i) of link i's subtree as seen in frame i-1 about O_(i-1)."""
         lets, geo = self.program.let_vector, self.geometry[i]
-        if self.standard:
-            n = lets(add(n, cross(geo.offset, f)))
-            return lets(mat_vec(geo.R, f)), lets(mat_vec(geo.R, n))
+        n = lets(add(n, cross(geo.after, f)))  # about X
         f, n = lets(mat_vec(geo.R, f)), lets(mat_vec(geo.R, n))
-        return f, lets(add(n, cross(geo.offset, f)))
+        return f, lets(add(n, cross(geo.before, f)))
 
     def joint_torque(self, i, f, n):
         """Joint i's generalised force from link i's subtree wrench (f, n about O_i, frame i)."""
         geo = self.geometry[i]
-        if not self.robot.joints[i].revolute:
-            return self.program.let(sp.Add(*(x * y for x, y in zip(geo.axis, f))))
-        if self.standard:  # moment about O_(i-1), which is on the axis
-            n = self.program.let_vector(add(n, cross(geo.offset, f)))
-        return self.program.let(sp.Add(*(x * y for x, y in zip(geo.axis, n))))
+        if not geo.revolute:  # a slide needs no moment
+            return self.program.let(sp.Add(*(x * y for x, y in zip(geo.slide, f))))
+        n = self.program.let_vector(add(n, cross(geo.after, f)))  # about X, which is on the axis
+        return self.program.let(sp.Add(*(x * y for x, y in zip(geo.spin, n))))
 
     def backward(self, wrenches) -> list:
         """Joint torques from per-link wrenches [(F_i, N_i)], tip to base."""

@@ -13,18 +13,20 @@ from pathlib import Path
 import sympy as sp
 
 from ..errors import InputError
+from ..extraction.options import Options as ExtractionOptions
+from ..options import check_yaml, yaml_keys
 from ..parameters import dynamic_symbols, standard_symbols
 from ..untrusted import read_yaml
 from .expressions import ExpressionError, exact_number, parse_expression, shorten
 from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
 
 _TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
-_EXTRACTION_KEYS = {"procedure", "restarts", "seed", "margin", "identities", "compare"}
+_EXTRACTION_KEYS = yaml_keys(ExtractionOptions) | {"compare"}  # every extraction option, and the compared file
 _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
 _IDENTIFIED_KINDS = ("gravity", "inertia", "full")
-_C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_extract.cpp and the like
+_C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_kinds.h and the like
 MAX_JOINTS = 20
 # Ranges no real serial arm leaves (SI units); outside them a value is a typo or an attack, and
 # extreme magnitudes (1e308, 1e-320) would overflow or underflow the generated self-test.
@@ -142,16 +144,7 @@ class _Reader:
 
     def extraction(self, value, names) -> dict:
         value = dict(self.mapping(value, "extraction", _EXTRACTION_KEYS))
-        if "procedure" in value and value["procedure"] not in ("joint", "two-stage"):
-            self.fail("extraction.procedure", f'expected "joint" or "two-stage", got {_describe(value["procedure"])}')
-        for key in ("restarts", "seed"):
-            if key in value and (not isinstance(value[key], int) or isinstance(value[key], bool)
-                                 or not 1 <= value[key] <= 100000):
-                self.fail(f"extraction.{key}", f"expected a whole number from 1 to 100000, got {_describe(value[key])}")
-        if "margin" in value:
-            value["margin"] = self.number(value["margin"], "extraction.margin", MAX_INERTIA)
-            if value["margin"] < 0:
-                self.fail("extraction.margin", f"expected a number >= 0, got {value['margin']:g}")
+        value.update(check_yaml(ExtractionOptions, value, self.fail, "extraction"))
         if "identities" in value:
             ids = self.sequence(value["identities"], "extraction.identities")
             for k, text in enumerate(ids):

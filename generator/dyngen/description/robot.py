@@ -7,11 +7,13 @@ derivation drops the zero terms of cos(pi/2) exactly. Inertial data are floats.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Optional
 
 import sympy as sp
 
 from ..parameters import DYNAMIC_NAMES_PER_LINK
+from .dh import joint_models
 
 
 @dataclass(frozen=True)
@@ -80,6 +82,11 @@ class Robot:
     @property
     def dof(self) -> int:
         return len(self.joints)
+
+    @cached_property
+    def joint_models(self) -> tuple:
+        """One JointModel per joint (description/joint_model.py), built once from the DH table."""
+        return joint_models(self.convention, self.joints)
 
     @property
     def gravity_symbols(self) -> tuple[sp.Symbol, ...]:

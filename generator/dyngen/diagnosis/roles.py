@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..catalogue import RNEA
+
 REPEATED_SHARE = 0.02  # RMS position difference below this share of the motion's range: same trajectory
 
 
@@ -43,7 +45,7 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
     def segment(sig, fit, select, test):
         # The filtered motion's torque is the filtered torque's model (filtering it again
         # would smooth twice what the recording smoothed once).
-        tau_model = model.batch("rnea", sig.q, sig.qd, sig.qdd, s)
+        tau_model = model.batch(RNEA.name, sig.q, sig.qd, sig.qdd, s)
         return Segment(sig, tau_model, sig.tau - tau_model, fit, select, test)
 
     none = lambda sig: np.zeros(sig.t.size, dtype=bool)  # noqa: E731

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..catalogue import STANDARD_FROM_DYNAMIC
 from . import baseline as simple_model
 from . import design as dz
 from . import joints, phases, reidentify, roles
@@ -130,7 +131,7 @@ def predict(context, chosen, x, segment) -> np.ndarray:
 def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options = Options(),
              test=None) -> Diagnosis:
     p = np.asarray(p, dtype=float)
-    s = model("standard_from_dynamic", p)
+    s = model(STANDARD_FROM_DYNAMIC.name, p)
     n = robot.dof
     segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
     # Position- and velocity-dependent laws are known only over what the fit data cover.

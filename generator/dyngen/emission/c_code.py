@@ -96,7 +96,7 @@ class StraightLine:
     used: set  # input arguments the statements or outputs read
 
 
-def straight_line(prefix: str, joints, model, outputs) -> StraightLine:
+def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     """Declarations of everything `outputs` (expressions of the model's program) need."""
     pruned = model.program.pruned(outputs)
     names = input_names(model)
@@ -113,8 +113,9 @@ def straight_line(prefix: str, joints, model, outputs) -> StraightLine:
     for s in trig_used:
         joint, fn = model.trig[s]
         angle = f"q[{joint}]"
-        if joints[joint].theta != 0:
-            angle = f"q[{joint}] + {macro}_K({float(joints[joint].theta)!r})"
+        offset = joint_models[joint].offset
+        if offset != 0:
+            angle = f"q[{joint}] + {macro}_K({float(offset)!r})"
         body.append(f"const {real} {s.name} = {macro}_{fn.upper()}({angle});")
     section = None
     for a in pruned:
@@ -130,9 +131,9 @@ def straight_line(prefix: str, joints, model, outputs) -> StraightLine:
     return StraightLine(body, printer, ops, used)
 
 
-def render_function(prefix: str, joints, name: str, model, outputs, output, doc: str) -> CFunction:
+def render_function(prefix: str, joint_models, name: str, model, outputs, output, doc: str) -> CFunction:
     """outputs: flat expressions written to output[0] (argument name, shape, meaning)."""
-    code = straight_line(prefix, joints, model, outputs)
+    code = straight_line(prefix, joint_models, model, outputs)
     body = code.body + [f"/* {output[0]} */"]
     flat = [sp.sympify(o) for o in outputs]
     zeros = sum(1 for o in flat if o == 0)

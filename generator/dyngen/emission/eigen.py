@@ -9,9 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-INPUT_TYPES = {"q": "Joints", "qd": "Joints", "qdd": "Joints", "p": "Parameters", "s": "Parameters",
-               "gravity": "GravitySymbols"}
-OUTPUT_TYPES = {"tau": "Joints", "g": "Joints", "s": "Parameters"}  # otherwise named after the function
+from ..catalogue import ARGUMENTS, FUNCTIONS
+
 TYPE_DOCS = {
     "Joints": "one entry per joint: q, qd, qdd, tau, g",
     "Parameters": "10 per link, link 1 first: p (dynamic) or s (standard)",
@@ -20,6 +19,7 @@ TYPE_DOCS = {
     "RegressorGravity": "Y_g(q): g = Y_g pi_gravity",
     "RegressorInertia": "Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)",
     "Regressor": "Y(q, qd, qdd): tau = Y pi_full",
+    "Friction": "friction values, 5 per joint: Fc, Fv, Fs, vs, eps",
 }
 
 
@@ -52,28 +52,25 @@ class Wrapper:
     output: tuple  # (argument name, EigenType name)
 
 
-def camel(name: str) -> str:
-    return "".join(part.capitalize() for part in name.split("_"))
-
-
-def eigen_interface(prefix: str, functions) -> dict:
+def eigen_interface(prefix: str, dims: dict, docs: dict) -> dict:
     """types: the EigenTypes (joint and parameter vectors first); largest: the biggest of them;
-    wrappers: one per C function."""
+    wrappers: one per catalogue function. dims: dimension name -> size (catalogue.dimensions);
+    docs: C name -> the function's documentation (as in the C header)."""
     types: dict[str, EigenType] = {}
 
-    def use(name, rows, cols):
+    def use(name, shape):
+        rows, cols = (dims[shape[0]], 1) if len(shape) == 1 else (dims[shape[0]], dims[shape[1]])
         known = types.setdefault(name, EigenType(name, rows, cols))
         assert (known.rows, known.cols) == (rows, cols), (name, known, rows, cols)
         return name
 
     wrappers = []
-    for f in functions:
-        short = f.name[len(prefix) + 1:]
-        inputs = [(arg, use(INPUT_TYPES[arg], length, 1)) for arg, length, _ in f.inputs]
-        out_arg, shape, _ = f.output
-        rows, cols = (shape[0], 1) if len(shape) == 1 else shape
-        out_type = OUTPUT_TYPES.get(out_arg, camel(short))
-        wrappers.append(Wrapper(short, f.name, f.doc, inputs, (out_arg, use(out_type, rows, cols))))
+    has_gravity = dims["gravity_symbols"] > 0
+    for f in FUNCTIONS:
+        c_name = f"{prefix}_{f.name}"
+        inputs = [(arg, use(ARGUMENTS[arg].eigen, ARGUMENTS[arg].shape)) for arg in f.arguments(has_gravity)]
+        output = (f.output.name, use(f.output.eigen, f.output.shape))
+        wrappers.append(Wrapper(f.name, c_name, docs.get(c_name, f.doc), inputs, output))
     first = ["Joints", "Parameters", "GravitySymbols", "MassMatrix"]
     ordered = sorted(types.values(), key=lambda t: first.index(t.name) if t.name in first else len(first))
     largest = max(ordered, key=lambda t: t.rows * t.cols)

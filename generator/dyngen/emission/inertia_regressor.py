@@ -25,13 +25,13 @@ from .opcount import OpCount, count, count_all
 MOTION_ARGS = (sp.symbols("a0:6", real=True), sp.symbols("b0:6", real=True))  # S_j and S_k in the loops
 
 
-def render_inertia_regressor(prefix: str, joints, motions, base, doc: str) -> CFunction:
+def render_inertia_regressor(prefix: str, joint_models, motions, base, doc: str) -> CFunction:
     """motions: the unit_accelerations Model (Derivation.unit_accelerations); base: the
     inertia BaseSet (its pivots are the columns of Y_m kept)."""
-    n = len(joints)
+    n = len(joint_models)
     n_stacked, rank = n * (n + 1) // 2, base.rank
     real = f"{prefix}_real"
-    code = straight_line(prefix, joints, motions, motions.outputs)
+    code = straight_line(prefix, joint_models, motions, motions.outputs)
     body = code.body + [
         f"/* S[i(i+1)/2 + j]: angular and linear acceleration of link i+1 (frame i+1, at its origin)",
         " * when joint j+1 accelerates at 1 and nothing else moves (no gravity) */",

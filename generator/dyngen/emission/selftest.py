@@ -1,16 +1,21 @@
 """The values embedded in the generated self-test (<robot>_selftest.c).
 
-Fixed link parameters (the YAML's nominal ones, or fixed consistent ones when it has none)
-and a few fixed states; the expected tau, g(q) and M(q) are computed by evaluating the
-generator's own programs in 40-digit arithmetic (derivation/evaluate.py), not by running
-the emitted C. The self-test then checks the compiled C, including the regressors times
-the base coefficients (different programs), against them.
+Fixed link parameters (the YAML's nominal ones, or fixed consistent ones when it has none),
+fixed friction values and a few fixed states; the expected output of every function of the
+catalogue is computed by evaluating the generator's own programs in 40-digit arithmetic
+(derivation/evaluate.py; friction by its law), not by running the emitted C. The self-test
+then checks the compiled C against them; each regressor times its base coefficients
+(different programs) against the values of the function it factors (catalogue Check).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import mpmath
+
+from ..catalogue import BY_NAME, FRICTION_PER_JOINT, FUNCTIONS
 from ..derivation.evaluate import evaluate
 from ..parameters import PER_LINK
 
@@ -24,16 +29,19 @@ TOLERANCE = {"double": 1e-9, "float": 2e-5}
 class SelfTestData:
     p: list  # dynamic parameters
     gravity: list  # values of the gravity symbols (empty when gravity is numeric)
+    f: list  # friction values, 5 per joint
     states: list  # [(q, qd, qdd)]
-    tau: list  # per state, rnea(q, qd, qdd)
-    g: list  # per state, gravity(q)
-    M: list  # per state, mass_matrix(q), row-major
+    once: dict  # function name -> expected output, for the functions of p alone
+    per_state: dict  # function name -> [expected output per state]
 
     def as_dict(self) -> dict:
         """For manifest.json, so that anyone can check the embedded values."""
-        return {"p": self.p, "gravity_symbols": self.gravity,
-                "states": [{"q": q, "qd": qd, "qdd": qdd, "tau": tau, "g": g, "M": M}
-                           for (q, qd, qdd), tau, g, M in zip(self.states, self.tau, self.g, self.M)]}
+        return {"p": self.p, "gravity_symbols": self.gravity, "f": self.f,
+                "states": [{"q": q, "qd": qd, "qdd": qdd, "tau": self.per_state["rnea"][k],
+                            "g": self.per_state["gravity"][k], "M": self.per_state["mass_matrix"][k],
+                            "friction": self.per_state["friction"][k]}
+                           for k, (q, qd, qdd) in enumerate(self.states)],
+                "expected": self.once}
 
 
 def fixed_parameters(robot) -> list[float]:
@@ -57,21 +65,76 @@ def fixed_states(robot) -> list[tuple[list, list, list]]:
             for k in range(N_STATES)]
 
 
-def selftest_data(robot, derivation, models: dict) -> SelfTestData:
-    """models: the rnea, gravity and mass_matrix Models the C was printed from."""
-    joints = robot.joints
+def fixed_friction(dof: int) -> list[float]:
+    """Fc, Fv, Fs, vs, eps per joint; every other joint with the plain sign (eps = 0), every
+    third without the Stribeck term (vs = 0), so both branches of the C are run."""
+    f = []
+    for j in range(dof):
+        f += [0.5 + 0.25 * j, 0.2 + 0.05 * j, 0.3, 0.0 if j % 3 == 2 else 0.1, 0.0 if j % 2 else 0.02]
+    return f
+
+
+def friction_torques(qd, f) -> list[float]:
+    """The friction law of templates/friction.c.j2, in 40-digit arithmetic."""
+    out = []
+    with mpmath.workdps(40):
+        for j, v in enumerate(qd):
+            Fc, Fv, Fs, vs, eps = (mpmath.mpf(x) for x in f[FRICTION_PER_JOINT * j: FRICTION_PER_JOINT * (j + 1)])
+            v = mpmath.mpf(v)
+            sgn = mpmath.tanh(v / eps) if eps > 0 else mpmath.sign(v)
+            level = Fc + (Fs * mpmath.exp(-(v / vs) ** 2) if vs > 0 else 0)
+            out.append(float(level * sgn + Fv * v))
+    return out
+
+
+def selftest_data(robot, programs: dict) -> SelfTestData:
+    """programs: catalogue name -> (derivation Model, outputs) the C was printed from."""
+    joint_models = robot.joint_models
     p = fixed_parameters(robot)
     assert len(p) == PER_LINK * robot.dof
-    s = evaluate(derivation.standard_from_dynamic(), joints, {"p": p})
     gravity = [GRAVITY_SYMBOL_VALUES[k % len(GRAVITY_SYMBOL_VALUES)] for k in range(len(robot.gravity_symbols))]
+    f = fixed_friction(robot.dof)
     states = fixed_states(robot)
-    tau, g, M = [], [], []
-    for q, qd, qdd in states:
-        common = {"q": q, "s": s, "gravity": gravity}
-        tau.append(evaluate(models["rnea"], joints, {**common, "qd": qd, "qdd": qdd}))
-        g.append(evaluate(models["gravity"], joints, common))
-        M.append(evaluate(models["mass_matrix"], joints, common))
-    return SelfTestData(p, gravity, states, tau, g, M)
+    direct = [fn for fn in FUNCTIONS if not fn.check.expected]
+    once = {fn.name: evaluate(programs[fn.name][0], joint_models, {"p": p}) for fn in direct if not fn.state}
+    s = once["standard_from_dynamic"]
+    per_state = {}
+    for fn in direct:
+        if not fn.state:
+            continue
+        if fn.model == "template":
+            assert fn.name == "friction"
+            per_state[fn.name] = [friction_torques(qd, f) for _, qd, _ in states]
+        else:
+            per_state[fn.name] = [evaluate(programs[fn.name][0], joint_models,
+                                           {"q": q, "qd": qd, "qdd": qdd, "s": s, "gravity": gravity})
+                                  for q, qd, qdd in states]
+    return SelfTestData(p, gravity, f, states, once, per_state)
+
+
+def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
+    """What the self-test calls and compares, one entry per catalogue function, in catalogue
+    order (the functions of p alone first: their outputs feed the others)."""
+    arrays = {"s": "standard_from_dynamic_out"}  # an argument computed by another function
+
+    def size(shape):
+        return math.prod(dims[d] for d in shape)
+
+    checks = []
+    for fn in sorted(FUNCTIONS, key=lambda fn: fn.state):
+        args = [arrays.get(a, a) for a in fn.arguments(has_gravity)] + [f"{fn.name}_out"]
+        check = {"name": fn.name, "state": fn.state, "out": f"{fn.name}_out", "length": size(fn.output.shape),
+                 "call": f"{prefix}_{fn.name}({', '.join(args)})", "expected": f"{BY_NAME[fn.expected].name}_expected",
+                 "label": fn.name, "times": None, "stacked": fn.check.stacked}
+        if fn.check.times:
+            rows, cols = (dims[d] for d in fn.output.shape)
+            check["times"] = {"out": f"{fn.check.times}_out", "rows": rows, "cols": cols}
+            check["label"] = f"{fn.name} * {fn.check.times}"
+            check["compared"] = rows
+        else:
+            check["compared"] = check["length"]
+        checks.append(check)
+    return checks
 
 
 def c_numbers(values, per_line: int = 0, indent: int = 8) -> str:

@@ -18,21 +18,17 @@ def forward_flange(robot):
     places = placements(robot)
 
     def flange(q):
-        q = np.atleast_2d(q)
-        out = np.zeros((q.shape[0], 3))
-        for k, row in enumerate(q):
-            T = np.eye(4)
-            for joint, place, value in zip(robot.joints, places, row):
-                J = np.eye(4)
-                if joint.revolute:
-                    c, s = np.cos(value), np.sin(value)
-                    J[:2, :2] = [[c, -s], [s, c]]
-                else:
-                    J[2, 3] = value
-                T = T @ place.origin @ J
-            T = T @ places[-1].post
-            out[k] = T[:3, 3]
-        return out
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        T = np.broadcast_to(np.eye(4), (q.shape[0], 4, 4)).copy()
+        for i, (joint, place) in enumerate(zip(robot.joints, places)):
+            J = np.broadcast_to(np.eye(4), T.shape).copy()
+            if joint.revolute:
+                c, s = np.cos(q[:, i]), np.sin(q[:, i])
+                J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1] = c, -s, s, c
+            else:
+                J[:, 2, 3] = q[:, i]
+            T = T @ place.origin @ J
+        return (T @ places[-1].post)[:, :3, 3]
 
     return flange
 
@@ -126,6 +122,12 @@ def cmd_excite(argv, prog="dyngen excite") -> int:
     t = np.arange(int(round(args.period * args.periods * args.rate)) + 1) / args.rate
     q, qd, qdd = design.trajectory(t)
     problems = check_limits(robot, t, q, qd, qdd)
+    if workspace:
+        box = np.asarray(workspace).reshape(3, 2)
+        where = forward_flange(robot)(q)
+        outside = np.flatnonzero(~np.all((where >= box[:, 0]) & (where <= box[:, 1]), axis=1))
+        if outside.size:
+            problems.append(f"the flange leaves the workspace box at t = {t[outside[0]]:.4g} s")
     if problems:  # cannot happen by construction; never write a trajectory that breaks a limit
         raise InputError(args.robot, "joints[].limits", "; ".join(problems[:3]))
     out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"

@@ -123,15 +123,18 @@ class _Shape:
         return traj
 
     def _into_box(self, traj, q0):
-        box = np.asarray(self.settings.workspace, dtype=float).reshape(3, 2)
+        # the flange is checked on every second grid point against the box shrunk by 1 mm (the
+        # written samples are checked again by the command)
+        box = np.asarray(self.settings.workspace, dtype=float).reshape(3, 2) + np.array([1e-3, -1e-3])
+        grid = self.grid[::2]
         if not _inside(self.flange(q0[None, :]), box).all():
-            raise InputError("--workspace", "", "the flange at the trajectory's centre lies outside the box")
-        lo, hi = 0.0, 1.0
-        if _inside(self.flange(_shrunk(traj, q0, 1.0)(self.grid[::4])[0]), box).all():
+            raise InputError("--workspace", "", "the flange at the trajectory's start lies outside the box")
+        if _inside(self.flange(traj(grid)[0]), box).all():
             return traj
-        for _ in range(20):  # bisection on a common shrink factor
+        lo, hi = 0.0, 1.0
+        for _ in range(12):  # bisection on a common shrink factor of the motion about q0
             mid = 0.5 * (lo + hi)
-            if _inside(self.flange(_shrunk(traj, q0, mid)(self.grid[::4])[0]), box).all():
+            if _inside(self.flange(_shrunk(traj, q0, mid)(grid)[0]), box).all():
                 lo = mid
             else:
                 hi = mid

@@ -1,17 +1,12 @@
-"""What URDF and MJCF share: joint placements from the DH table, inertials in joint frames,
+"""What URDF and MJCF share: joint placements from the joint models, inertials in joint frames,
 checks that a simulator can load the parameters, and number formatting.
 
 Simulators turn a joint about (or slide along) the z axis of its own frame, and a child
-link's frame is that joint frame. Each DH transform is split as
-T(i-1, i)(q) = pre_i * J(q) * post_i with J a pure Rz(q) or Tz(q):
-
-  standard  revolute : pre = Rz(theta0)                    post = Tz(d) Tx(a) Rx(alpha)
-  standard  prismatic: pre = Rz(theta) Tz(d0)              post = Tx(a) Rx(alpha)
-  modified  revolute : pre = Rx(alpha) Tx(a) Rz(theta0)    post = Tz(d)
-  modified  prismatic: pre = Rx(alpha) Tx(a) Rz(theta) Tz(d0)   post = I
-
-so the simulator's joint frame J_i sits at post_{i-1} * pre_i in J_{i-1} (post_0 = I, J_0 =
-frame 0), DH frame i is J_i * post_i, and the simulator's q is the DH q (offsets are in pre).
+link's frame is that joint frame: exactly the joint model's J_i (description/joint_model.py),
+T(i-1, i)(q) = placement_i * motion_i(q) * frame_i. With pre_i = placement_i * motion_i(0)
+(the joint's offset included) and post_i = frame_i, the simulator's joint frame J_i sits at
+post_{i-1} * pre_i in J_{i-1} (post_0 = I, J_0 = frame 0), link frame i is J_i * post_i, and
+the simulator's q is the description's q (offsets are in pre).
 """
 
 from __future__ import annotations
@@ -26,42 +21,6 @@ import sympy as sp
 CONSISTENCY_TOL = 1e-12
 
 
-def _rx(alpha) -> sp.Matrix:
-    c, s = sp.cos(alpha), sp.sin(alpha)
-    return sp.Matrix([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
-
-
-def _rz(theta) -> sp.Matrix:
-    c, s = sp.cos(theta), sp.sin(theta)
-    return sp.Matrix([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
-
-
-def _tx(a) -> sp.Matrix:
-    T = sp.eye(4)
-    T[0, 3] = a
-    return T
-
-
-def _tz(d) -> sp.Matrix:
-    T = sp.eye(4)
-    T[2, 3] = d
-    return T
-
-
-def split_joint(convention: str, joint) -> tuple[sp.Matrix, sp.Matrix]:
-    """(pre, post), exact, with T(i-1, i)(q) = pre * J(q) * post (see module docstring)."""
-    a, alpha, d, theta = joint.a, joint.alpha, joint.d, joint.theta
-    if convention == "standard":
-        if joint.revolute:
-            return _rz(theta), _tz(d) * _tx(a) * _rx(alpha)
-        return _rz(theta) * _tz(d), _tx(a) * _rx(alpha)
-    if convention == "modified":
-        if joint.revolute:
-            return _rx(alpha) * _tx(a) * _rz(theta), _tz(d)
-        return _rx(alpha) * _tx(a) * _rz(theta) * _tz(d), sp.eye(4)
-    raise ValueError(f"unknown DH convention {convention!r}")
-
-
 def _to_float(T: sp.Matrix) -> np.ndarray:
     # Products are formed exactly first, so cos(pi/2) etc. give exact zeros in the files.
     return np.array([[float(x) for x in T.row(r)] for r in range(T.rows)], dtype=float)
@@ -69,17 +28,17 @@ def _to_float(T: sp.Matrix) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Placement:
-    """Joint i: where its frame J_i sits in J_{i-1}, and where DH frame i sits in J_i."""
+    """Joint i: where its frame J_i sits in J_{i-1}, and where link (DH) frame i sits in J_i."""
 
     origin: np.ndarray  # 4x4, J_i in J_{i-1} at q = 0
-    post: np.ndarray  # 4x4, DH frame i in J_i
+    post: np.ndarray  # 4x4, link (DH) frame i in J_i
 
 
 def placements(robot) -> list[Placement]:
     out = []
     prev_post = sp.eye(4)
-    for joint in robot.joints:
-        pre, post = split_joint(robot.convention, joint)
+    for model in robot.joint_models:
+        pre, post = model.joint_frame_at_zero(), model.frame.matrix()
         out.append(Placement(_to_float(prev_post * pre), _to_float(post)))
         prev_post = post
     return out

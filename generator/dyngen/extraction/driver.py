@@ -1,4 +1,4 @@
-"""Build the emitted NLopt driver (<robot>_extract.cpp) and run it on a problem file."""
+"""Build the static NLopt driver (extractor/driver.cpp) for one arm and run it on a problem file."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import numpy as np
 from .. import cache
 from ..errors import DriverError
 from .problem import Options, Problem, Stage
+from .protocol import problem_text
 
 
 def eigen_include() -> str:
@@ -27,28 +28,78 @@ def eigen_include() -> str:
         raise DriverError("Eigen 3 not found: run scripts/setup.sh (apt package libeigen3-dev)") from None
 
 
-def build(folder: Path, cache_dir: Path | None = None) -> Path:
-    """Compile the driver once per source content into the per-user cache (dyngen.cache;
-    `cache_dir` replaces its root); returns the executable, its recorded hash checked."""
-    folder = Path(folder)
-    name = folder.name
-    sources = [folder / f"{name}_extract.cpp", folder / f"{name}_parameters.c", folder / f"{name}.h"]
-    digest = hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:16]
-    cache_dir = cache.folder("drivers", cache_dir)
-    exe = cache_dir / f"{name}_extract-{digest}"
-    if cache.verified(exe):
-        return exe
-    work = Path(tempfile.mkdtemp(prefix="build-", dir=cache_dir))
+DRIVER = Path(__file__).resolve().parents[1] / "extractor"  # the static driver's sources (package data)
+CORE_SOURCES = ("driver.cpp", "protocol.hpp", "robot.h")
+
+
+def _digest(paths) -> str:
+    return hashlib.sha256(b"".join(Path(p).read_bytes() for p in paths)).hexdigest()[:16]
+
+
+def _cached(target: Path, make) -> Path:
+    """`target` from the cache while its recorded hash still matches; else make(work, built)
+    builds it in a private temporary folder beside it, and it is installed (dyngen.cache)."""
+    if cache.verified(target):
+        return target
+    work = Path(tempfile.mkdtemp(prefix="build-", dir=target.parent))
     try:
-        obj = work / "parameters.o"
-        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(sources[1]), "-o", str(obj)])
-        tmp_exe = work / exe.name
-        _run(["c++", "-O2", "-std=c++17", "-I", str(folder), "-I", eigen_include(), str(sources[0]), str(obj),
-              "-o", str(tmp_exe), "-lnlopt", "-lpthread"])
-        cache.install(tmp_exe, exe)
+        built = work / target.name
+        make(work, built)
+        cache.install(built, target)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    return exe
+    return target
+
+
+def build_core(cache_dir: Path | None = None) -> Path:
+    """The static driver (driver.cpp, Eigen and NLopt: the slow part) compiled once per user and
+    source content into the per-user cache; every arm links this object."""
+    folder = cache.folder("drivers", cache_dir)
+
+    def make(work, built):
+        _run(["c++", "-O2", "-std=c++17", "-I", str(DRIVER), "-I", eigen_include(), "-c", str(DRIVER / "driver.cpp"),
+              "-o", str(built)])
+
+    return _cached(folder / f"driver-{_digest(DRIVER / name for name in CORE_SOURCES)}.o", make)
+
+
+def build(folder: Path, cache_dir: Path | None = None) -> Path:
+    """The extractor of the arm generated in `folder`: the static driver (build_core) linked
+    with the arm's generated C (<robot>_parameters.c, <robot>_kinds.h) and robot.c, once per
+    content into the per-user cache (dyngen.cache; `cache_dir` replaces its root); returns the
+    executable, its recorded hash checked."""
+    folder = Path(folder)
+    name = folder.name
+    core = build_core(cache_dir)
+    parameters, robot_c = folder / f"{name}_parameters.c", DRIVER / "robot.c"
+    sources = [parameters, folder / f"{name}.h", folder / f"{name}_kinds.h", robot_c]
+
+    def make(work, built):
+        objects = [work / "parameters.o", work / "robot.o"]
+        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-c", str(parameters), "-o", str(objects[0])])
+        _run(["cc", "-O2", "-std=c99", "-I", str(folder), "-I", str(DRIVER), f'-DDYNGEN_KINDS_H="{name}_kinds.h"',
+              "-c", str(robot_c), "-o", str(objects[1])])
+        if not cache.verified(core):  # checked again right before it is linked in
+            raise DriverError(f"{core} changed after it was built; run again to rebuild it")
+        _run(["c++", str(core), *map(str, objects), "-o", str(built), "-lnlopt", "-lpthread"])
+
+    return _cached(cache.folder("drivers", cache_dir) / f"{name}_extract-{_digest([core, *sources])}", make)
+
+
+def standalone_files(folder: Path) -> dict:
+    """The driver as a standalone program for the arm generated in `folder` (outside that
+    firmware folder: it needs NLopt and threads): file name -> text."""
+    name = Path(folder).name
+    files = {source.name: source.read_text() for source in sorted(DRIVER.iterdir())
+             if source.suffix in (".cpp", ".hpp", ".h", ".c")}
+    files["BUILD.txt"] = (
+        f"The extractor driver of {name} (dyngen extract builds the same program in its cache).\n"
+        f"With the generated folder of {name} as MODEL (it holds {name}.h, {name}_parameters.c, {name}_kinds.h):\n\n"
+        "  c++ -O2 -std=c++17 -I. -I/usr/include/eigen3 -c driver.cpp\n"
+        f"  cc -O2 -std=c99 -I. -IMODEL -DDYNGEN_KINDS_H='\"{name}_kinds.h\"' -c robot.c MODEL/{name}_parameters.c\n"
+        f"  c++ driver.o robot.o {name}_parameters.o -lnlopt -lpthread -o {name}_extract\n\n"
+        f"  ./{name}_extract PROBLEM_FILE RESULT_FILE   (the problem file: extraction/protocol.py)\n")
+    return files
 
 
 def _run(cmd):
@@ -58,35 +109,6 @@ def _run(cmd):
         raise DriverError(f"{cmd[0]} not found: run scripts/setup.sh") from None
     except subprocess.CalledProcessError as err:
         raise DriverError(f"building the extractor failed:\n{err.stderr[-2000:]}") from None
-
-
-def problem_text(problem: Problem, stage: Stage, options: Options) -> str:
-    def vec(x):
-        return " ".join(repr(float(v)) for v in x)
-
-    lines = ["dyngen-extraction 1", f"parameters {problem.lower.size}",
-             f"lower {vec(problem.lower)}", f"upper {vec(problem.upper)}", f"value {vec(stage.value)}",
-             f"reference {vec(problem.reference)}", f"weight {vec(problem.weight)}",
-             f"center {vec(problem.center)}",
-             "free " + " ".join(str(int(f)) for f in stage.free)]
-    lo, hi = problem.total_mass if problem.total_mass else (0.0, 0.0)
-    lines.append(f"total_mass {int(problem.total_mass is not None)} {lo!r} {hi!r}")
-    lines.append(f"margin {options.margin!r}")
-    for key, blocks in (("blocks", stage.blocks), ("next_blocks", stage.next_blocks)):
-        lines.append(f"{key} {len(blocks)}")
-        for block in blocks:
-            lines.append(f"{block.kind} {block.W.shape[0]}")
-            lines.extend(vec(row) for row in block.W)
-            lines.append(vec(block.v))
-    lines.append(f"equalities {len(problem.equalities)}")
-    for terms in problem.equalities:
-        lines.append(str(len(terms)) + " " + " ".join(
-            f"{c!r} {len(idx)} " + " ".join(map(str, idx)) for c, idx in terms))
-    lines += [f"restarts {options.restarts}", f"seed {options.seed}", f"threads {options.threads}",
-              f"global_algorithm {options.global_algorithm}", f"global_maxeval {options.global_maxeval}",
-              f"local_maxeval {options.local_maxeval}", f"tolerance {options.tolerance!r}",
-              f"hops {options.hops} {options.hop_size!r}", "end"]
-    return "\n".join(lines) + "\n"
 
 
 @dataclass

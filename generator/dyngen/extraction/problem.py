@@ -16,24 +16,8 @@ from scipy.optimize import linprog
 from ..description.expressions import ExpressionError, parse_expression, shorten
 from ..errors import Infeasible, InputError
 from ..parameters import PER_LINK, dynamic_name, dynamic_symbols
+from .options import Options  # noqa: F401  (re-exported: the problem is built from them)
 from .targets import Target
-
-
-@dataclass
-class Options:
-    procedure: str = "joint"  # "joint" (one stage, all coefficients) or "two-stage" (eqs. 16 then 19)
-    restarts: int = 16
-    seed: int = 1
-    threads: int = 0  # 0: all cores
-    global_algorithm: str = "isres"  # or "none" (local refinement from the random starts only)
-    global_maxeval: int = 1500
-    local_maxeval: int = 1000
-    hops: int = 0  # basin-hopping kicks of each restart's local minimum
-    hop_size: float = 0.1  # kick standard deviation, as a fraction of each parameter's range
-    margin: float = 1e-7  # kg m^2: smallest eigenvalue of tr(I)/2 E - I accepted as consistent
-    mass_margin: float = 1e-3  # kg: smallest link mass accepted
-    tolerance: float = 1e-10  # constraint violation still counted as satisfied
-    identities: tuple = ()  # e.g. ("I7xz = c7x*c7z*m7",), eq. (15)
 
 
 @dataclass

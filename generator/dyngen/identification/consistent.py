@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import InputError
 from ..extraction import driver
 from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import Stage, build_problem, consistency_margin
@@ -410,10 +411,19 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     2-s block of the fit data)."""
     options = options or ConsistentOptions()
     dof = robot.dof
+    signals_list = [_trimmed(s) for s in signals_list]
+    select = [_trimmed(s) for s in select] if select else select
     names = [e["standard"] for e in model.manifest["coefficients"]["full"]["expressions"]]
     r = len(names)
     wanted = set(options.friction) | ({"ripple_cos", "ripple_sin"} if "ripple" in options.friction else set())
     kinds = tuple(k for k in FRICTION_KINDS if k in wanted)
+    rows = dof * sum(len(s.t) for s in signals_list)
+    unknowns = r + len(kinds) * dof + (2 if options.tilt else 0)
+    if rows <= 2 * unknowns:  # before anything is compiled or solved
+        raise InputError(", ".join(s.name for s in signals_list), "",
+                         f"under-determined: {rows} equations for {unknowns} coefficients and friction values; "
+                         f"record at least {2 * unknowns // dof + 1} samples (many more, on an exciting trajectory, "
+                         "for a usable estimate)")
     armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
     labels = _labels(kinds, armature_ok, dof)
     columns = _Columns(model, signals_list, dof) if "coulomb" in kinds else None
@@ -510,6 +520,19 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     return Consistent(result.p, pi, names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
                       lam, selection, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
                       pinned(solver.problem, result.p), V, tilt, dropped, lags)
+
+
+def _trimmed(s):
+    """The recording without the filter's start-up at both ends (Signals.trim samples), which is
+    not data (data/conditioning.py)."""
+    k = int(getattr(s, "trim", 0) or 0)
+    if k <= 0 or 2 * k >= len(s.t):
+        return s
+    T = len(s.t)
+    cut = {name: value[k:T - k] for name, value in vars(s).items()
+           if isinstance(value, np.ndarray) and value.ndim >= 1 and value.shape[0] == T}
+    cut["extra"] = {name: v[k:T - k] for name, v in s.extra.items()}
+    return replace(s, trim=0, **cut)
 
 
 def velocity_limits(robot, signals_list) -> np.ndarray:

@@ -66,13 +66,15 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     sources = [Path(p).name for p in args.data]
     from ..measured_cli import _conditioning_text
 
-    write_file(out, consistent_yaml(robot, result, sources, _conditioning_text(args)))
+    write_file(out, consistent_yaml(robot, result, sources, _conditioning_text(signals)))
     table = out.with_suffix(".md")
     write_file(table, f"# {robot.name}: consistent identification from {', '.join(sources)}\n\n"
                + "\n".join(summary_lines(robot, result)) + "\n\n" + consistent_table(result) + "\n")
     exported = write_all(robot, result.p, out.parent, result.joint_dynamics())
     if not args.quiet:
         print("\n".join(summary_lines(robot, result)))
+        for w in (w for s in signals for w in getattr(s, "warnings", [])):
+            print(f"  warning: {w}")
         print(f"  {seconds:.1f} s; written: {out}, {table}, " + ", ".join(str(p) for p in exported))
     return 0
 

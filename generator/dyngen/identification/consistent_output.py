@@ -30,8 +30,9 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
         "links:",
     ]
     lines.append(links_yaml(c.p).rstrip("\n"))
-    lines.append("friction:   # per joint; Coulomb Fc [Nm] with tanh smoothing vs [rad/s], viscous Fv [Nm s/rad], "
-                 "offset [Nm], rotor inertia Ia [kg m^2] (null: carried by the rigid body), sigma: noise [Nm]")
+    lines.append("friction:   # per joint; Coulomb Fc tanh(qd(t - lag) / vs) [Nm, s, rad/s], viscous Fv [Nm s/rad], "
+                 "offset [Nm], rotor inertia Ia [kg m^2] (null: carried by the rigid body), ripple [a, b]: "
+                 "a cos q + b sin q [Nm], sigma: noise [Nm]")
     k = {name: i for i, name in enumerate(c.column_names)}
     for j in range(n):
         def std(kind):
@@ -39,6 +40,8 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
             return _f(ols.std[i]) if i is not None else "null"
         lines.append(f"  - {{Fc: {_f(c.friction['coulomb'][j])}, vs: {_f(c.smoothing[j])}, Fv: {_f(c.friction['viscous'][j])}, "
                      f"offset: {_f(c.friction['offset'][j])}, Ia: {_f(c.friction['armature'][j])}, "
+                     f"lag: {_f(c.lags[j] if c.lags is not None else 0.0)}, "
+                     f"ripple: [{_f(c.friction['ripple_cos'][j])}, {_f(c.friction['ripple_sin'][j])}], "
                      f"sigma: {_f(c.sigma[j])}}}   # joint {j + 1}; std Fc {std('coulomb')}, Fv {std('viscous')}, "
                      f"offset {std('offset')}, Ia {std('armature')}")
     if c.tilt_model is not None:

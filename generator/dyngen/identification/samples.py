@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..catalogue import REGRESSORS
 from ..errors import InputError
 from .least_squares import Estimate, fit
 
-REGRESSOR = {"gravity": "regressor_gravity", "inertia": "regressor_inertia", "full": "regressor"}
+REGRESSOR = {kind: f.name for kind, f in REGRESSORS.items()}
 
 
 def stacked_inertia_columns(manifest) -> list[str]:

@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..catalogue import REGRESSOR_GRAVITY, REGRESSOR_INERTIA, RNEA, STANDARD_FROM_DYNAMIC
+
 _H_REVOLUTE = 2.0 * np.pi / 5.0
 _W_REVOLUTE = np.linalg.solve(
     2.0 * np.array([[np.sin(_H_REVOLUTE), np.sin(2 * _H_REVOLUTE)],
@@ -61,8 +63,8 @@ def newton_euler(model, p, q, qd, qdd) -> np.ndarray:
     """tau (T x N) by the generated recursive Newton-Euler routine, s = standard_from_dynamic(p)."""
     n = _check_model(model)
     q, qd, qdd = (_rows(x, n, name) for x, name in ((q, "q"), (qd, "qd"), (qdd, "qdd")))
-    s = model("standard_from_dynamic", np.asarray(p, dtype=float))
-    return np.array([model("rnea", a, b, c, s) for a, b, c in zip(q, qd, qdd)])
+    s = model(STANDARD_FROM_DYNAMIC.name, np.asarray(p, dtype=float))
+    return np.array([model(RNEA.name, a, b, c, s) for a, b, c in zip(q, qd, qdd)])
 
 
 def _stencils(types, derivative: str):
@@ -93,14 +95,14 @@ def inertia_and_derivatives(model, pi_m, q, derivative: str = "exact"):
         M[iu] = m
         return M + np.triu(M, 1).T
 
-    stacked = model("regressor_inertia", q) @ pi_m
+    stacked = model(REGRESSOR_INERTIA.name, q) @ pi_m
     dm = np.zeros((n, stacked.size))
     for k, (h, terms) in enumerate(_stencils(model.manifest["joint_types"], derivative)):
         for j, w in terms:
             up, down = q.copy(), q.copy()
             up[k] += j * h
             down[k] -= j * h
-            dm[k] += w * ((model("regressor_inertia", up) - model("regressor_inertia", down)) @ pi_m)
+            dm[k] += w * ((model(REGRESSOR_INERTIA.name, up) - model(REGRESSOR_INERTIA.name, down)) @ pi_m)
     return unstack(stacked), np.array([unstack(row) for row in dm])
 
 
@@ -118,7 +120,7 @@ def from_coefficients(model, pi_g, pi_m, q, qd, qdd, derivative: str = "exact") 
     tau = np.empty_like(q)
     for row, (a, b, c) in enumerate(zip(q, qd, qdd)):
         M, dM = inertia_and_derivatives(model, pi_m, a, derivative)
-        tau[row] = M @ c + coriolis(dM, b) + model("regressor_gravity", a) @ pi_g
+        tau[row] = M @ c + coriolis(dM, b) + model(REGRESSOR_GRAVITY.name, a) @ pi_g
     return tau
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...catalogue import REGRESSOR, RNEA
 from ...parameters import PER_LINK, STANDARD_NAMES_PER_LINK
 from .base import Effect
 
@@ -35,7 +36,7 @@ class Payload(Effect):
         for k in range(PER_LINK):
             unit = np.zeros(PER_LINK * n)
             unit[PER_LINK * (n - 1) + k] = 1.0
-            out[:, :, k] = context.model.batch("rnea", signals.q, signals.qd, signals.qdd, unit)
+            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, unit)
         return out
 
 
@@ -69,7 +70,7 @@ class PointPayload(Payload):
         for k, unit in enumerate(units):
             s = np.zeros(PER_LINK * n)
             s[PER_LINK * (n - 1):] = unit
-            out[:, :, k] = context.model.batch("rnea", signals.q, signals.qd, signals.qdd, s)
+            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, s)
         return out
 
 
@@ -109,4 +110,4 @@ class Coefficients(Effect):
     def columns(self, context, signals, tau_model):
         if not self.parameters:
             self.bind(context.model.manifest)
-        return context.model.batch("regressor", signals.q, signals.qd, signals.qdd)
+        return context.model.batch(REGRESSOR.name, signals.q, signals.qd, signals.qdd)

@@ -17,7 +17,7 @@ gravity_scale: G(q) n dg, n along gravity: the gravity torque of every link scal
   tilt does this; masses and centres of mass all wrong by one factor, or a torque gain, do.
   It is always reported as suspect (a symptom, not a cause).
 
-G(q) comes from plain forward kinematics of the DH table (numpy, vectorised over samples):
+G(q) comes from the joint models' forward kinematics (numpy, vectorised over samples):
 for joint i with axis z through o, and every link k it carries, with centre of mass p_k,
   revolute:  G_i = - sum_k m_k (z x (p_k - o))      prismatic:  G_i = - sum_k m_k z
 (the potential is V = -sum m_k gvec . p_k and g = dV/dq).
@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...description.joint_model import forward_kinematics
 from .base import Effect
 
 
@@ -119,55 +120,17 @@ def tilt_axes(robot) -> tuple[str, str]:
     return names[0], names[1]
 
 
-def _dh(robot, q):
-    """Per joint: rotation (T, 3, 3) and origin (T, 3) of frame i, and joint axis and point."""
-    T = q.shape[0]
-    R = np.broadcast_to(np.eye(3), (T, 3, 3)).copy()
-    o = np.zeros((T, 3))
-    frames, axes = [], []
-    for i, joint in enumerate(robot.joints):
-        a, alpha, d, theta = (float(joint.a), float(joint.alpha), float(joint.d), float(joint.theta))
-        th = theta + (q[:, i] if joint.revolute else 0.0)
-        dd = d + (0.0 if joint.revolute else q[:, i])
-        th = np.broadcast_to(th, (T,))
-        dd = np.broadcast_to(dd, (T,))
-        if robot.convention == "standard":
-            axes.append((R[:, :, 2].copy(), o.copy()))  # joint i turns about z(i-1)
-            # Rz(th) Tz(d) Tx(a): the new origin is R (a cos th, a sin th, d)
-            o = o + np.einsum("tij,tj->ti", R, np.stack([a * np.cos(th), a * np.sin(th), dd], axis=1))
-            R = R @ _rz(th) @ _rx(alpha)
-        else:
-            R = R @ _rx(alpha)
-            o = o + a * R[:, :, 0]
-            R = R @ _rz(th)
-            axes.append((R[:, :, 2].copy(), o.copy()))  # joint i turns about z(i)
-            o = o + dd[:, None] * R[:, :, 2]
-        frames.append((R.copy(), o.copy()))
-    return frames, axes
-
-
-def _rz(th):
-    c, s = np.cos(th), np.sin(th)
-    z, one = np.zeros_like(th), np.ones_like(th)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, one], -1)], -2)
-
-
-def _rx(alpha):
-    c, s = np.cos(alpha), np.sin(alpha)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
 def gravity_matrix(robot, p, q) -> np.ndarray:
     """G (T, N, 3) with g(q) = G(q) gvec for link parameters p (dynamic, 10N)."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     links = np.asarray(p, dtype=float).reshape(-1, 10)
-    frames, axes = _dh(robot, q)
-    n = len(robot.joints)
+    poses = forward_kinematics(robot.joint_models, q)
+    n = len(poses)
     G = np.zeros((q.shape[0], n, 3))
-    centres = [o + np.einsum("tij,j->ti", R, links[k, 1:4]) for k, (R, o) in enumerate(frames)]
-    for i, joint in enumerate(robot.joints):
-        z, o = axes[i]
+    centres = [pose.origin + np.einsum("tij,j->ti", pose.R, links[k, 1:4]) for k, pose in enumerate(poses)]
+    for i, model in enumerate(robot.joint_models):
+        z, o = poses[i].axis, poses[i].point
         for k in range(i, n):
             m = links[k, 0]
-            G[:, i, :] -= m * (np.cross(z, centres[k] - o) if joint.revolute else z)
+            G[:, i, :] -= m * (np.cross(z, centres[k] - o) if model.revolute else z)
     return G

@@ -1,0 +1,1 @@
+"""One module per `dyngen` command, each thin over its step function; dyngen.cli only dispatches."""

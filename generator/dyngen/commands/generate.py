@@ -1,0 +1,61 @@
+"""`dyngen generate`: derive, reduce and emit one arm's C (the generate step, dyngen.generate)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from .. import __version__
+from ..progress import Progress
+
+
+def parser(prog: str) -> argparse.ArgumentParser:
+    """The generate options; extract adds its own to them."""
+    result = argparse.ArgumentParser(
+        prog=prog, description="Derive the regressors and Newton-Euler of an arm symbolically, reduce them to "
+        "a minimal set of base coefficients and emit standalone C99 (header, sources, CMakeLists.txt, "
+        "manifest.json, coefficients.md) into DIR/<robot name>/.")
+    result.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
+    result.add_argument("-o", "--output", default="generated", metavar="DIR",
+                        help="parent folder of the robot's output folder (default: generated)")
+    result.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    return result
+
+
+def main(argv, prog="dyngen generate") -> int:
+    args = parser(prog).parse_args(argv)
+    generate_step(args, load(args))
+    return 0
+
+
+def generate_step(args, robot, out_root="from args"):
+    """Generate into args.output (or, with out_root None, into the per-user cache for now)."""
+    from ..generate import generate
+
+    progress = Progress(quiet=args.quiet)
+    start = time.perf_counter()
+    progress.say(f"dyngen {__version__}: generating {args.robot}")
+    result = generate(robot, args.output if out_root == "from args" else out_root, progress)
+    if not args.quiet:
+        summary(result, Path(args.output) / robot.name, time.perf_counter() - start)
+    return result
+
+
+def summary(result, destination: Path, seconds: float) -> None:
+    robot, bases = result.robot, result.bases
+    print(f"{robot.name}: {robot.dof} joints, {robot.convention} DH -> {destination}/ in {seconds:.1f} s")
+    print("  base coefficients: " + ", ".join(f"{k} {b.rank}" for k, b in bases.items())
+          + f" (of {10 * robot.dof} standard parameters)")
+    width = max(len(f.name) for f in result.emitted.functions)
+    for f in result.emitted.functions:
+        print(f"  {f.name:<{width}}  {f.ops}")
+    print(f"  coefficient expressions: {destination}/coefficients.md")
+
+
+
+
+def load(args):
+    from ..description import load_robot
+
+    return load_robot(args.robot)

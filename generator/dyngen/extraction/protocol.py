@@ -1,0 +1,184 @@
+"""The problem file the extractor driver reads, written down once.
+
+One line per field, `key value...`, in the order of SCHEMA. The Python writer (`problem_text`)
+and reader (`read_problem_text`) below and the C++ reader, writer and the members of the
+driver's Problem (generator/dyngen/extractor/protocol.hpp, rendered from SCHEMA by `cpp_header`
+through templates/protocol.hpp.j2) all follow it, so an option is added by one line here (and
+its field in extraction/options.py), then `python3 -m dyngen.extraction.protocol`.
+
+Kinds (C++ type, and the text after the key):
+  integer   int, or the field's `cpp` type     one whole number
+  real      double                             one number (shortest round-trip text)
+  word      std::string                        one word
+  reals     Eigen::VectorXd                    `length` numbers (length: parameters)
+  flags     std::vector<int> of the set ones   `length` 0/1 values
+  blocks    std::vector<Block>                 count, then per block: kind rows, W row by row, v
+  terms     std::vector<std::vector<Term>>     count, then per polynomial: terms, (c, factors, indices)...
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+MAGIC, VERSION = "dyngen-extraction", 2
+
+
+@dataclass(frozen=True)
+class Field:
+    key: str  # in the file, and the C++ Problem member
+    kind: str
+    value: Callable  # (problem, stage, options) -> the value written
+    cpp: str = ""  # the C++ member type, when it is not the kind's
+    length: str = ""  # "parameters" for reals and flags
+
+    @property
+    def cpp_type(self) -> str:
+        return self.cpp or {"integer": "int", "real": "double", "word": "std::string", "reals": "Eigen::VectorXd",
+                            "flags": "std::vector<int>", "blocks": "std::vector<Block>",
+                            "terms": "std::vector<std::vector<Term>>"}[self.kind]
+
+
+def _opt(name, kind, cpp=""):
+    """An extraction option (extraction/options.py) the driver reads."""
+    return Field(name, kind, lambda problem, stage, options: getattr(options, name), cpp)
+
+
+SCHEMA = (
+    Field("lower", "reals", lambda problem, stage, options: problem.lower, length="parameters"),
+    Field("upper", "reals", lambda problem, stage, options: problem.upper, length="parameters"),
+    Field("value", "reals", lambda problem, stage, options: stage.value, length="parameters"),
+    Field("reference", "reals", lambda problem, stage, options: problem.reference, length="parameters"),
+    Field("weight", "reals", lambda problem, stage, options: problem.weight, length="parameters"),
+    Field("center", "reals", lambda problem, stage, options: problem.center, length="parameters"),
+    Field("free", "flags", lambda problem, stage, options: stage.free, length="parameters"),
+    Field("has_total_mass", "integer", lambda problem, stage, options: int(problem.total_mass is not None), "bool"),
+    Field("mass_lo", "real", lambda problem, stage, options: (problem.total_mass or (0.0, 0.0))[0]),
+    Field("mass_hi", "real", lambda problem, stage, options: (problem.total_mass or (0.0, 0.0))[1]),
+    Field("blocks", "blocks", lambda problem, stage, options: stage.blocks),
+    Field("next_blocks", "blocks", lambda problem, stage, options: stage.next_blocks),
+    Field("equalities", "terms", lambda problem, stage, options: problem.equalities),
+    _opt("margin", "real"),
+    _opt("restarts", "integer"),
+    _opt("seed", "integer", "unsigned long"),
+    _opt("threads", "integer"),
+    _opt("global_algorithm", "word"),
+    _opt("global_maxeval", "integer"),
+    _opt("local_maxeval", "integer"),
+    _opt("tolerance", "real"),
+    _opt("hops", "integer"),
+    _opt("hop_size", "real"),
+)
+
+
+def _number(x) -> str:
+    return repr(float(x))
+
+
+def _format(field: Field, value) -> list[str]:
+    """The lines of one field."""
+    kind = field.kind
+    if kind == "integer":
+        return [f"{field.key} {int(value)}"]
+    if kind == "real":
+        return [f"{field.key} {_number(value)}"]
+    if kind == "word":
+        return [f"{field.key} {value}"]
+    if kind == "reals":
+        return [f"{field.key} " + " ".join(_number(v) for v in value)]
+    if kind == "flags":
+        return [f"{field.key} " + " ".join(str(int(bool(f))) for f in value)]
+    if kind == "blocks":
+        lines = [f"{field.key} {len(value)}"]
+        for block in value:
+            lines.append(f"{block.kind} {block.W.shape[0]}")
+            lines.extend(" ".join(_number(v) for v in row) for row in block.W)
+            lines.append(" ".join(_number(v) for v in block.v))
+        return lines
+    if kind == "terms":
+        lines = [f"{field.key} {len(value)}"]
+        for terms in value:
+            lines.append(str(len(terms)) + " " + " ".join(
+                f"{_number(c)} {len(idx)} " + " ".join(map(str, idx)) for c, idx in terms))
+        return lines
+    raise ValueError(kind)
+
+
+def problem_text(problem, stage, options) -> str:
+    lines = [f"{MAGIC} {VERSION}", f"parameters {problem.lower.size}"]
+    for field in SCHEMA:
+        lines += _format(field, field.value(problem, stage, options))
+    return "\n".join(lines + ["end"]) + "\n"
+
+
+@dataclass
+class ReadBlock:
+    kind: str
+    W: np.ndarray
+    v: np.ndarray
+
+
+def read_problem_text(text: str, ranks: dict) -> dict:
+    """The fields of a problem file (as the driver echoes it): key -> value; ranks: coefficient
+    kind -> number of base coefficients (the columns of a block's W)."""
+    words = iter(text.split())
+
+    def expect(word):
+        got = next(words)
+        if got != word:
+            raise ValueError(f"expected {word!r}, got {got!r}")
+
+    expect(MAGIC)
+    expect(str(VERSION))
+    expect("parameters")
+    n = int(next(words))
+    out = {}
+    for field in SCHEMA:
+        expect(field.key)
+        kind = field.kind
+        if kind == "integer":
+            out[field.key] = int(next(words))
+        elif kind == "real":
+            out[field.key] = float(next(words))
+        elif kind == "word":
+            out[field.key] = next(words)
+        elif kind == "reals":
+            out[field.key] = np.array([float(next(words)) for _ in range(n)])
+        elif kind == "flags":
+            out[field.key] = np.array([int(next(words)) for _ in range(n)], dtype=bool)
+        elif kind == "blocks":
+            blocks = []
+            for _ in range(int(next(words))):
+                name, rows = next(words), int(next(words))
+                W = np.array([float(next(words)) for _ in range(rows * ranks[name])]).reshape(rows, ranks[name])
+                blocks.append(ReadBlock(name, W, np.array([float(next(words)) for _ in range(rows)])))
+            out[field.key] = blocks
+        elif kind == "terms":
+            polys = []
+            for _ in range(int(next(words))):
+                terms = []
+                for _ in range(int(next(words))):
+                    c = float(next(words))
+                    terms.append((c, [int(next(words)) for _ in range(int(next(words)))]))
+                polys.append(terms)
+            out[field.key] = polys
+    expect("end")
+    return out
+
+
+def cpp_header() -> str:
+    """protocol.hpp of the static driver (generator/dyngen/extractor/), rendered from SCHEMA."""
+    from ..emission.render import environment
+
+    return environment().get_template("protocol.hpp.j2").render(
+        protocol=[{"key": f.key, "kind": f.kind, "cpp_type": f.cpp_type} for f in SCHEMA],
+        protocol_magic=MAGIC, protocol_version=VERSION)
+
+
+HEADER = Path(__file__).resolve().parents[1] / "extractor" / "protocol.hpp"
+
+if __name__ == "__main__":  # rewrite the checked-in header after a schema change
+    HEADER.write_text(cpp_header())
