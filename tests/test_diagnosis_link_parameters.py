@@ -34,9 +34,6 @@ def diagnosed(tmp_path_factory):
     return {name: run(robot, model, out, doc, name, "forward", Options(reidentify=True)) for name in names}
 
 
-@pytest.mark.xfail(strict=False, reason="fragile: passes with one BLAS thread (OPENBLAS_NUM_THREADS=1, as the "
-                   "dyngen command runs), fails with OpenBLAS's default threads: the consistent solve then lands "
-                   "elsewhere and no longer beats the effects on joint 2's selection data (README)")
 def test_wrong_link_parameters_are_named_and_replaced(diagnosed):
     d = diagnosed["coefficients"]["diagnosis"]
     off = d["link_parameters_off"]
