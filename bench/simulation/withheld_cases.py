@@ -50,8 +50,9 @@ PAYLOAD = np.array([_M, 0.03, -0.02, 0.13,
                     _M * (3 * _R**2 + _H**2) / 12, 0.0, 0.0, _M * (3 * _R**2 + _H**2) / 12, 0.0, _M * _R**2 / 2])
 TILT_AXIS = (np.cos(np.radians(30)), np.sin(np.radians(30)), 0.0)
 
+# The coulomb law names the module's former path, kept so that case folders stay byte-identical.
 LAWS = {
-    "coulomb": "fc * sign(qd)  [Nm]  (MuJoCo frictionloss, sharp: see bench/simulation/mujoco_measurements.py)",
+    "coulomb": "fc * sign(qd)  [Nm]  (MuJoCo frictionloss, sharp: see tests/oracles/mujoco_measurements.py)",
     "viscous": "fv * qd  [Nm s/rad]  (MuJoCo damping)",
     "stribeck": "sign(qd) * (fc + (fs - fc) * exp(-(qd / vs)^2))  (fc by MuJoCo frictionloss, the rest added)",
     "armature": "ia * qdd  [kg m^2]  (MuJoCo armature)",
