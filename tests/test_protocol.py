@@ -77,6 +77,15 @@ def test_every_field_round_trips_through_the_driver(tmp_path, lwr):
                 assert got == sent, field.key
 
 
+def test_the_result_schema_reads_in_order():
+    """Every length and the status a field depends on is read before it."""
+    keys = [f.key for f in RESULT]
+    for k, field in enumerate(RESULT):
+        if field.ok_only:
+            assert keys.index("status") < k, field.key
+        if field.kind == "reals" and field.length not in ("parameters", "links"):
+            assert RESULT[keys.index(field.length)].kind == "integer" and keys.index(field.length) < k, field.key
+
 def random_result(status: str, links: int) -> dict:
     """A value for every result field (the ok-only ones too: an infeasible result must omit them)."""
     rng = np.random.default_rng(7)
