@@ -102,7 +102,7 @@ def test_identify_cli(setup, tmp_path):
     csv = tmp_path / "run.csv"
     np.savetxt(csv, rows, delimiter=",", header=",".join(header), comments="")
     out = tmp_path / "id.yaml"
-    r = subprocess.run([sys.executable, "-m", "dyngen", "identify", LWR, "--data", csv, "--differentiate",
+    r = subprocess.run([sys.executable, "-m", "dyngen", "identify", LWR, "--ols", "--data", csv, "--differentiate",
                         "--model", ROOT / "generated" / "lwr", "-o", out], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "condition number" in r.stdout and out.exists() and out.read_text().count("coefficient:") == 43

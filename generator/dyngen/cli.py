@@ -19,17 +19,26 @@ dyngen: robot dynamic models as exact, standalone C from a DH table.
   dyngen generate ROBOT.yaml [-o DIR]  derive, reduce to base coefficients, emit C into DIR/<name>/
   dyngen extract ROBOT.yaml [options]  physically consistent link parameters from the identified
                                        coefficients, written to OUT/<name>/
-  dyngen identify ROBOT.yaml --data a.csv [--kind full|gravity|inertia]
-                                       base coefficients by least squares from recordings
+  dyngen identify ROBOT.yaml --data a.csv [--kind full|gravity|inertia] [--ols]
+                                       physically consistent link parameters with friction from
+                                       recordings (--ols, gravity, inertia: least squares)
   dyngen diagnose ROBOT.yaml --params P.yaml --data a.csv [--test b.csv]
                                        where the measured-model gap lies and which effect explains it
+  dyngen excite ROBOT.yaml [-o CSV]    an optimised excitation trajectory within the joint limits
 
 Run `dyngen COMMAND --help` for a command's options. The YAML schema and the parameter
 conventions are in docs/conventions.md; examples/ has the KUKA LWR IV+ and other arms.
 """
 
 
-COMMANDS = {"generate": generate.main, "extract": extract.main, "identify": identify.main, "diagnose": diagnose.main}
+def _excite(argv, prog="dyngen excite") -> int:
+    from .excitation.command import cmd_excite
+
+    return cmd_excite(argv, prog)
+
+
+COMMANDS = {"generate": generate.main, "extract": extract.main, "identify": identify.main, "diagnose": diagnose.main,
+            "excite": _excite}
 
 
 def main(argv=None) -> int:

@@ -84,8 +84,11 @@ def _read(paths, robot, args, require_torques=True, required=()):
 
 def cmd_identify(argv, prog="dyngen identify") -> int:
     parser = argparse.ArgumentParser(prog=prog, description=(
-        "Identify base coefficients by least squares (the paper's eq. 11) from recordings, and write "
-        "them as the `identified:` YAML block that `dyngen extract` reads. --kind full uses torque "
+        "Identify from recordings. --kind full (default): physically consistent link parameters with "
+        "per-joint friction, offset and rotor inertia (weighted least squares subject to consistency of every "
+        "link, the YAML's bounds and total mass; --ols for plain least squares), written with URDF and MJCF. "
+        "Otherwise base coefficients by least squares (the paper's eq. 11), as the `identified:` YAML block "
+        "that `dyngen extract` reads. --kind full uses torque "
         "trajectories (Y(q, qd, qdd) pi = tau); gravity reads the torques as gravity torques g(q) (static "
         "poses or the FRI's g(q), eq. 9); inertia reads the stacked inertia matrix from columns M11, M12, ... "
         "(eq. 10). Reports the regressor's condition number, every coefficient's standard deviation and "
@@ -95,6 +98,9 @@ def cmd_identify(argv, prog="dyngen identify") -> int:
                         help="which coefficients (default full)")
     parser.add_argument("-o", "--output", metavar="FILE",
                         help="where to write the YAML (default out/<robot>/identified_<kind>.yaml)")
+    from .identification.consistent_cli import add_options, run_consistent
+
+    add_options(parser)
     args = parser.parse_args(argv)
     from .description import load_robot
     from .identification import identified_yaml, identify, summary_table
@@ -107,6 +113,8 @@ def cmd_identify(argv, prog="dyngen identify") -> int:
     signals = _read(args.data, robot, args, require_torques=args.kind != "inertia", required=required)
     progress.say(f"dyngen identify: {robot.name}, {args.kind} coefficients from {len(args.data)} recording(s)")
     model = _model(args, robot, progress)
+    if args.kind == "full" and not args.ols:
+        return run_consistent(args, robot, model, signals, progress)
     if args.kind == "inertia":
         assert stacked_inertia_columns(model.manifest) == list(required)
     with progress.step("least squares"):

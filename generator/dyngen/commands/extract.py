@@ -115,7 +115,8 @@ def _write_extraction(args, robot, folder, extraction, options, seconds, compare
         columns = {compare[0]: compare[1], **columns}
     residual_rows = report.residual_comparison(robot, extraction, columns, folder)
     table = report.consistency_table(columns)
-    write_file(out / "consistency.md", table + "\n")
+    warnings = "".join(f"**{line}**\n\n" for line in report.unreachable(robot, extraction))
+    write_file(out / "consistency.md", warnings + table + "\n")
     exported = []
     if not robot.gravity_symbols:  # simulators need a numeric gravity
         from ..export import write_all

@@ -23,7 +23,7 @@ from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
 _TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
 _EXTRACTION_KEYS = yaml_keys(ExtractionOptions) | {"compare"}  # every extraction option, and the compared file
 _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
-_LIMIT_KEYS = {"lower", "upper", "velocity", "effort"}
+_LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
 _IDENTIFIED_KINDS = ("gravity", "inertia", "full")
 _C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_kinds.h and the like
@@ -180,6 +180,9 @@ class _Reader:
             limits = Limits(**{k: self.number(v, f"{field}.limits.{k}", 1e6) for k, v in raw.items()})
             if limits.lower is not None and limits.upper is not None and limits.lower > limits.upper:
                 self.fail(f"{field}.limits", f"lower {limits.lower} > upper {limits.upper}")
+            for key in ("velocity", "acceleration", "effort"):
+                if getattr(limits, key) is not None and getattr(limits, key) <= 0:
+                    self.fail(f"{field}.limits.{key}", f"expected a positive number, got {getattr(limits, key)!r}")
         return Joint(type=kind, limits=limits, **numbers)
 
     def link_values(self, value, field) -> LinkValues:

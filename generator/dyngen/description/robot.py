@@ -21,6 +21,7 @@ class Limits:
     lower: Optional[float] = None
     upper: Optional[float] = None
     velocity: Optional[float] = None
+    acceleration: Optional[float] = None
     effort: Optional[float] = None
 
 

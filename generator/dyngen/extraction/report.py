@@ -18,9 +18,41 @@ def links_yaml(p) -> str:
     return "\n".join(lines) + "\n"
 
 
+UNREACHABLE = 1e-2  # relative coefficient residual above which the targets count as unreachable
+
+
+def unreachable(robot, extraction, threshold: float = UNREACHABLE, top: int = 6) -> list[str]:
+    """Warnings, first thing in the summary and the files, when no consistent parameters come near
+    the identified coefficients: the relative residual of a kind above `threshold`, the coefficients
+    missed most (target and the closest consistent value) and the parameters pinned at a bound.
+    "N/N restarts consistent" alone is not a success."""
+    from ..identification.consistent import pinned
+
+    lines = []
+    for kind, r in (extraction.stages[-1].residuals or {}).items():
+        t = extraction.targets[kind]
+        rel = float(np.linalg.norm(r) / max(np.linalg.norm(t.v), 1e-300))
+        if rel <= threshold:
+            continue
+        worst = [k for k in np.argsort(-np.abs(r))[:top] if abs(r[k]) >= 0.1 * np.max(np.abs(r))]
+        missed = ", ".join(f"{robot.identified[kind][k].coefficient} = {t.v[k]:.4g} (closest consistent "
+                           f"{t.v[k] + r[k]:.4g})" for k in worst)
+        lines.append(f"WARNING: the identified {kind} coefficients are not reachable by physically consistent "
+                     f"parameters within the bounds: relative residual {rel:.2g}. Cannot be met: {missed}.")
+    if lines:
+        at = pinned(extraction.problem, extraction.p)
+        if at:
+            lines.append(f"WARNING: parameters pinned at a bound: {', '.join(at)}.")
+        lines.append("WARNING: these coefficients are not a consistent robot (typically least squares on data that "
+                     "do not excite them, or unmodelled friction and offsets pushed into them); identify from the "
+                     "recordings with `dyngen identify ROBOT.yaml --data ...` (physically consistent, with friction) "
+                     "instead of extracting from them.")
+    return lines
+
+
 def extracted_yaml(robot, extraction, options, seconds: float) -> str:
     last = extraction.stages[-1]
-    head = [
+    head = [f"# {line}" for line in unreachable(robot, extraction)] + [
         f"# Link parameters of {robot.name} extracted by dyngen from {robot.source}:",
         f"# procedure {options.procedure}, {options.restarts} restarts, seed {options.seed}, "
         f"consistency margin {options.margin:g} kg m^2.",
@@ -53,7 +85,7 @@ def consistency_table(columns: dict) -> str:
 
 
 def summary(robot, extraction, options, seconds: float) -> str:
-    lines = [f"extraction of {robot.name}: procedure {options.procedure}, {options.restarts} restarts, "
+    lines = unreachable(robot, extraction) + [f"extraction of {robot.name}: procedure {options.procedure}, {options.restarts} restarts, "
              f"seed {options.seed}, {seconds:.1f} s"]
     for s in extraction.stages:
         lines.append(f"  stage {s.name}: {s.consistent}/{s.restarts} restarts consistent, "

@@ -3,12 +3,16 @@
     estimate = identify(model, signals, kind="full")        # or "gravity", "inertia"
     text = identified_yaml(model.manifest, {"full": estimate}, sources)   # what `dyngen extract` reads
 
-Modules: samples (stacked regressors and measurements from recordings), least_squares (the
+    result = identify_consistent(robot, model, folder, signals)   # physically consistent, with friction
+
+Modules: consistent (weighted least squares over consistent link parameters, friction, offsets and
+rotor inertia through the extraction's solver), samples (stacked regressors and measurements from recordings), least_squares (the
 fit, condition number, standard deviations, unexcited coefficients), output (YAML, table).
 """
 
+from .consistent import Consistent, ConsistentOptions, identify_consistent
 from .least_squares import Estimate, fit
 from .output import identified_yaml, summary_table
 from .samples import identify, stacked
 
-__all__ = ["Estimate", "fit", "identified_yaml", "identify", "stacked", "summary_table"]
+__all__ = ["Consistent", "ConsistentOptions", "identify_consistent", "Estimate", "fit", "identified_yaml", "identify", "stacked", "summary_table"]

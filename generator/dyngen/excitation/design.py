@@ -1,0 +1,252 @@
+"""The excitation design: a Fourier series at rest at its ends, scaled into the limits, with the
+condition number of the identification matrix minimised over its coefficients.
+
+Parametrisation (validation.excitation.FourierTrajectory, joint j, harmonics l = 1..L):
+    qd_j(t) = sum_l a_jl cos(w l t) + b_jl sin(w l t),   q_j = q0_j + integral
+At rest at t = 0 (hence at every multiple of the period): qd_j(0) = sum_l a_jl = 0 and
+qdd_j(0) = w sum_l l b_jl = 0; a_j1 and b_j1 are solved from these, the other 2 (L - 1)
+coefficients of each joint and its centre q0_j are free.
+
+Limits by construction, not by penalty: for any coefficients, each joint's motion about q0_j is
+scaled by the largest factor that keeps position, velocity and acceleration within `margin`
+of their limits (the peaks taken on a grid of 200 points per period of the highest harmonic,
+then checked again on the written samples), and the whole motion shrinks further if the flange
+would leave the optional workspace box. The optimiser therefore sees only feasible trajectories;
+motion at the limits is what excites best, so the scaling is where the optimum lies anyway.
+
+Criterion: log cond(A), A = [Y(q, qd, qdd), friction and offset columns] on `points` samples of
+one period, the matrix that `dyngen identify --consistent` fits (columns as they are, as in
+Swevers 1997 and Gaz 2019; the condition with unit-norm columns is reported too). Minimised by
+L-BFGS-B (finite differences) from the best of `candidates` random starts; all draws come from
+`seed`, so the design is deterministic.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize
+
+from ..errors import InputError
+from ..validation.excitation import FourierTrajectory
+
+GRID_PER_HARMONIC = 200  # samples per period of the highest harmonic for the peaks
+
+
+@dataclass
+class Settings:
+    seed: int = 1
+    period: float = 10.0  # s (base frequency 1 / period)
+    harmonics: int = 5
+    margin: float = 0.95  # fraction of each limit the motion may use
+    points: int = 200  # samples of one period in the criterion
+    candidates: int = 16  # random starts; the best is refined
+    max_iterations: int = 60  # L-BFGS-B iterations
+    coulomb_velocity: float = 0.01  # rad/s, tanh smoothing of the Coulomb column
+    workspace: tuple | None = None  # (xmin, xmax, ymin, ymax, zmin, zmax) of the flange [m]
+    criterion: str = "cond"  # "cond" or "logdet" (maximise log det A^T A, columns unit norm)
+
+
+@dataclass
+class Design:
+    trajectory: FourierTrajectory
+    condition: float  # cond(A) on the criterion's samples
+    scaled_condition: float  # with unit-norm columns
+    random_condition: float  # the same for random coefficients with the same limits (median of the candidates)
+    random_scaled_condition: float
+    random_trajectory: FourierTrajectory
+    evaluations: int
+    seconds: float = 0.0
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+
+
+def limits_of(robot) -> JointLimits:
+    """The YAML's joint limits; an InputError names the first missing one."""
+    values = {k: [] for k in ("lower", "upper", "velocity", "acceleration")}
+    for i, joint in enumerate(robot.joints):
+        lim = joint.limits
+        for key in values:
+            value = getattr(lim, key, None) if lim is not None else None
+            if value is None:
+                raise InputError(robot.source, f"joints[{i}].limits.{key}",
+                                 "missing (dyngen excite needs lower, upper, velocity and acceleration)")
+            values[key].append(value)
+    return JointLimits(*(np.array(values[k], dtype=float) for k in ("lower", "upper", "velocity", "acceleration")))
+
+
+class _Shape:
+    """x (vector) <-> trajectory; x = [u (N), free coefficients (N, 2 (L - 1))]."""
+
+    def __init__(self, limits: JointLimits, settings: Settings, flange=None):
+        self.limits, self.settings, self.flange = limits, settings, flange
+        self.n = limits.lower.size
+        self.L = settings.harmonics
+        self.base_hz = 1.0 / settings.period
+        self.grid = np.arange(GRID_PER_HARMONIC * self.L) / (GRID_PER_HARMONIC * self.L * self.base_hz)
+        self.size = self.n + 2 * self.n * (self.L - 1)
+
+    def coefficients(self, x):
+        free = x[self.n:].reshape(self.n, 2, self.L - 1)
+        harmonic = np.arange(2, self.L + 1)
+        a = np.column_stack([-free[:, 0].sum(axis=1), free[:, 0]])
+        b = np.column_stack([-(free[:, 1] * harmonic).sum(axis=1), free[:, 1]])
+        return a, b
+
+    def trajectory(self, x) -> FourierTrajectory:
+        lim, m = self.limits, self.settings.margin
+        centre, half = (lim.upper + lim.lower) / 2, (lim.upper - lim.lower) / 2
+        q0 = centre + np.clip(x[:self.n], -0.5, 0.5) * half
+        a, b = self.coefficients(x)
+        q, qd, qdd = FourierTrajectory(self.base_hz, np.zeros(self.n), a, b)(self.grid)
+        dev = q - q[0]  # q(0) is where the motion starts; q0 is where it starts from rest
+        tiny = 1e-300
+        scale = np.min([m * (lim.upper - q0) / np.maximum(dev.max(axis=0), tiny),
+                        m * (q0 - lim.lower) / np.maximum(-dev.min(axis=0), tiny),
+                        m * lim.velocity / np.maximum(np.abs(qd).max(axis=0), tiny),
+                        m * lim.acceleration / np.maximum(np.abs(qdd).max(axis=0), tiny)], axis=0)
+        scale = np.where(np.isfinite(scale), scale, 0.0)
+        a, b = a * scale[:, None], b * scale[:, None]
+        # offset such that q(0) = q0: the series' value at 0 is -sum b / (w l)
+        w = 2 * np.pi * self.base_hz * np.arange(1, self.L + 1)
+        offset = q0 + (b / w).sum(axis=1)
+        traj = FourierTrajectory(self.base_hz, offset, a, b)
+        if self.flange is not None and self.settings.workspace is not None:
+            traj = self._into_box(traj, q0)
+        return traj
+
+    def _into_box(self, traj, q0):
+        # the flange is checked on every second grid point against the box shrunk by 1 mm (the
+        # written samples are checked again by the command)
+        box = np.asarray(self.settings.workspace, dtype=float).reshape(3, 2) + np.array([1e-3, -1e-3])
+        grid = self.grid[::2]
+        if not _inside(self.flange(q0[None, :]), box).all():
+            raise InputError("--workspace", "", "the flange at the trajectory's start lies outside the box")
+        if _inside(self.flange(traj(grid)[0]), box).all():
+            return traj
+        lo, hi = 0.0, 1.0
+        for _ in range(12):  # bisection on a common shrink factor of the motion about q0
+            mid = 0.5 * (lo + hi)
+            if _inside(self.flange(_shrunk(traj, q0, mid)(grid)[0]), box).all():
+                lo = mid
+            else:
+                hi = mid
+        return _shrunk(traj, q0, lo)
+
+
+def _shrunk(traj, q0, factor) -> FourierTrajectory:
+    w = 2 * np.pi * traj.base_hz * np.arange(1, traj.a.shape[1] + 1)
+    a, b = traj.a * factor, traj.b * factor
+    return FourierTrajectory(traj.base_hz, q0 + (b / w).sum(axis=1), a, b)
+
+
+def _inside(points, box) -> np.ndarray:
+    return np.all((points >= box[:, 0]) & (points <= box[:, 1]), axis=1)
+
+
+def identifiable_armature(model, dof: int) -> list:
+    from ..identification.consistent import identifiable_armature as check
+
+    return check(model, dof)
+
+
+def identification_matrix(model, q, qd, qdd, coulomb_velocity=0.01, armature=None) -> np.ndarray:
+    """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major."""
+    T, n = q.shape
+    Y = model.batch("regressor", q, qd, qdd).reshape(T * n, -1)
+    cols = []
+    for j in range(n):
+        for kind in ("coulomb", "viscous", "offset", "armature"):
+            if kind == "armature" and not (armature and armature[j]):
+                continue
+            col = np.zeros((T, n))
+            col[:, j] = {"coulomb": lambda: np.tanh(qd[:, j] / coulomb_velocity), "viscous": lambda: qd[:, j],
+                         "offset": lambda: np.ones(T), "armature": lambda: qdd[:, j]}[kind]()
+            cols.append(col.reshape(-1))
+    return np.hstack([Y, np.column_stack(cols)])
+
+
+def _conditions(A) -> tuple[float, float]:
+    sv = np.linalg.svd(A, compute_uv=False)
+    norms = np.linalg.norm(A, axis=0)
+    svs = np.linalg.svd(A / np.where(norms > 0, norms, 1.0), compute_uv=False)
+    return (float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf, float(svs[0] / svs[-1]) if svs[-1] > 0 else np.inf)
+
+
+def optimise(robot, model, settings: Settings | None = None, flange=None) -> Design:
+    """The optimised excitation for `robot` (its YAML limits) with the compiled `model`."""
+    import time
+
+    settings = settings or Settings()
+    if settings.harmonics < 2:
+        raise InputError("--harmonics", "", f"{settings.harmonics}: at least 2 (one is used to start at rest)")
+    if settings.criterion not in ("cond", "logdet"):
+        raise InputError("--criterion", "", f'expected "cond" or "logdet", got "{settings.criterion}"')
+    start = time.perf_counter()
+    limits = limits_of(robot)
+    shape = _Shape(limits, settings, flange)
+    armature = identifiable_armature(model, robot.dof)
+    times = np.arange(settings.points) * settings.period / settings.points
+    evaluations = 0
+
+    def matrix(x):
+        q, qd, qdd = shape.trajectory(x)(times)
+        return identification_matrix(model, q, qd, qdd, settings.coulomb_velocity, armature)
+
+    def criterion(x):
+        nonlocal evaluations
+        evaluations += 1
+        A = matrix(x)
+        if settings.criterion == "logdet":
+            norms = np.linalg.norm(A, axis=0)
+            sign, logdet = np.linalg.slogdet((A / np.where(norms > 0, norms, 1)).T @ (A / np.where(norms > 0, norms, 1)))
+            return -logdet if sign > 0 else 1e6
+        ev = np.linalg.eigvalsh(A.T @ A)  # the Gram matrix's eigenvalues: 10 times faster than the SVD
+        return float(0.5 * (np.log(max(ev[-1], 1e-300)) - np.log(max(ev[0], 1e-300))))
+
+    rng = np.random.default_rng(settings.seed)
+    decay = np.tile(np.repeat(1.0 / np.arange(2, settings.harmonics + 1)[None, :], 2, axis=0).ravel(), robot.dof)
+    starts = []
+    for _ in range(settings.candidates):
+        u = rng.uniform(-0.2, 0.2, robot.dof)
+        starts.append(np.concatenate([u, rng.standard_normal(shape.size - robot.dof) * decay]))
+    values = [criterion(x) for x in starts]
+    random_index = int(np.argsort(values)[len(values) // 2])  # the median random trajectory
+    best = starts[int(np.argmin(values))]
+    bounds = [(-0.5, 0.5)] * robot.dof + [(None, None)] * (shape.size - robot.dof)
+    result = minimize(criterion, best, method="L-BFGS-B", bounds=bounds,
+                      options={"maxiter": settings.max_iterations, "eps": 1e-6})
+    x = result.x if result.fun <= min(values) else best
+    traj = shape.trajectory(x)
+    cond, scaled = _conditions(matrix(x))
+    rcond, rscaled = _conditions(matrix(starts[random_index]))
+    return Design(traj, cond, scaled, rcond, rscaled, shape.trajectory(starts[random_index]), evaluations,
+                  time.perf_counter() - start)
+
+
+def random_design(robot, settings: Settings, seed: int) -> FourierTrajectory:
+    """A random trajectory of the same family and limits (the comparison for a design)."""
+    shape = _Shape(limits_of(robot), settings)
+    rng = np.random.default_rng(seed)
+    decay = np.tile(np.repeat(1.0 / np.arange(2, settings.harmonics + 1)[None, :], 2, axis=0).ravel(), robot.dof)
+    x = np.concatenate([rng.uniform(-0.2, 0.2, robot.dof), rng.standard_normal(shape.size - robot.dof) * decay])
+    return shape.trajectory(x)
+
+
+def check_limits(robot, t, q, qd, qdd, tolerance: float = 1e-9) -> list[str]:
+    """Every violated limit on the given samples (empty: all respected)."""
+    lim = limits_of(robot)
+    problems = []
+    for name, bad in (("lower", q < lim.lower - tolerance), ("upper", q > lim.upper + tolerance),
+                      ("velocity", np.abs(qd) > lim.velocity + tolerance),
+                      ("acceleration", np.abs(qdd) > lim.acceleration + tolerance)):
+        for j in np.flatnonzero(bad.any(axis=0)):
+            problems.append(f"joint {j + 1}: {name} limit exceeded at t = {t[np.argmax(bad[:, j])]:.4g} s")
+    return problems

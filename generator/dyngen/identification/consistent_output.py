@@ -1,0 +1,102 @@
+"""What `dyngen identify` writes for the consistent identification: a YAML with the link
+parameters (the `parameters.nominal` / extraction `links:` format, so `dyngen diagnose --params`
+and the exporters read it), the friction per joint, and the `identified:` block of the base
+coefficients (each with the unconstrained fit's standard deviation); a Markdown table; the
+summary lines printed."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..extraction.report import links_yaml
+
+
+def _f(x) -> str:
+    return "null" if not np.isfinite(x) else f"{float(x):.6g}"
+
+
+def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
+    n = robot.dof
+    ols = c.ols
+    r = len(c.names)
+    lines = [
+        f"# {robot.name}: physically consistent identification by dyngen from {', '.join(sources)}.",
+        f"# Conditioning: {conditioning}. Rows weighted by 1 / sigma_j (per-joint noise below); "
+        f"regularisation toward the prior: {c.regularisation:g}.",
+        "# Torque model: Y(q, qd, qdd) pi(links) + Fc tanh(qd / vs) + Fv qd + offset + Ia qdd"
+        + (" + tilt columns dg" if c.tilt_model is not None else "") + ".",
+        "# std: of the unconstrained weighted least squares of the same columns (uncorrelated residuals assumed).",
+        f"robot: {robot.name}",
+        "links:",
+    ]
+    lines.append(links_yaml(c.p).rstrip("\n"))
+    lines.append("friction:   # per joint; Coulomb Fc tanh(qd(t - lag) / vs) [Nm, s, rad/s], viscous Fv [Nm s/rad], "
+                 "offset [Nm], rotor inertia Ia [kg m^2] (null: carried by the rigid body), ripple [a, b]: "
+                 "a cos q + b sin q [Nm], sigma: noise [Nm]")
+    k = {name: i for i, name in enumerate(c.column_names)}
+    for j in range(n):
+        def std(kind):
+            i = k.get(f"{kind} j{j + 1}")
+            return _f(ols.std[i]) if i is not None else "null"
+        lines.append(f"  - {{Fc: {_f(c.friction['coulomb'][j])}, vs: {_f(c.smoothing[j])}, Fv: {_f(c.friction['viscous'][j])}, "
+                     f"offset: {_f(c.friction['offset'][j])}, Ia: {_f(c.friction['armature'][j])}, "
+                     f"lag: {_f(c.lags[j] if c.lags is not None else 0.0)}, "
+                     f"ripple: [{_f(c.friction['ripple_cos'][j])}, {_f(c.friction['ripple_sin'][j])}], "
+                     f"sigma: {_f(c.sigma[j])}}}   # joint {j + 1}; std Fc {std('coulomb')}, Fv {std('viscous')}, "
+                     f"offset {std('offset')}, Ia {std('armature')}")
+    if c.tilt_model is not None:
+        dg = c.friction["tilt"]
+        lines.append(f"tilt: {{dg: [{_f(dg[0])}, {_f(dg[1])}, 0]}}   # m/s^2, horizontal gravity in the base frame "
+                     f"({np.degrees(np.arctan2(np.hypot(*dg), 9.81)):.2f} deg)")
+    lines.append(f"identified:\n  full:   # base coefficients of the links above; condition number {ols.condition:.3g} "
+                 f"(weighted, with the friction columns; columns scaled {ols.scaled_condition:.3g})")
+    for i in range(r):
+        note = "not excited by the data: set by the prior and consistency" if i in ols.unexcited \
+            else f"std {ols.std[i]:.3g}, unconstrained fit {ols.values[i]:.6g}"
+        lines.append(f'    - {{coefficient: "{c.names[i]}", value: {float(c.pi[i])!r}}}   # {note}')
+    return "\n".join(lines) + "\n"
+
+
+def consistent_table(c) -> str:
+    """Markdown: per base coefficient the consistent value, the unconstrained one and its std."""
+    rows = ["| coefficient | consistent | unconstrained | std | excited |", "|---|---:|---:|---:|---|"]
+    for i, name in enumerate(c.names):
+        rows.append(f"| {name} | {c.pi[i]:.6g} | {c.ols.values[i]:.6g} | {c.ols.std[i]:.3g} | "
+                    f"{'no' if i in c.ols.unexcited else 'yes'} |")
+    return "\n".join(rows)
+
+
+def summary_lines(robot, c) -> list[str]:
+    n = robot.dof
+    out = [f"{robot.name}: physically consistent identification, {len(c.names)} base coefficients + friction "
+           f"from {c.ols.rows} equations; condition number {c.ols.condition:.3g} (columns scaled "
+           f"{c.ols.scaled_condition:.3g})"]
+    out.append("  per-joint noise sigma used as weight [Nm]: " + ", ".join(f"{x:.3g}" for x in c.sigma))
+    out.append("  residual RMS on the fit data [Nm], consistent: " + ", ".join(f"{x:.3g}" for x in c.residual_rms)
+               + "; unconstrained: " + ", ".join(f"{x:.3g}" for x in c.ols_residual_rms))
+    if c.selection:
+        out.append("  regularisation toward the prior chosen on held-out data: " + ", ".join(
+            f"{lam:g}{'*' if lam == c.regularisation else ''} ({score:.4g})" for lam, score in c.selection))
+    else:
+        out.append(f"  regularisation toward the prior: {c.regularisation:g}")
+    out.append("  friction: " + "; ".join(
+        f"j{j + 1} Fc {c.friction['coulomb'][j]:.3g} Fv {c.friction['viscous'][j]:.3g} b {c.friction['offset'][j]:+.3g}"
+        + (f" Ia {c.friction['armature'][j]:.3g}" if np.isfinite(c.friction['armature'][j]) else "")
+        for j in range(n)))
+    if c.tilt_model is not None:
+        dg = c.friction["tilt"]
+        out.append(f"  base tilt: dg = ({dg[0]:+.3g}, {dg[1]:+.3g}, 0) m/s^2 "
+                   f"({np.degrees(np.arctan2(np.hypot(*dg), 9.81)):.2f} deg)")
+    out.append("  every link consistent: lambda_min(tr(I)/2 E - I) = " + ", ".join(f"{x:.2e}" for x in c.lambda_min))
+    if c.ols.unexcited:
+        out.append(f"  {len(c.ols.unexcited)} coefficient(s) not excited by the data (set by the prior and "
+                   "consistency): " + ", ".join(c.column_names[i] for i in c.ols.unexcited))
+    if c.dropped_columns:
+        out.append("  left out (the data cannot tell them from the rest of the model): " + ", ".join(c.dropped_columns))
+    if c.at_bounds:
+        out.append(f"  parameters at a bound of the YAML: {', '.join(c.at_bounds)}")
+    negative = [j + 1 for j in range(n) if c.friction["viscous"][j] < 0]
+    if negative:
+        out.append(f"  viscous friction below 0 on joint(s) {', '.join(map(str, negative))} (Coulomb friction falling with "
+                   "speed, still opposing motion up to the velocity limit); left out of the MJCF/URDF damping")
+    return out
