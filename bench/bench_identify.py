@@ -111,7 +111,7 @@ def real(lines):
 def synthetic(seconds=30.0, rate=1000.0):
     from dataclasses import replace
 
-    from oracles.mujoco_measurements import Effects, Trajectory, measure
+    from simulation.mujoco_measurements import Effects, Trajectory, measure
     from oracles.random_params import random_parameters
 
     from dyngen.data.recording import Recording

@@ -3,7 +3,7 @@
     python bench/bench_withheld.py                    # 200, 500 and 1000 Hz, encoder positions
     python bench/bench_withheld.py --rates 500        # one rate
 
-For every case of tests/oracles/withheld_cases.py (CASES: the LWR in MuJoCo, torques from
+For every case of bench/simulation/withheld_cases.py (CASES: the LWR in MuJoCo, torques from
 mj_inverse with effects the nominal model lacks; TRACKED_CASES: a forward simulation of the arm
 tracking its reference, with friction that sticks at reversals; OFF_GRID_CASES: settings
 between the diagnosis's variants), positions as a 20-bit encoder records them (1e-5 rad noise,
@@ -12,7 +12,7 @@ quantised), no qd or qdd columns, torque noise 0.05 Nm. Each case runs through
 excitation (selection on blocks of it) and test on Table V, and the reverse. The verdict
 (tests/oracles/withheld_verdict.py) asks for exactly the injected effects on their joints,
 every magnitude within 20 %, and a test RMS after within 1.5 x what the perfect model leaves
-on the same conditioned test data (tests/oracles/perfect.py). The noise-free variant (exact
+on the same conditioned test data (bench/simulation/perfect.py). The noise-free variant (exact
 q, qd, qdd columns, 1 kHz) runs as well (--noise-free-rate). Tables to
 bench/results/withheld.md (--results).
 """
@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests"))  # the verdict: tests/oracles/withheld_run.py
 sys.path.insert(0, str(ROOT / "generator"))
 
 from dyngen import blas  # noqa: E402
@@ -35,9 +35,9 @@ from dyngen import blas  # noqa: E402
 blas.use_one_thread()
 
 import numpy as np  # noqa: E402
-from oracles.mujoco_measurements import Encoder  # noqa: E402
-from oracles.withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, write_cases  # noqa: E402
 from oracles.withheld_run import DIRECTIONS, run  # noqa: E402
+from simulation.mujoco_measurements import Encoder  # noqa: E402
+from simulation.withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, write_cases  # noqa: E402
 
 from dyngen.atomic import write_file  # noqa: E402
 from dyngen.description import load_robot  # noqa: E402

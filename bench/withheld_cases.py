@@ -3,8 +3,8 @@
     python bench/withheld_cases.py --out /tmp/withheld              # 1 kHz, about 300 MB
     python bench/withheld_cases.py --out /tmp/withheld --rate 200   # the real LWR data's rate
 
-The cases are tests/oracles/withheld_cases.py's CASES, simulated in MuJoCo
-(tests/oracles/mujoco_measurements.py); see bench/README.md. After writing, the script reads
+The cases are bench/simulation/withheld_cases.py's CASES, simulated in MuJoCo
+(bench/simulation/mujoco_measurements.py); see bench/README.md. After writing, the script reads
 every CSV back and reports, per case, the residual of the nominal model (params.yaml through
 the generated rnea of generated/lwr) on the fit and the held-out trajectory: the RMS per joint
 that a diagnosis starts from, and its ratio to the noise sigma. Table to
@@ -21,11 +21,10 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "generator"))
 
-from oracles.mujoco_measurements import read_csv  # noqa: E402
-from oracles.withheld_cases import write_cases  # noqa: E402
+from simulation.mujoco_measurements import read_csv  # noqa: E402
+from simulation.withheld_cases import write_cases  # noqa: E402
 
 from dyngen.atomic import write_file  # noqa: E402
 from dyngen.data.parameters_file import read_link_parameters  # noqa: E402

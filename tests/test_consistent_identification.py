@@ -15,8 +15,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from conftest import ROOT
-from oracles.mujoco_measurements import Effects, Trajectory, measure
 from oracles.random_params import random_parameters
+from simulation.mujoco_measurements import Effects, Trajectory, measure
 
 from dyngen.data import Conditioning, condition
 from dyngen.data.recording import Recording

@@ -1,5 +1,5 @@
 """Does a diagnosis (diagnosis.json, docs/conventions.md) match the truth of a withheld case
-(truth.json, tests/oracles/withheld_cases.py)? `problems(truth, diagnosis, noise)` lists every
+(truth.json, bench/simulation/withheld_cases.py)? `problems(truth, diagnosis, noise)` lists every
 mismatch as a sentence; an empty list is a pass.
 
 The verdict must name exactly the injected effects on exactly their joints, recover each
@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .withheld_cases import standard_of_body
+from simulation.withheld_cases import standard_of_body
 
 TOLERANCE = 0.20  # relative, on magnitudes
 NOISE_FACTOR = 1.5  # held-out RMS after, per joint, at most this many noise sigmas

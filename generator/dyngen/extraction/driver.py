@@ -14,7 +14,7 @@ import numpy as np
 from .. import cache
 from ..errors import DriverError
 from .problem import Options, Problem, Stage
-from .protocol import problem_text
+from .protocol import problem_text, read_result_text
 
 
 def eigen_include() -> str:
@@ -145,24 +145,14 @@ def run(exe: Path, problem: Problem, stage: Stage, options: Options, on_progress
 
 
 def parse(name: str, text: str) -> StageResult:
-    fields, residuals = {}, {}
-    for line in text.splitlines():
-        words = line.split()
-        if not words:
-            continue
-        if words[0] == "residual":
-            residuals[words[1]] = np.array([float(w) for w in words[2:]])
-        else:
-            fields[words[0]] = words[1:]
-    result = StageResult(name, fields["status"][0], int(fields["restarts"][0]), int(fields["restarts"][2]),
-                         np.array([float(w) for w in fields["restart_costs"]]),
-                         np.array([float(w) for w in fields["restart_violations"]]))
-    if "parameters" in fields:
-        result.p = np.array([float(w) for w in fields["parameters"]])
+    """The stage's result from the driver's result file (extraction/protocol.py, RESULT)."""
+    fields = read_result_text(text)
+    result = StageResult(name, fields["status"], fields["restarts"], fields["consistent"], fields["restart_costs"],
+                         fields["restart_violations"], fields["parameters"])
     if result.status == "ok":
-        result.fit_cost = float(fields["fit_cost"][0])
-        result.cost = float(fields["cost"][0])
-        result.violation = float(fields["violation"][0])
-        result.residuals = residuals
-        result.lambda_min = np.array([float(w) for w in fields["lambda_min"]])
+        result.fit_cost = fields["fit_cost"]
+        result.cost = fields["cost"]
+        result.violation = fields["violation"]
+        result.residuals = fields["residuals"]
+        result.lambda_min = fields["lambda_min"]
     return result

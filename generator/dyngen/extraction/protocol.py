@@ -6,6 +6,10 @@ driver's Problem (generator/dyngen/extractor/protocol.hpp, rendered from SCHEMA 
 through templates/protocol.hpp.j2) all follow it, so an option is added by one line here (and
 its field in extraction/options.py), then `python3 -m dyngen.extraction.protocol`.
 
+The result file the driver writes back follows RESULT the same way: the C++ Result, its writer
+and reader (`--echo-result`) are rendered into protocol.hpp, the Python reader
+(`read_result_text`, used by extraction/driver.py) and writer (`result_text`) read RESULT.
+
 Kinds (C++ type, and the text after the key):
   integer   int, or the field's `cpp` type     one whole number
   real      double                             one number (shortest round-trip text)
@@ -169,13 +173,110 @@ def read_problem_text(text: str, ranks: dict) -> dict:
     return out
 
 
+@dataclass(frozen=True)
+class ResultField:
+    """One field of the result file, `key value...` in the order of RESULT."""
+
+    key: str  # in the file, and the C++ Result member
+    kind: str  # integer, real, word, reals, or residuals (count, then per block: kind rows values)
+    length: str = ""  # reals: "parameters", "links", or the key of an earlier integer field
+    ok_only: bool = False  # written only when status is "ok"
+
+    @property
+    def cpp_type(self) -> str:
+        return {"integer": "int", "real": "double", "word": "std::string", "reals": "Eigen::VectorXd",
+                "residuals": "std::vector<Residual>"}[self.kind]
+
+    @property
+    def cpp_read(self) -> str:
+        """The C++ expression that reads the value (Reader r, the Result so far R)."""
+        size = {"parameters": "kParameters", "links": "kLinks"}.get(self.length, f"R.{self.length}")
+        return {"integer": "static_cast<int>(r.integer())", "real": "r.number()", "word": "r.word()",
+                "reals": f"r.vector({size})", "residuals": "read_residuals(r)"}[self.kind]
+
+
+RESULT_MAGIC = "dyngen-extraction-result"
+
+RESULT = (
+    ResultField("restarts", "integer"),
+    ResultField("consistent", "integer"),  # restarts that end physically consistent
+    ResultField("restart_costs", "reals", "restarts"),
+    ResultField("restart_violations", "reals", "restarts"),
+    ResultField("status", "word"),  # ok | infeasible
+    ResultField("best_restart", "integer", ok_only=True),
+    ResultField("fit_cost", "real", ok_only=True),  # the best restart's cost
+    ResultField("cost", "real", ok_only=True),  # the chosen parameters' cost
+    ResultField("violation", "real", ok_only=True),
+    ResultField("parameters", "reals", "parameters"),  # infeasible: the least violating restart's
+    ResultField("residuals", "residuals", ok_only=True),  # per block: W pi(p) - v
+    ResultField("lambda_min", "reals", "links", ok_only=True),
+)
+
+
+def result_text(values: dict, links: int) -> str:
+    """A result file (as the driver writes it) from key -> value; residuals: kind -> vector."""
+    lines = [f"{RESULT_MAGIC} {VERSION}", f"links {links}"]
+    for field in RESULT:
+        if field.ok_only and values["status"] != "ok":
+            continue
+        value = values[field.key]
+        if field.kind == "residuals":
+            lines.append(f"{field.key} {len(value)}")
+            lines.extend(f"{kind} {len(r)} " + " ".join(_number(x) for x in r) for kind, r in value.items())
+        else:
+            lines += _format(Field(field.key, field.kind, None), value)
+    return "\n".join(lines + ["end"]) + "\n"
+
+
+def read_result_text(text: str) -> dict:
+    """The fields of a result file: key -> value (residuals: kind -> vector); the ok-only fields
+    are absent when the status is not "ok"."""
+    words = iter(text.split())
+
+    def expect(word):
+        got = next(words)
+        if got != word:
+            raise ValueError(f"result file: expected {word!r}, got {got!r}")
+
+    def reals(count):
+        return np.array([float(next(words)) for _ in range(count)])
+
+    expect(RESULT_MAGIC)
+    expect(str(VERSION))
+    expect("links")
+    links = int(next(words))
+    out = {}
+    for field in RESULT:
+        if field.ok_only and out["status"] != "ok":
+            continue
+        expect(field.key)
+        if field.kind == "integer":
+            out[field.key] = int(next(words))
+        elif field.kind == "real":
+            out[field.key] = float(next(words))
+        elif field.kind == "word":
+            out[field.key] = next(words)
+        elif field.kind == "reals":
+            sizes = {"parameters": 10 * links, "links": links}
+            out[field.key] = reals(sizes[field.length] if field.length in sizes else out[field.length])
+        elif field.kind == "residuals":
+            residuals = {}
+            for _ in range(int(next(words))):
+                kind = next(words)
+                residuals[kind] = reals(int(next(words)))
+            out[field.key] = residuals
+    expect("end")
+    return out
+
+
 def cpp_header() -> str:
     """protocol.hpp of the static driver (generator/dyngen/extractor/), rendered from SCHEMA."""
     from ..emission.render import environment
 
     return environment().get_template("protocol.hpp.j2").render(
         protocol=[{"key": f.key, "kind": f.kind, "cpp_type": f.cpp_type} for f in SCHEMA],
-        protocol_magic=MAGIC, protocol_version=VERSION)
+        result=[{"key": f.key, "cpp_type": f.cpp_type, "read": f.cpp_read, "ok_only": f.ok_only} for f in RESULT],
+        protocol_magic=MAGIC, result_magic=RESULT_MAGIC, protocol_version=VERSION)
 
 
 HEADER = Path(__file__).resolve().parents[1] / "extractor" / "protocol.hpp"

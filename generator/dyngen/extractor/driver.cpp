@@ -8,6 +8,7 @@
 //   c++ driver.o robot.o <robot>_parameters.o -lnlopt -lpthread -o <robot>_extract
 // Run:   <robot>_extract PROBLEM_FILE RESULT_FILE   (both written/read by `dyngen extract`)
 //        <robot>_extract --echo PROBLEM_FILE COPY  (writes the problem back as read)
+//        <robot>_extract --echo-result RESULT_FILE COPY  (writes the result back as read)
 //
 // Solves  min_p  sum_b || W_b pi_b(p) - v_b ||^2
 //         s.t.   LB <= p <= UB                     (free parameters; the others are fixed)
@@ -131,7 +132,8 @@ std::vector<std::vector<Term>> read_terms(Reader &r) {
     return polys;
 }
 
-// The Problem struct, its reader and its --echo writer, generated from extraction/protocol.py.
+// The Problem struct, its reader and its --echo writer, the Result struct, its writer and its
+// --echo-result reader, generated from extraction/protocol.py.
 #include "protocol.hpp"
 
 // ==== cost and constraints over the free parameters p (unit box), as NLopt sees them ==============
@@ -1042,19 +1044,22 @@ Outcome hand_off(const Problem &P, const StandardBarrier &fitted, const Outcome 
     return prefer_reference(P, fit);
 }
 
-// ==== result writing; closes the namespace; main() runs the restarts in threads ===================
-void write_vector(std::ostream &out, const char *key, const Eigen::VectorXd &x) {
-    out << key;
-    for (int k = 0; k < x.size(); ++k) out << ' ' << x[k];
-    out << '\n';
-}
-
+// ==== closes the namespace; main() runs the restarts in threads and writes the Result ============
 }  // namespace
 
 int main(int argc, char **argv) {
     const bool echo = argc == 4 && std::string(argv[1]) == "--echo";
+    if (argc == 4 && std::string(argv[1]) == "--echo-result") {  // the result's round-trip test
+        try {
+            write_result(argv[3], read_result(argv[2]));
+        } catch (const std::exception &e) {
+            std::cerr << argv[2] << ": " << e.what() << '\n';
+            return 2;
+        }
+        return 0;
+    }
     if (argc != 3 && !echo) {
-        std::cerr << "usage: " << argv[0] << " [--echo] PROBLEM_FILE RESULT_FILE\n";
+        std::cerr << "usage: " << argv[0] << " [--echo | --echo-result] PROBLEM_FILE RESULT_FILE\n";
         return 2;
     }
     Problem P;
@@ -1091,39 +1096,41 @@ int main(int argc, char **argv) {
         ++consistent;
         if (best < 0 || outcomes[k].cost < outcomes[best].cost) best = k;
     }
-    std::ofstream out(argv[2]);
-    out << std::setprecision(17);
-    out << "restarts " << P.restarts << " consistent " << consistent << '\n';
-    out << "restart_costs";
-    for (const Outcome &o : outcomes) out << ' ' << o.cost;
-    out << "\nrestart_violations";
-    for (const Outcome &o : outcomes) out << ' ' << o.violation;
-    out << '\n';
+    Result R;
+    R.restarts = P.restarts;
+    R.consistent = consistent;
+    R.restart_costs.resize(P.restarts);
+    R.restart_violations.resize(P.restarts);
+    for (int k = 0; k < P.restarts; ++k) {
+        R.restart_costs[k] = outcomes[k].cost;
+        R.restart_violations[k] = outcomes[k].violation;
+    }
     if (best < 0) {  // report the least violating point, so the caller can name what conflicts
         int closest = 0;
         for (int k = 1; k < P.restarts; ++k)
             if (outcomes[k].violation < outcomes[closest].violation) closest = k;
-        out << "status infeasible\n";
-        write_vector(out, "parameters", outcomes[closest].p);
-        out << "end\n";
+        R.status = "infeasible";
+        R.parameters = outcomes[closest].p;
+        write_result(argv[2], R);
         return 0;
     }
     const Outcome fit = outcomes[best];
     const Outcome chosen = P.next_blocks.empty() ? prefer_reference(P, fit) : hand_off(P, barrier, fit);
-    out << "status ok\nbest_restart " << best << "\nfit_cost " << fit.cost << "\ncost " << chosen.cost
-        << "\nviolation " << chosen.violation << '\n';
-    write_vector(out, "parameters", chosen.p);
+    R.status = "ok";
+    R.best_restart = best;
+    R.fit_cost = fit.cost;
+    R.cost = chosen.cost;
+    R.violation = chosen.violation;
+    R.parameters = chosen.p;
     for (const Block &b : P.blocks) {
         Eigen::VectorXd pi(b.kind->rank);
         b.kind->pi(chosen.p.data(), pi.data());
-        out << "residual " << b.kind->name;
-        write_vector(out, "", b.W * pi - b.v);
+        R.residuals.push_back({b.kind->name, b.W * pi - b.v});
     }
-    Eigen::VectorXd lambda(kLinks);
+    R.lambda_min.resize(kLinks);
     for (int link = 0; link < kLinks; ++link)
-        lambda[link] = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(density_matrix(chosen.p, link),
-                                                                        Eigen::EigenvaluesOnly).eigenvalues()[0];
-    write_vector(out, "lambda_min", lambda);
-    out << "end\n";
+        R.lambda_min[link] = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(density_matrix(chosen.p, link),
+                                                                            Eigen::EigenvaluesOnly).eigenvalues()[0];
+    write_result(argv[2], R);
     return 0;
 }

@@ -1,6 +1,6 @@
 """The catalogue of withheld-effect cases for the diagnosis benchmark, and the folder writer.
 
-Every case simulates the LWR (examples/lwr.yaml) in MuJoCo (oracles/mujoco_measurements.py)
+Every case simulates the LWR (examples/lwr.yaml) in MuJoCo (mujoco_measurements.py)
 with effects that the nominal model does not contain, on two trajectories:
 
   fit      a finite Fourier excitation (dyngen.validation.excitation) within the joint limits
@@ -50,6 +50,7 @@ PAYLOAD = np.array([_M, 0.03, -0.02, 0.13,
                     _M * (3 * _R**2 + _H**2) / 12, 0.0, 0.0, _M * (3 * _R**2 + _H**2) / 12, 0.0, _M * _R**2 / 2])
 TILT_AXIS = (np.cos(np.radians(30)), np.sin(np.radians(30)), 0.0)
 
+# The coulomb law names the module's former path, kept so that case folders stay byte-identical.
 LAWS = {
     "coulomb": "fc * sign(qd)  [Nm]  (MuJoCo frictionloss, sharp: see tests/oracles/mujoco_measurements.py)",
     "viscous": "fv * qd  [Nm s/rad]  (MuJoCo damping)",
@@ -97,7 +98,7 @@ CASES = [
 
 # Friction as real joints have it: the arm tracks its reference in a forward simulation, and
 # friction (MuJoCo's stiff friction loss, a Stribeck excess through qfrc_applied) sticks at
-# reversals and rests (tests/oracles/mujoco_tracking.py).
+# reversals and rests (bench/simulation/mujoco_tracking.py).
 TRACKED_CASES = [
     Case("sticky", Effects(coulomb={2: 0.9, 4: 0.5}, viscous={2: 0.4}), tracked=True),
     Case("stribeck_sticky", Effects(coulomb={4: 0.6}, stribeck={4: (0.6, 0.08)}), tracked=True),
@@ -265,6 +266,7 @@ def write_cases(folder, rate_hz: float = 1000.0, noise: float = NOISE, seed: int
     robot = load_robot(robot_path)
     p_model = nominal_model(robot)
     trajs = trajectories(robot, rate_hz, fit_seconds)
+    # The path in this comment is the module's former one, kept so that case folders stay byte-identical.
     files = {"params.yaml": "# The nominal model: examples/lwr.yaml's V-REP parameters, inertias of links 3 and 7 "
                             "made consistent (tests/oracles/withheld_cases.py consistent_nominal).\n"
                             f"robot: {robot.name}\nsolution:\n" + links_yaml(p_model)}
