@@ -14,8 +14,8 @@ import json
 import numpy as np
 import pytest
 from conftest import ROOT
-from oracles.mujoco_measurements import Encoder
-from oracles.withheld_cases import CASES, write_cases
+from simulation.mujoco_measurements import Encoder
+from simulation.withheld_cases import CASES, write_cases
 from oracles.withheld_run import run
 
 from dyngen.description import load_robot
