@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import real, whole
 from ..errors import InputError
 from ..progress import Progress
 
@@ -71,6 +72,9 @@ def figure(robot, design, t, q, qd, qdd, limits, path):
     plt.close(fig)
 
 
+MAX_SAMPLES = 1e7  # rows of the written CSV (about 3 hours at 1 kHz)
+
+
 def cmd_excite(argv, prog="dyngen excite") -> int:
     parser = argparse.ArgumentParser(prog=prog, description=(
         "Design a periodic excitation trajectory (finite Fourier series, at rest at its start and end) that "
@@ -80,19 +84,22 @@ def cmd_excite(argv, prog="dyngen excite") -> int:
         "summary with the condition number of a random trajectory with the same limits beside it."))
     parser.add_argument("robot", metavar="ROBOT.yaml")
     parser.add_argument("-o", "--output", metavar="CSV", help="default out/<robot>/excitation.csv")
-    parser.add_argument("--rate", type=float, default=1000.0, metavar="HZ", help="CSV sample rate (default 1000)")
-    parser.add_argument("--period", type=float, default=10.0, metavar="S", help="period [s] (default 10)")
-    parser.add_argument("--periods", type=int, default=1, metavar="K", help="periods written (default 1)")
-    parser.add_argument("--harmonics", type=int, default=5, metavar="L", help="harmonics per joint (default 5)")
-    parser.add_argument("--seed", type=int, default=1, help="seed of every random draw (default 1)")
-    parser.add_argument("--margin", type=float, default=0.95, help="fraction of each limit used (default 0.95)")
+    parser.add_argument("--rate", type=real(1, 100000), default=1000.0, metavar="HZ", help="CSV sample rate (default 1000)")
+    parser.add_argument("--period", type=real(0.1, 3600), default=10.0, metavar="S", help="period [s] (default 10)")
+    parser.add_argument("--periods", type=whole(1, 1000), default=1, metavar="K", help="periods written (default 1)")
+    parser.add_argument("--harmonics", type=whole(1, 50), default=5, metavar="L", help="harmonics per joint (default 5)")
+    parser.add_argument("--seed", type=whole(0, 2**31 - 1), default=1, help="seed of every random draw (default 1)")
+    parser.add_argument("--margin", type=real(0, 1, above=True), default=0.95, help="fraction of each limit used (default 0.95)")
     parser.add_argument("--criterion", choices=("cond", "logdet"), default="cond")
-    parser.add_argument("--iterations", type=int, default=60, help="optimiser iterations (default 60)")
+    parser.add_argument("--iterations", type=whole(1, 100000), default=60, help="optimiser iterations (default 60)")
     parser.add_argument("--workspace", metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX",
                         help="keep the flange (last DH frame's origin) inside this box [m]")
     parser.add_argument("--model", metavar="DIR", help="an already generated folder of this robot")
     parser.add_argument("-q", "--quiet", action="store_true")
     args = parser.parse_args(argv)
+    if args.rate * args.period * args.periods > MAX_SAMPLES:
+        parser.error(f"--rate x --period x --periods gives {args.rate * args.period * args.periods:.3g} samples; "
+                     f"at most {MAX_SAMPLES:g}")
     from ..description import load_robot
     from ..measured_cli import _model
     from .design import Settings, check_limits, limits_of, optimise

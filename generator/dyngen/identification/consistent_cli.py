@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import real
 from ..errors import InputError
 
 
@@ -20,7 +21,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--prior", metavar="P.yaml",
                        help="link parameters to regularise toward and to keep what the data do not see near "
                             "(default: the YAML's parameters.nominal)")
-    group.add_argument("--regularisation", type=float, metavar="L",
+    group.add_argument("--regularisation", type=real(0, 1e9), metavar="L",
                        help="weight of the prior (default: chosen by cross-validation over contiguous halves of "
                             "the fit data, or on --select data)")
     group.add_argument("--select", action="append", metavar="CSV",
@@ -30,7 +31,7 @@ def add_options(parser: argparse.ArgumentParser) -> None:
                             "(default coulomb,viscous,offset,armature)")
     group.add_argument("--tilt", action="store_true",
                        help="also fit a tilted base (a horizontal gravity component)")
-    group.add_argument("--smoothing", type=float, metavar="V",
+    group.add_argument("--smoothing", type=real(0, 100, above=True), metavar="V",
                        help="Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint (default: chosen "
                             "per joint on the fit data)")
 
