@@ -20,7 +20,6 @@ bench/results/withheld.md (--results).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 import time

@@ -51,7 +51,7 @@ YAML_CASES = {
     "import in an identity": (yaml_case("restarts: 2", f'restarts: 2\n  identities: ["I2xz = 0*{_escape("touch MARKER")}"]'),
                               [], "extraction.identities[0]"),
     "import in --identity": (TINY, ["--identity", f"I2xz = 0*{_escape('touch MARKER')}"], "identities"),
-    "python tag": (yaml_case("name: tiny", f'name: !!python/object/apply:os.system ["touch MARKER"]'), [],
+    "python tag": (yaml_case("name: tiny", 'name: !!python/object/apply:os.system ["touch MARKER"]'), [],
                    "line 2"),
     # expressions that would never finish, or overflow
     "tower of powers": (yaml_case('alpha: "pi/2"', 'alpha: "9**9**9"'), [], "joints[0].alpha"),

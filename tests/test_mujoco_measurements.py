@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 from oracles import pinocchio_arm
 from oracles.arm import Arm
-from simulation.mujoco_measurements import Effects, Trajectory, csv_text, measure, read_csv, simulator_xml, write_csv
+from simulation.mujoco_measurements import Effects, Trajectory, measure, read_csv, simulator_xml, write_csv
 from oracles.random_params import is_consistent, random_parameters
 from simulation.withheld_cases import (CASES, PAYLOAD, ROBOT, consistent_nominal, cubic_at, grid, nominal_model, perturbed,
                                     trajectories, write_cases)
