@@ -2,6 +2,14 @@
 before anything heavy, so that even an early Ctrl-C or failure is one line)."""
 
 
+def shorten(text: str, limit: int = 60) -> str:
+    """User input as quoted in an error: at most `limit` characters, control characters escaped
+    (the input may be anyone's, and an error is one line)."""
+    text = str(text)
+    text = text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+    return text.encode("unicode_escape").decode("ascii").replace('"', '\\"')
+
+
 class InputError(Exception):
     """Bad user input. str() is one line: `file: field: what is wrong`."""
 

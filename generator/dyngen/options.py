@@ -13,6 +13,7 @@ import math
 from dataclasses import MISSING, field, fields
 
 from .arguments import real, whole
+from .errors import shorten
 
 
 def option(default, help: str, *, flag: str = "", metavar: str = "", choices: tuple = (),
@@ -71,11 +72,6 @@ def _out_of_bounds(value, bounds) -> str:
     return ""
 
 
-def _short(value) -> str:
-    text = repr(value)  # the value comes from an untrusted file: never echo much of it
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
 def yaml_keys(cls) -> set:
     return {f.name for f in fields(cls)}
 
@@ -94,9 +90,9 @@ def check_yaml(cls, block: dict, fail, prefix: str) -> dict:
             continue
         if m["choices"]:
             if value not in m["choices"]:
-                fail(where, "expected " + " or ".join(f'"{c}"' for c in m["choices"]) + f", got {_short(value)}")
+                fail(where, "expected " + " or ".join(f'"{c}"' for c in m["choices"]) + f", got {shorten(repr(value), 40)}")
         elif isinstance(value, bool) or not isinstance(value, (int, float) if kind is float else kind):
-            fail(where, f"expected {_what(kind, m['bounds'])}, got {_short(value)}")
+            fail(where, f"expected {_what(kind, m['bounds'])}, got {shorten(repr(value), 40)}")
         else:
             problem = _out_of_bounds(value, m["bounds"])
             if problem:

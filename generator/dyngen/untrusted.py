@@ -17,7 +17,7 @@ from pathlib import Path
 
 import yaml
 
-from .errors import InputError
+from .errors import InputError, shorten
 
 MAX_YAML_BYTES = 4 << 20  # a 20-joint description with bounds is about 20 kB
 MAX_CSV_BYTES = 2 << 30  # an hour at 1 kHz for 12 joints is about 0.5 GB of text
@@ -75,7 +75,7 @@ class _Loader(yaml.SafeLoader):
             except TypeError:  # an unhashable key: the base class reports it
                 break
             if duplicate:
-                raise yaml.constructor.ConstructorError(None, None, f"duplicate key {_short(key)!s}",
+                raise yaml.constructor.ConstructorError(None, None, f"duplicate key {shorten(key)!s}",
                                                         key_node.start_mark)
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
@@ -93,11 +93,6 @@ def read_yaml(path):
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         if "could not determine a constructor" in problem:
             problem = "tags such as !!python/... are not allowed (plain data only)"
-        raise InputError(name, where, f"malformed YAML: {_short(problem)}") from None
+        raise InputError(name, where, f"malformed YAML: {shorten(problem)}") from None
     except RecursionError:
         raise InputError(name, "", "malformed YAML: nested too deeply") from None
-
-
-def _short(value, limit: int = 60) -> str:
-    text = str(value)
-    return text if len(text) <= limit else text[:limit] + "..."

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, shorten
 from ..untrusted import MAX_CSV_BYTES, read_text
 
 # No robot's time [s], position [rad, m], velocity, acceleration or torque [Nm] comes near this;
@@ -73,7 +73,7 @@ def _check_header(name, header, dof, require_torques, required) -> dict:
         if not h:
             raise InputError(name, where, f"column {k + 1} has no name")
         if h in columns:
-            raise InputError(name, where, f"column {_short(h)} appears twice")
+            raise InputError(name, where, f"column {shorten(h)} appears twice")
         columns[h] = k
     if "t" not in columns:
         raise InputError(name, where, "no time column t")
@@ -126,28 +126,24 @@ def _numbers(body: str, name, header) -> np.ndarray:
             try:
                 values.append(float(cell))
             except ValueError:
-                raise InputError(name, f"line {line}, column {_short(column)}",
-                                 f'not a number ("{_short(cell.strip())}")') from None
+                raise InputError(name, f"line {line}, column {shorten(column)}",
+                                 f'not a number ("{shorten(cell.strip())}")') from None
         rows.append(values)
     if not rows:
         raise InputError(name, "line 2", "no data rows after the header")
     return np.array(rows, dtype=float)
 
 
-def _short(text: str, limit: int = 40) -> str:
-    return text if len(text) <= limit else text[:limit] + "..."
-
-
 def _check_values(name, header, data) -> None:
     bad = np.argwhere(~np.isfinite(data))
     if bad.size:
         row, col = bad[0]
-        raise InputError(name, f"line {row + 2}, column {_short(header[col])}",
+        raise InputError(name, f"line {row + 2}, column {shorten(header[col])}",
                          f"{float(data[row, col])} (NaN or infinite value)")
     bad = np.argwhere(np.abs(data) > MAX_VALUE)
     if bad.size:
         row, col = bad[0]
-        raise InputError(name, f"line {row + 2}, column {_short(header[col])}",
+        raise InputError(name, f"line {row + 2}, column {shorten(header[col])}",
                          f"{float(data[row, col]):g}: value out of range (|x| at most {MAX_VALUE:g})")
 
 

@@ -18,6 +18,8 @@ from typing import Callable, Mapping
 
 import sympy as sp
 
+from ..errors import shorten
+
 MAX_CHARACTERS = 2000  # one expression (a 20-link coefficient needs a few hundred)
 MAX_NODES = 600
 MAX_DEPTH = 40
@@ -26,17 +28,10 @@ MAX_BITS = 256  # numerator and denominator of any exact number met on the way
 MAX_DEGREE = 6  # polynomial degree in the named symbols (identities need 3)
 
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
-_SHOWN = 60  # characters of a bad input echoed in an error
 
 
 class ExpressionError(ValueError):
     pass
-
-
-def shorten(text: str) -> str:
-    """The text as it is quoted in errors: at most _SHOWN characters, control characters escaped."""
-    text = text if len(text) <= _SHOWN else text[:_SHOWN] + f"... ({len(text)} characters)"
-    return text.encode("unicode_escape").decode("ascii").replace('"', '\\"')
 
 
 def exact_number(value, allow_symbols: bool = False, reserved: Callable[[str], bool] | None = None) -> sp.Expr:
