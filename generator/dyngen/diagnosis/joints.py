@@ -5,12 +5,10 @@ are fitted on the fit samples and compared on the selection samples:
 
   effects    the selected effects as fitted together (the diagnosis's findings);
   simple     b + Fc tanh(qd/0.02) + Fv qd alone;
-  completed  the effects acting on the joint plus those of the simple model's three columns that
-             none of them already is (Effect.covers), refitted on that joint (the arm-wide
-             effects' torque kept as it is): a joint whose effects were each chosen for a large
-             gain may still lack an offset or a plain friction term that none of them covers.
-             (Two viscous columns, one clipped to the fit velocities and one not, agree on the
-             fit data and disagree wildly beyond it: hence no column twice.)
+  completed  the effects acting on the joint plus the simple model's three columns, refitted on
+             that joint (the arm-wide effects' torque kept as it is): a joint whose effects
+             were each chosen for a large gain may still lack an offset or a plain friction
+             term that none of them covers.
 
   consistent the link parameters re-identified, physically consistent, with their own friction
              (reidentify.py), where they were computed: counted as its per-joint values plus one
@@ -42,12 +40,6 @@ def _split(chosen, x):
     return out
 
 
-def _missing(chosen, j) -> list[int]:
-    """The simple model's columns that no effect on joint j already is."""
-    covered = {c.effect.covers for c in chosen if c.joint == j}
-    return [k for k, name in enumerate(baseline.NAMES) if name not in covered]
-
-
 def _parts(context, chosen, x, seg, j):
     """(arm-wide effects' torque on joint j, columns of the per-joint effects on joint j)."""
     arm = np.zeros(seg.residual.shape[0])
@@ -62,54 +54,22 @@ def _parts(context, chosen, x, seg, j):
 
 
 def _completed_fit(context, chosen, x, segments, j):
-    """Least squares of [per-joint effects on j, the simple model's missing columns] to the
-    residual left by the arm-wide effects, on the fit samples. Friction must dissipate over the
-    velocities the fit data cover: a negative Coulomb level, or a negative viscous slope that
-    makes the joint's friction push at the fastest fit velocity, is dropped and the rest
-    refitted (such values are no joint's, and they extrapolate worst; a friction that falls
-    with speed but stays positive is a real joint's Stribeck curve). Returns (the simple
-    columns kept, the values)."""
-    extra = _missing(chosen, j)
-    fastest = max(abs(context.qd_range[0][j]), abs(context.qd_range[1][j])) if context.qd_range else 0.0
-    coulomb = [c for c in chosen if c.joint == j and c.effect.covers == "Fc"]
-    while True:
-        rows, targets = [], []
-        for seg in segments:
-            if not seg.fit.any():
-                continue
-            arm, columns = _parts(context, chosen, x, seg, j)
-            rows.append(np.column_stack(columns + [baseline.columns(seg.signals)[:, j, extra]])[seg.fit])
-            targets.append((seg.residual[:, j] - arm)[seg.fit])
-        values = np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]
-        own = values.size - len(extra)
-        named = {baseline.NAMES[k]: (k, v) for k, v in zip(extra, values[own:])}
-        level = named["Fc"][1] if "Fc" in named else 0.0
-        level += sum(v for c, v in zip(_joint_chosen(chosen, j), _own_values(chosen, j, values)) if c in coulomb)
-        if "Fc" in named and named["Fc"][1] < 0:
-            extra.remove(named["Fc"][0])
-        elif "Fv" in named and level + named["Fv"][1] * fastest < 0:
-            extra.remove(named["Fv"][0])
-        else:
-            return extra, values
+    """Least squares of [per-joint effects on j, simple columns] to the residual left by the
+    arm-wide effects, on the fit samples; returns the values."""
+    rows, targets = [], []
+    for seg in segments:
+        if not seg.fit.any():
+            continue
+        arm, columns = _parts(context, chosen, x, seg, j)
+        A = np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]])
+        rows.append(A[seg.fit])
+        targets.append((seg.residual[:, j] - arm)[seg.fit])
+    return np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]
 
 
-def _joint_chosen(chosen, j) -> list:
-    return [c for c in chosen if c.joint == j]
-
-
-def _own_values(chosen, j, values) -> list[float]:
-    """The first value of each per-joint effect on j, in the completed fit's values."""
-    out, offset = [], 0
-    for c in _joint_chosen(chosen, j):
-        out.append(float(values[offset]))
-        offset += c.size
-    return out
-
-
-def _completed_predict(context, chosen, x, completed, seg, j):
-    extra, values = completed
+def _completed_predict(context, chosen, x, values, seg, j):
     arm, columns = _parts(context, chosen, x, seg, j)
-    return arm + np.column_stack(columns + [baseline.columns(seg.signals)[:, j, extra]]) @ values
+    return arm + np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]]) @ values
 
 
 def decide(context, segments, chosen, x, simple, min_gain: float, consistent=None, consistent_values: int = 0) \
@@ -122,7 +82,6 @@ def decide(context, segments, chosen, x, simple, min_gain: float, consistent=Non
     for j in range(n):
         acting = any(c.joint is None or c.joint == j for c in chosen)
         values = _completed_fit(context, chosen, x, segments, j) if acting else None
-        acting = acting and bool(values[0])  # no simple column left to add: the same model as the effects
         sse = {EFFECTS: 0.0, SIMPLE: 0.0, COMPLETED: 0.0, CONSISTENT: 0.0}
         for i, seg in enumerate(segments):
             m = seg.select
@@ -136,7 +95,7 @@ def decide(context, segments, chosen, x, simple, min_gain: float, consistent=Non
             if consistent is not None:
                 sse[CONSISTENT] += float(np.sum((r - consistent[i][m, j]) ** 2))
         own = sum(c.size for c in chosen if c.joint == j)  # values of the effects on this joint
-        size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(values[0]) if acting else 0}
+        size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES)}
         best = EFFECTS
         for other in (SIMPLE, COMPLETED) if acting else (SIMPLE,):
             if _better(sse[other], size[other], sse[best], size[best], min_gain):
@@ -159,8 +118,8 @@ def _better(sse, size, best_sse, best_size, min_gain) -> bool:
 
 def apply(context, segments, chosen, x, simple, modes, consistent=None) -> dict:
     """Set seg.correction per joint by its mode (the effects' torques already there; consistent:
-    per segment the consistent model's corrections); returns {joint (1-based): {column: value}
-    of the completed model} for the report."""
+    per segment the consistent model's corrections); returns {joint (1-based): values of the
+    completed model} for the report."""
     completed = {}
     for j, mode in enumerate(modes):
         if mode == CONSISTENT:
@@ -170,9 +129,8 @@ def apply(context, segments, chosen, x, simple, modes, consistent=None) -> dict:
             for seg in segments:
                 seg.correction[:, j] = baseline.predict(simple, seg)[:, j]
         elif mode == COMPLETED:
-            fitted = _completed_fit(context, chosen, x, segments, j)
-            names = [f"{c.key}.{p}" for c in chosen if c.joint == j for p in c.effect.parameters]
-            completed[j + 1] = dict(zip(names + [baseline.NAMES[k] for k in fitted[0]], fitted[1].tolist()))
+            values = _completed_fit(context, chosen, x, segments, j)
+            completed[j + 1] = values.tolist()
             for seg in segments:
-                seg.correction[:, j] = _completed_predict(context, chosen, x, fitted, seg, j)
+                seg.correction[:, j] = _completed_predict(context, chosen, x, values, seg, j)
     return completed

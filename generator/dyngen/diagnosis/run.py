@@ -65,7 +65,7 @@ class Diagnosis:
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
     warnings: list = field(default_factory=list)
     joint_models: list = field(default_factory=list)
-    completed: dict = field(default_factory=dict)  # joint -> {column: value}: its effects' and the simple model's missing ones
+    completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
     conditioning: list = field(default_factory=list)  # per recording: what was done to it
     segments: list = field(default_factory=list)  # roles.Segment, for figures
     consistent: dict | None = None  # "link parameters off": reidentify.finding, where the consistent model won

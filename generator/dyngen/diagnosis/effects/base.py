@@ -44,7 +44,6 @@ class Effect:
     suspect = False  # a symptom rather than a cause: always reported with a warning
     secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
     switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
-    covers = ""  # the simple model's value (baseline.NAMES) this effect already is on its joint, if any
 
     def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the

@@ -34,7 +34,6 @@ class _Dissipative(Effect):
 class Coulomb(_Dissipative):
     name, parameters, units = "coulomb", ("Fc",), ("Nm",)
     refinable = switching = True
-    covers = "Fc"
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)
@@ -84,7 +83,6 @@ class Ripple(Effect):
 
 class Viscous(_Dissipative):
     name, parameters, units = "viscous", ("Fv",), ("Nm s/rad",)
-    covers = "Fv"
 
     def columns(self, context, signals, tau_model):
         return signals.qd[:, :, None]
