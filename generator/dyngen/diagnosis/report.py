@@ -22,6 +22,7 @@ def to_json(d, sources: dict) -> str:
         "selected": d.selected, "superseded": d.superseded, "refused": d.refused, "where": d.where,
         "candidates": d.candidates, "steps": d.steps, "dropped": d.dropped, "warnings": d.warnings,
         "recordings": d.conditioning, "joint_models": d.joint_models,
+        "completed": {str(j): values for j, values in d.completed.items()},
         "link_parameters_off": d.consistent,
     }
     return json.dumps(_plain(doc), indent=1) + "\n"

@@ -159,6 +159,9 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         design, chosen = refine(context, segments, design, chosen)
     chosen, final, refused = _plausible(design, chosen)
     design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
+    if chosen:
+        design = _reweighted(design, final)
+        final = solve(design, chosen)
     correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
     # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
     # compared on the selection samples (joints.py).
@@ -260,6 +263,16 @@ def _refit(robot, model, p, segments, reid, consistent):
     if np.all(refit.residual_rms <= reidentify.REFIT_WORSE * reid.residual_rms):
         return refit, reidentify.corrections(refit, model, segments)
     return reid, consistent
+
+
+def _reweighted(design, final) -> Design:
+    """The design with each joint weighted by 1 / the RMS its residual keeps after the chosen
+    effects (on the fit samples). The selection's weights come from the nominal residual, which
+    holds the very effects sought: a payload's 9 Nm on joint 2 would weigh joint 2 down as if
+    it were noise, and the arm-wide values would be set by the other joints alone."""
+    rms = np.sqrt(design.fit.mse(final.slots, final.x))
+    weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
+    return Design(design.candidates, design.fit, design.select, design.test, weights)
 
 
 def _plausible(design, chosen):
