@@ -9,6 +9,7 @@ model (offset + Coulomb + viscous per joint, fitted on the same fit data).
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -82,8 +83,34 @@ def main() -> int:
         print(f"{name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple {np.round(simple, 3)}; "
               f"worse on {worse}; --reidentify {np.round(r_after, 3)} mean {r_after.mean():.3f} worse on {r_worse}, "
               f"link parameters off {r.consistent['joints'] if r.consistent else None}", flush=True)
+    lines += positions_only(robot, model, p)
     write_file(ROOT / "bench" / "results" / "lwr_real.md", "\n".join(lines))
     return 0
+
+
+def positions_only(robot, model, p) -> list[str]:
+    """The same fits and tests with the recordings' qd and qdd columns dropped: the real
+    encoder positions alone, differentiated by dyngen's conditioning (cutoff chosen from the data)."""
+    def recording(k):
+        r = read_recording(HERE / f"measurement_{k}.csv", 7)
+        return condition(dataclasses.replace(r, qd=None, qdd=None))
+
+    lines = ["## Positions only (qd and qdd columns dropped)", "",
+             "The recordings' velocity and acceleration columns removed: dyngen differentiates the real encoder "
+             "positions through the low-pass it chooses from the data. Test RMS on m3 [Nm].", "",
+             "| fit -> test | | " + " | ".join(f"J{j}" for j in range(1, 8)) + " | mean |", "|---|---|" + "---:|" * 8]
+    for fit, test in RUNS[:3]:
+        d = diagnose(robot, model, p, [recording(k) for k in fit], None, test=[recording(k) for k in test])
+        after, simple = np.array(d.rms_after), np.array(d.rms_simple)
+        worse = [j + 1 for j in range(7) if after[j] > simple[j] + 1e-9]
+        name = f"m{'+m'.join(map(str, fit))} -> m{test[0]}"
+        cut = ", ".join(f"{c['note']}" for c in d.conditioning[:1])
+        lines += [f"| {name} | **final model** | " + " | ".join(f"{x:.3f}" for x in after) + f" | {after.mean():.3f} |",
+                  f"| | simple model | " + " | ".join(f"{x:.3f}" for x in simple) + f" | {simple.mean():.3f} |",
+                  f"| | worse than simple on | {worse or 'none'} | | | | | | | |"]
+        print(f"positions only, {name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple "
+              f"{np.round(simple, 3)}; worse on {worse}; {cut}", flush=True)
+    return lines + [""]
 
 
 if __name__ == "__main__":

@@ -126,3 +126,48 @@ def test_automatic_conditioning_of_encoder_positions(tmp_path, rate):
     raw = np.gradient(np.gradient(measured, t, axis=0), t, axis=0)
     assert np.sqrt(np.mean((raw - qdd) ** 2)) > 50 * error
     assert condition(read_recording(path, N), Conditioning(cutoff=3.0)).cutoff == 3.0  # the override
+
+
+def _stamped(tmp_path, stamps, clock, name):
+    """Positions of a smooth motion sampled on `clock`, written with the times `stamps`."""
+    w = 2 * np.pi * 0.4
+    q = np.column_stack([np.sin(w * clock), 0.5 * np.cos(1.3 * w * clock)])
+    rows = np.column_stack([stamps, q, q])
+    return write(tmp_path, HEADER, [[f"{v:.12g}" for v in row] for row in rows], name), w
+
+
+@pytest.mark.parametrize("dropped", [False, True])
+def test_jittering_stamps_give_way_to_the_clock(tmp_path, dropped):
+    """A logger that stamps samples late (pairs of +1.5 ms, as the real LWR4+ recordings):
+    the accelerations over the stamps carry spikes, over the recovered clock they match the
+    analytic ones; a dropped sample stays a gap of two periods."""
+    rate = 200.0
+    clock = np.arange(0, 12, 1 / rate)
+    if dropped:
+        clock = np.delete(clock, 1000)
+    stamps = clock.copy()
+    late = np.random.default_rng(1).choice(np.arange(10, clock.size - 10), 40, replace=False)
+    stamps[late] += 0.0015
+    path, w = _stamped(tmp_path, stamps, clock, "jitter.csv")
+    s = condition(read_recording(path, N), Conditioning(cutoff=None, differentiate=True))
+    assert np.max(np.abs(s.t - clock)) < 1e-9
+    assert any("jitter" in x for x in s.warnings) and "clock" in s.note
+    inner = slice(5, -5)
+    analytic = -w ** 2 * np.sin(w * clock)
+    assert np.max(np.abs(s.qdd[inner, 0] - analytic[inner])) < 0.01 * w ** 2
+    # what differentiating over the stamps would have given: the case is not trivial
+    over_stamps = np.gradient(np.gradient(np.sin(w * clock), stamps), stamps)
+    assert np.max(np.abs(over_stamps[inner] - analytic[inner])) > 10 * w ** 2
+
+
+def test_exact_or_truly_irregular_stamps_are_kept(tmp_path):
+    """Stamps that are the sampling times (regular, or irregular but where the positions were
+    really taken) are left alone: over them the motion is already smooth."""
+    rng = np.random.default_rng(2)
+    regular = np.arange(0, 10, 1 / 500.0)
+    irregular = np.cumsum(rng.uniform(0.0035, 0.0065, 2000))
+    for name, t in (("regular.csv", regular), ("irregular.csv", irregular)):
+        path, _ = _stamped(tmp_path, t, t, name)
+        s = condition(read_recording(path, N), Conditioning(cutoff=None, differentiate=True))
+        assert np.array_equal(s.t, read_recording(path, N).t), name
+        assert not any("jitter" in x for x in s.warnings), name

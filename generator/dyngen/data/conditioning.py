@@ -11,11 +11,13 @@ torques so that no signal is shifted or smoothed against another; it is kept on 
 (`lowpass`) so that whatever is compared with the filtered torque (a model torque, an effect's
 columns) can be passed through the very same filter. The filter's start-up at both ends is
 not data: `trim` samples at each end are to be left out of every fit and every figure.
-The sampling rate is the median rate (recordings with jitter are treated as uniformly sampled).
+Stamps that jitter around a regular clock are replaced by the clock (timeline.py); the sampling
+rate is the median rate.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -23,7 +25,7 @@ import numpy as np
 from scipy import signal
 
 from ..errors import InputError
-from . import automatic
+from . import automatic, timeline
 from .recording import Recording
 
 AUTO = "auto"
@@ -78,7 +80,8 @@ class Signals:
 
 
 def condition(recording: Recording, options: Conditioning = Conditioning()) -> Signals:
-    r = recording
+    t, timing = timeline.regular(recording.t, recording.q)
+    r = dataclasses.replace(recording, t=t)
     rate = 1.0 / float(np.median(np.diff(r.t)))
     differentiate = r.qd is None or options.differentiate
     decision = None
@@ -110,6 +113,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     trim = min(trim, max((r.t.size - 4) // 4, 0))
     out = Signals(r.name, r.t, q, qd, qdd, tau, extra, lowpass, trim, cutoff, _note(differentiate, cutoff, options,
                                                                                       decision, r.qdd is None))
+    if timing:
+        out.note = f"{timing}; {out.note}"
+        out.warnings.append(f"{r.name}: {timing}")
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
         if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
