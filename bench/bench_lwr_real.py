@@ -105,9 +105,10 @@ def positions_only(robot, model, p) -> list[str]:
         worse = [j + 1 for j in range(7) if after[j] > simple[j] + 1e-9]
         name = f"m{'+m'.join(map(str, fit))} -> m{test[0]}"
         cut = ", ".join(f"{c['note']}" for c in d.conditioning[:1])
-        lines += [f"| {name} | **final model** | " + " | ".join(f"{x:.3f}" for x in after) + f" | {after.mean():.3f} |",
-                  f"| | simple model | " + " | ".join(f"{x:.3f}" for x in simple) + f" | {simple.mean():.3f} |",
-                  f"| | worse than simple on | {worse or 'none'} | | | | | | | |"]
+        label = "worse than simple on " + (", ".join(f"J{j}" for j in worse) if worse else "none")
+        lines += [f"| {name} | **final model** ({label}) | " + " | ".join(f"{x:.3f}" for x in after)
+                  + f" | {after.mean():.3f} |",
+                  "| | simple model | " + " | ".join(f"{x:.3f}" for x in simple) + f" | {simple.mean():.3f} |"]
         print(f"positions only, {name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple "
               f"{np.round(simple, 3)}; worse on {worse}; {cut}", flush=True)
     return lines + [""]
