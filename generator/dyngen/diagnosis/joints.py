@@ -77,12 +77,22 @@ def decide(context, segments, chosen, x, simple, min_gain: float, consistent=Non
     """Per joint EFFECTS, SIMPLE, COMPLETED or (given consistent: per segment its corrections
     (T, N), with consistent_values values counted per joint) CONSISTENT; seg.correction holds
     the effects' torques."""
+    return choose(errors(context, segments, chosen, x, simple, consistent), chosen, min_gain, consistent_values)
+
+
+def errors(context, segments, chosen, x, simple, consistent=None) -> list[dict]:
+    """Per joint {model: sum of squared residuals on the selection samples}, every model
+    fitted on the fit samples (seg.correction holds the effects' torques at values x)."""
     n = segments[0].residual.shape[1]
-    modes = []
+    out = []
     for j in range(n):
         acting = any(c.joint is None or c.joint == j for c in chosen)
         values = _completed_fit(context, chosen, x, segments, j) if acting else None
-        sse = {EFFECTS: 0.0, SIMPLE: 0.0, COMPLETED: 0.0, CONSISTENT: 0.0}
+        sse = {EFFECTS: 0.0, SIMPLE: 0.0}
+        if acting:
+            sse[COMPLETED] = 0.0
+        if consistent is not None:
+            sse[CONSISTENT] = 0.0
         for i, seg in enumerate(segments):
             m = seg.select
             if not m.any():
@@ -94,13 +104,21 @@ def decide(context, segments, chosen, x, simple, min_gain: float, consistent=Non
                 sse[COMPLETED] += float(np.sum((r - _completed_predict(context, chosen, x, values, seg, j)[m]) ** 2))
             if consistent is not None:
                 sse[CONSISTENT] += float(np.sum((r - consistent[i][m, j]) ** 2))
+        out.append(sse)
+    return out
+
+
+def choose(sse_per_joint: list[dict], chosen, min_gain: float, consistent_values: int = 0) -> list[str]:
+    """The model per joint from its selection errors (errors(), or their sums over folds)."""
+    modes = []
+    for j, sse in enumerate(sse_per_joint):
         own = sum(c.size for c in chosen if c.joint == j)  # values of the effects on this joint
         size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES)}
         best = EFFECTS
-        for other in (SIMPLE, COMPLETED) if acting else (SIMPLE,):
+        for other in (SIMPLE, COMPLETED) if COMPLETED in sse else (SIMPLE,):
             if _better(sse[other], size[other], sse[best], size[best], min_gain):
                 best = other
-        if consistent is not None and _better(sse[CONSISTENT], consistent_values, sse[best], size[best], min_gain) \
+        if CONSISTENT in sse and _better(sse[CONSISTENT], consistent_values, sse[best], size[best], min_gain) \
                 and sse[CONSISTENT] < (1 - min_gain) * sse[best]:
             best = CONSISTENT
         modes.append(best)

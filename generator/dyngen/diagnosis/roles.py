@@ -57,7 +57,7 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
         split = "selection on separate recordings"
     else:
         for sig in fit_signals:
-            fit, select = _blocks(sig, block_seconds)
+            fit, select = blocks(sig, block_seconds)
             out.append(segment(sig, fit, select, none(sig)))
         split = f"selection on blocks of {block_seconds:g} s of the fit data (every third)"
     for sig in test_signals or []:
@@ -65,10 +65,15 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
     return out, split
 
 
-def _blocks(sig, block_seconds: float) -> tuple[np.ndarray, np.ndarray]:
+FOLDS = 3  # every third block selects; the per-joint models are compared over all three (run.py)
+
+
+def blocks(sig, block_seconds: float, phase: int = FOLDS - 1) -> tuple[np.ndarray, np.ndarray]:
+    """(fit, select) masks: blocks number phase, phase + FOLDS, ... select, the rest fit, and the
+    filter's reach around every cut belongs to neither."""
     inner = sig.inner()
     block = np.floor((sig.t - sig.t[0]) / block_seconds).astype(int)
-    select = block % 3 == 2
+    select = block % FOLDS == phase
     guard = max(sig.trim - 2, 0)  # the filter's reach in samples (conditioning.EDGE_PERIODS)
     if guard:
         edges = np.flatnonzero(np.diff(select.astype(int))) + 0.5

@@ -169,8 +169,12 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     sel_before = design.select.c / max(design.select.count, 1)
     sel_effects = design.select.mse(final.slots, final.x) if chosen else sel_before.copy()
     sel_simple = _simple_mse(segments, simple, "select", n)
-    modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain) if design.select.count \
-        else [joints.EFFECTS] * n
+    if not design.select.count:
+        modes = [joints.EFFECTS] * n
+    elif select_signals:
+        modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain)
+    else:
+        modes = _decide_on_folds(context, segments, design, chosen, final, options)
     reid, consistent = None, None
     if options.reidentify and design.select.count:
         reid, consistent, modes = _reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
@@ -235,6 +239,34 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
                                                ("test", test or [])) for sig in group]
     result.warnings = _warnings(result, model, s, fit_signals, select_signals or [], test or [], used)
     return result
+
+
+def _decide_on_folds(context, segments, design, chosen, final, options) -> list[str]:
+    """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS ways of
+    cutting the fit recordings into fit and selection blocks, each model refitted per fold. One
+    cut selects on one phase of the motion only (on a periodic trajectory, the same stretch
+    every period); every sample judges once this way. Leaves the segments' masks and
+    corrections as they were."""
+    saved = [(seg.fit, seg.select, seg.correction) for seg in segments]
+    own = [seg.fit.any() or seg.select.any() for seg in segments]
+    totals = None
+    try:
+        for phase in range(roles.FOLDS):
+            for seg, mine in zip(segments, own):
+                if mine:
+                    seg.fit, seg.select = roles.blocks(seg.signals, options.block_seconds, phase)
+            x = np.zeros(0)
+            if chosen:
+                fold_design, fold_chosen = restricted(context, segments, design, chosen)
+                x = solve(fold_design, fold_chosen, covariance=False).x
+            for seg in segments:
+                seg.correction = predict(context, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
+            sse = joints.errors(context, segments, chosen, x, simple_model.fit(segments))
+            totals = sse if totals is None else [{k: a[k] + b[k] for k in a} for a, b in zip(totals, sse)]
+    finally:
+        for seg, (fit, select, correction) in zip(segments, saved):
+            seg.fit, seg.select, seg.correction = fit, select, correction
+    return joints.choose(totals, chosen, options.min_gain)
 
 
 def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):
