@@ -19,22 +19,13 @@ from . import design as dz
 from . import joints, phases, reidentify, roles
 from .correlation import integrated_time
 from .effects import Context, library
+from .options import Options
 from .refine import refine, restricted
-from .selection import ALPHA, MIN_GAIN, forward, prune, selection_gain, solve
+from .selection import forward, prune, selection_gain, solve
 
 RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
-
-
-@dataclass(frozen=True)
-class Options:
-    effects: tuple | None = None  # effect names to try (default: all but the coefficient errors)
-    min_gain: float = MIN_GAIN
-    alpha: float = ALPHA
-    sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd) (Stribeck, direction)
-    block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
-    reidentify: bool = False  # consistent link parameters as a per-joint alternative (reidentify.py; opt-in)
 
 
 @dataclass
