@@ -37,16 +37,24 @@ def check_names(names) -> None:
         raise ValueError(f"unknown effect(s) {', '.join(unknown)}; known: {', '.join(sorted(NAMES))}")
 
 
-def library(names=None) -> list[Effect]:
-    """Every candidate effect tried by default (or those whose name is in `names`)."""
-    effects = [Offset(), *[Coulomb(v) for v in COULOMB_VELOCITIES], Viscous(),
-               *[Stribeck(v) for v in STRIBECK_VELOCITIES], Direction(), Ripple(), Armature(), Gain(),
-               Payload(), Tilt(), GravityScale(), *[TimeShift(dt) for dt in TIME_SHIFTS], Coefficients()]
+def effect_class(name: str) -> type:
+    """The class of the effect a report entry names (PointPayload reports as "payload")."""
+    return next(cls for cls in EFFECTS if cls.name == name)
+
+
+def library(context: Context, names=None) -> list[Effect]:
+    """Every candidate effect tried by default (or those whose name is in `names`), for the
+    diagnosis of one robot and its link parameters (context)."""
     names = DEFAULT_NAMES if names is None else names
     check_names(names)
+    effects = [Offset(), *[Coulomb(v) for v in COULOMB_VELOCITIES], Viscous(),
+               *[Stribeck(v) for v in STRIBECK_VELOCITIES], Direction(), Ripple(), Armature(), Gain(),
+               Payload.of(context), Tilt.of(context), GravityScale.of(context), *[TimeShift(dt) for dt in TIME_SHIFTS],
+               Coefficients.of(context)]
     return [e for e in effects if e.name in names]
 
 
 __all__ = ["Armature", "Coefficients", "Context", "Coulomb", "Direction", "Effect", "Gain", "GravityScale", "Offset",
-           "Payload", "Ripple", "Stribeck", "Tilt", "TimeShift", "Viscous", "gravity_matrix", "library",
-           "COULOMB_VELOCITIES", "STRIBECK_VELOCITIES", "TIME_SHIFTS"]
+           "Payload", "Ripple", "Stribeck", "Tilt", "TimeShift", "Viscous", "check_names", "effect_class",
+           "gravity_matrix", "library", "COULOMB_VELOCITIES", "DEFAULT_NAMES", "EFFECTS", "NAMES",
+           "STRIBECK_VELOCITIES", "TIME_SHIFTS"]
