@@ -10,7 +10,7 @@ between the diagnosis's variants), positions as a 20-bit encoder records them (1
 quantised), no qd or qdd columns, torque noise 0.05 Nm. Each case runs through
 `dyngen diagnose`'s function with default options, in both directions: fit on the Fourier
 excitation (selection on blocks of it) and test on Table V, and the reverse. The verdict
-(tests/oracles/withheld_verdict.py) asks for exactly the injected effects on their joints,
+(bench/simulation/withheld_verdict.py) asks for exactly the injected effects on their joints,
 every magnitude within 20 %, and a test RMS after within 1.5 x what the perfect model leaves
 on the same conditioned test data (bench/simulation/perfect.py). The noise-free variant (exact
 q, qd, qdd columns, 1 kHz) runs as well (--noise-free-rate). Tables to
@@ -26,7 +26,6 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))  # the verdict: tests/oracles/withheld_run.py
 sys.path.insert(0, str(ROOT / "generator"))
 
 from dyngen import blas  # noqa: E402
@@ -34,8 +33,8 @@ from dyngen import blas  # noqa: E402
 blas.use_one_thread()
 
 import numpy as np  # noqa: E402
-from oracles.withheld_run import DIRECTIONS, run  # noqa: E402
 from simulation.mujoco_measurements import Encoder  # noqa: E402
+from simulation.withheld_run import DIRECTIONS, run  # noqa: E402
 from simulation.withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, write_cases  # noqa: E402
 
 from dyngen.atomic import write_file  # noqa: E402

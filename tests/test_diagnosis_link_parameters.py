@@ -2,10 +2,10 @@
 predict another trajectory, and not where they are not (diagnosis/reidentify.py).
 
 With the opt-in Options(reidentify=True): the withheld "coefficients" case of
-tests/oracles/withheld_cases.py (the simulated LWR's link masses and inertias scaled by 10 %,
+bench/simulation/withheld_cases.py (the simulated LWR's link masses and inertias scaled by 10 %,
 signs per link) at 500 Hz with encoder positions, fit on one trajectory (selection on blocks of
 it), test on the other; `none`, `payload` and `coulomb` beside it, which must not claim it (the
-verdict, tests/oracles/withheld_verdict.py, refuses a false "link parameters off")."""
+verdict, bench/simulation/withheld_verdict.py, refuses a false "link parameters off")."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ import pytest
 from conftest import ROOT
 from simulation.mujoco_measurements import Encoder
 from simulation.withheld_cases import CASES, write_cases
-from oracles.withheld_run import run
+from simulation.withheld_run import run
 
 from dyngen.description import load_robot
 from dyngen.diagnosis import Options

@@ -1,6 +1,8 @@
 """Step options (dyngen.options): for the extraction step, the command line's defaults, the
 YAML block's defaults and the dataclass defaults are the same, every option can be set either
-way with the same result, and both refuse the same out-of-range values."""
+way with the same result, and both refuse the same out-of-range values. For identify, diagnose
+and excite (no YAML block), the real parser's defaults are the dataclasses' and every option
+is set by its flag."""
 
 from __future__ import annotations
 
@@ -14,10 +16,18 @@ import pytest
 import yaml
 from conftest import ROOT
 
+from dyngen.data import Conditioning
 from dyngen.description import load_robot
+from dyngen.diagnosis.options import Options as DiagnosisOptions
 from dyngen.errors import InputError
+from dyngen.excitation.command import Sampling
+from dyngen.excitation.command import parser as excite_parser
+from dyngen.excitation.design import Settings
 from dyngen.extraction.options import Options
-from dyngen.options import add_arguments, default_of, flag_of, resolve
+from dyngen.identification.consistent import ConsistentOptions
+from dyngen.identification.options import Options as IdentifyOptions
+from dyngen.measured_cli import diagnose_parser, identify_parser
+from dyngen.options import add_arguments, default_of, flag_of, options_of, resolve
 
 LWR = ROOT / "examples" / "lwr.yaml"
 CHANGED = {"procedure": "two-stage", "restarts": 5, "seed": 7, "threads": 2, "global_algorithm": "none",
@@ -88,3 +98,68 @@ def test_both_refuse_the_same_values(tmp_path, name, bad):
     flag = flag_of(next(f for f in fields(Options) if f.name == name))
     with pytest.raises(SystemExit):
         parser().parse_args([flag, str(bad)])
+
+# The other steps: identify, diagnose and excite read no YAML block; their flags come from
+# their dataclasses, through the commands' real parsers.
+
+REQUIRED = {"identify": ["lwr.yaml", "--data", "a.csv"], "diagnose": ["lwr.yaml", "--data", "a.csv", "--params", "p.yaml"],
+            "excite": ["lwr.yaml"]}
+STEPS = {"identify": (identify_parser, (IdentifyOptions, ConsistentOptions, Conditioning)),
+         "diagnose": (diagnose_parser, (DiagnosisOptions, Conditioning)),
+         "excite": (excite_parser, (Settings, Sampling))}
+# A value other than the default for every option of these steps, as typed on the command line.
+TYPED = {"kind": ("gravity", "gravity"), "ols": (None, True), "consistent": (None, True),
+         "friction": ("coulomb, ripple", ("coulomb", "ripple")), "smoothing": ("0.01", 0.01),
+         "regularisation": ("3", 3.0), "tilt": (None, True), "cutoff": ("none", None), "order": ("2", 2),
+         "differentiate": (None, True), "effects": ("offset,gain", ("offset", "gain")), "min_gain": ("0.1", 0.1),
+         "sign_velocity": ("0.01", 0.01), "reidentify": (None, True), "seed": ("7", 7), "period": ("5", 5.0),
+         "harmonics": ("3", 3), "margin": ("0.5", 0.5), "max_iterations": ("9", 9), "criterion": ("logdet", "logdet"),
+         "rate": ("200", 200.0), "periods": ("2", 2)}
+
+
+@pytest.mark.parametrize("step", sorted(STEPS))
+def test_command_line_defaults_equal_dataclass_defaults(step):
+    make, classes = STEPS[step]
+    args = make().parse_args(REQUIRED[step])
+    for cls in classes:
+        assert resolve(cls, args, {}) == cls(), cls.__name__
+
+
+@pytest.mark.parametrize("step", sorted(STEPS))
+def test_every_option_of_a_step_is_set_by_its_flag(step):
+    make, classes = STEPS[step]
+    argv = list(REQUIRED[step])
+    for cls in classes:
+        for f in options_of(cls):
+            typed = TYPED[f.name][0]
+            argv += [flag_of(f)] if typed is None else [flag_of(f), typed]
+    args = make().parse_args(argv)
+    for cls in classes:
+        expected = {f.name: TYPED[f.name][1] for f in options_of(cls)}
+        assert all(expected[f.name] != default_of(f) for f in options_of(cls))
+        assert resolve(cls, args, {}) == cls(**expected), cls.__name__
+
+
+@pytest.mark.parametrize("step", sorted(STEPS))
+def test_the_help_of_every_step_shows_the_dataclass_defaults(step):
+    text = subprocess.run([sys.executable, "-m", "dyngen.cli", step, "--help"], capture_output=True, text=True,
+                          check=True).stdout
+    text = re.sub(r"\s+", " ", text)
+    for cls in STEPS[step][1]:
+        for f in options_of(cls):
+            default = default_of(f)
+            assert flag_of(f) in text, f.name
+            if default is not None and not isinstance(default, bool):
+                shown = ", ".join(default) if isinstance(default, tuple) else str(default)
+                assert re.search(re.escape(flag_of(f)) + r" .*?\(default: " + re.escape(shown) + r"\)", text), f.name
+
+
+@pytest.mark.parametrize("step, option", [("identify", ["--order", "0"]), ("identify", ["--cutoff", "nan"]),
+                                          ("identify", ["--smoothing", "0"]), ("identify", ["--kind", "all"]),
+                                          ("diagnose", ["--min-gain", "2"]), ("diagnose", ["--sign-velocity", "0"]),
+                                          ("excite", ["--margin", "0"]), ("excite", ["--iterations", "0"]),
+                                          ("excite", ["--seed", "-1"])])
+def test_the_steps_refuse_out_of_range_values(step, option, capsys):
+    with pytest.raises(SystemExit):
+        STEPS[step][0]().parse_args(REQUIRED[step] + option)
+    assert f"argument {option[0]}" in capsys.readouterr().err.strip().splitlines()[-1]

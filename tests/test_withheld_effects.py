@@ -4,7 +4,7 @@ Cases of bench/simulation/withheld_cases.py (the LWR in MuJoCo with effects the 
 lacks; TRACKED_CASES: a forward simulation under a controller, so friction sticks at
 reversals) are written at 200 Hz with positions as a 20-bit encoder gives them (1e-5 rad
 noise, quantised) and no qd or qdd columns, and diagnosed with default options: fit on one
-trajectory (selection on blocks of it), test on the other (tests/oracles/withheld_run.py).
+trajectory (selection on blocks of it), test on the other (bench/simulation/withheld_run.py).
 The verdict must name exactly the injected effects on their joints, recover their magnitudes
 within 20 % and leave a test RMS within 1.5 x what the perfect model leaves on the same
 conditioned data (bench/simulation/perfect.py); with no effect it must claim nothing. The checker
@@ -24,8 +24,8 @@ import pytest
 from conftest import ROOT
 from simulation.mujoco_measurements import Encoder, tilted_gravity
 from simulation.withheld_cases import CASES, TRACKED_CASES, write_cases
-from oracles.withheld_run import run
-from oracles.withheld_verdict import problems
+from simulation.withheld_run import run
+from simulation.withheld_verdict import problems
 
 from dyngen.description import load_robot
 from dyngen.runtime import load

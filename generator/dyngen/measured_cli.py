@@ -4,38 +4,26 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
-from .arguments import real, whole
 from .errors import InputError
+from .options import add_arguments, resolve
 from .progress import Progress
 
 MIN_DIAGNOSIS_SAMPLES = 50
 
 
 def _data_options(parser: argparse.ArgumentParser) -> None:
+    from .data import Conditioning
+
     parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
     parser.add_argument("--data", action="append", required=True, metavar="CSV",
                         help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
-    group = parser.add_argument_group("signal conditioning")
-    group.add_argument("--cutoff", type=_cutoff, default="auto", metavar="HZ",
-                       help="override: zero-phase Butterworth low-pass on positions and torques alike, in Hz, or "
-                            "'none'. Default: recorded qd, qdd are used as they are; otherwise q is differentiated "
-                            "through a cutoff chosen from the recording (its position noise against the motion's "
-                            "acceleration), and the choice is reported")
-    group.add_argument("--order", type=whole(1, 12), default=4, metavar="N", help="Butterworth order (default 4)")
-    group.add_argument("--differentiate", action="store_true",
-                       help="compute qd, qdd from q even when the file has them")
+    add_arguments(parser.add_argument_group("signal conditioning"), Conditioning)
     parser.add_argument("--model", metavar="DIR",
                         help="an already generated folder of this robot (default: generate it first)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")
-
-
-def _cutoff(text: str):
-    """A cutoff in Hz, or "auto" (chosen from each recording) or "none" (no filter)."""
-    if text in ("auto", "none"):
-        return None if text == "none" else "auto"
-    return real(0, 1e6, above=True)(text)
 
 
 def _enough(name: str, t) -> None:
@@ -47,7 +35,7 @@ def _enough(name: str, t) -> None:
 def _conditioning(args):
     from .data import Conditioning
 
-    return Conditioning(cutoff=args.cutoff, order=args.order, differentiate=args.differentiate)
+    return resolve(Conditioning, args, {})
 
 
 def _conditioning_text(signals) -> str:
@@ -82,7 +70,10 @@ def _read(paths, robot, args, require_torques=True, required=()):
     return [condition(read_recording(p, robot.dof, require_torques, required), _conditioning(args)) for p in paths]
 
 
-def cmd_identify(argv, prog="dyngen identify") -> int:
+def identify_parser(prog="dyngen identify") -> argparse.ArgumentParser:
+    from .identification.consistent import ConsistentOptions
+    from .identification.options import Options
+
     parser = argparse.ArgumentParser(prog=prog, description=(
         "Identify from recordings. --kind full (default): physically consistent link parameters with "
         "per-joint friction, offset and rotor inertia (weighted least squares subject to consistency of every "
@@ -94,41 +85,53 @@ def cmd_identify(argv, prog="dyngen identify") -> int:
         "(eq. 10). Reports the regressor's condition number, every coefficient's standard deviation and "
         "the coefficients the data do not excite."))
     _data_options(parser)
-    parser.add_argument("--kind", choices=("full", "gravity", "inertia"), default="full",
-                        help="which coefficients (default full)")
+    add_arguments(parser.add_argument_group("identification"), Options)
     parser.add_argument("-o", "--output", metavar="FILE",
                         help="where to write the YAML (default out/<robot>/identified_<kind>.yaml)")
-    from .identification.consistent_cli import add_options, run_consistent
+    group = parser.add_argument_group("physically consistent identification (--kind full, the default)")
+    group.add_argument("--prior", metavar="P.yaml",
+                       help="link parameters to regularise toward and to keep what the data do not see near "
+                            "(default: the YAML's parameters.nominal)")
+    group.add_argument("--select", action="append", metavar="CSV",
+                       help="recording(s) to choose the regularisation on (never fitted)")
+    add_arguments(group, ConsistentOptions)
+    return parser
 
-    add_options(parser)
-    args = parser.parse_args(argv)
+
+def cmd_identify(argv, prog="dyngen identify") -> int:
+    args = identify_parser(prog).parse_args(argv)
+    from .identification.consistent_cli import run_consistent
+    from .identification.options import Options
+
+    options = resolve(Options, args, {})
     from .description import load_robot
     from .identification import identified_yaml, identify, summary_table
     from .identification.samples import stacked_inertia_columns
 
     robot = load_robot(args.robot)
     progress = Progress(quiet=args.quiet)
-    required = tuple(_inertia_names(robot)) if args.kind == "inertia" else ()
+    kind = options.kind
+    required = tuple(_inertia_names(robot)) if kind == "inertia" else ()
     # Bad input fails before anything is announced or written.
-    signals = _read(args.data, robot, args, require_torques=args.kind != "inertia", required=required)
-    progress.say(f"dyngen identify: {robot.name}, {args.kind} coefficients from {len(args.data)} recording(s)")
+    signals = _read(args.data, robot, args, require_torques=kind != "inertia", required=required)
+    progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = _model(args, robot, progress)
-    if args.kind == "full" and not args.ols:
+    if kind == "full" and not options.ols:
         return run_consistent(args, robot, model, signals, progress)
-    if args.kind == "inertia":
+    if kind == "inertia":
         assert stacked_inertia_columns(model.manifest) == list(required)
     with progress.step("least squares"):
-        estimate = identify(model, signals, args.kind)
-    out = Path(args.output) if args.output else Path("out") / robot.name / f"identified_{args.kind}.yaml"
+        estimate = identify(model, signals, kind)
+    out = Path(args.output) if args.output else Path("out") / robot.name / f"identified_{kind}.yaml"
     from .atomic import write_file
 
-    write_file(out, identified_yaml(robot.name, {args.kind: estimate}, [Path(p).name for p in args.data],
+    write_file(out, identified_yaml(robot.name, {kind: estimate}, [Path(p).name for p in args.data],
                                     _conditioning_text(signals)))
     if not args.quiet:
-        print(f"{robot.name}: {len(estimate.names)} {args.kind} coefficients from {estimate.rows} equations; "
+        print(f"{robot.name}: {len(estimate.names)} {kind} coefficients from {estimate.rows} equations; "
               f"condition number {estimate.condition:.3g} (columns scaled {estimate.scaled_condition:.3g}); "
               f"residual RMS {estimate.residual_rms:.4g}")
-        print("\n".join("  " + line for line in summary_table(args.kind, estimate).splitlines()))
+        print("\n".join("  " + line for line in summary_table(kind, estimate).splitlines()))
         for w in [*estimate.warnings(), *(w for s in signals for w in s.warnings)]:
             print(f"  warning: {w}")
         print(f"  written: {out}")
@@ -140,7 +143,9 @@ def _inertia_names(robot):
     return [f"M{j + 1}{k + 1}" for j in range(n) for k in range(j, n)]
 
 
-def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
+def diagnose_parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
+    from .diagnosis import Options
+
     parser = argparse.ArgumentParser(prog=prog, description=(
         "Diagnose the gap between measured torques and the Newton-Euler model with given link parameters: "
         "where the residual lies (per joint, per phase of the motion), which unmodelled effects explain it "
@@ -166,28 +171,28 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
                         help="cut every --data recording in time into fit, select and test pieces of these "
                              "fractions (e.g. 0.6,0.2,0.2), each conditioned on its own")
     parser.add_argument("--out", default=None, metavar="DIR", help="output folder (default out/<robot>/diagnosis)")
-    parser.add_argument("--effects", metavar="LIST",
-                        help="comma-separated effects to try (default: offset, coulomb, viscous, stribeck, direction, "
-                             "ripple, armature, gain, payload, tilt, gravity_scale, time_shift; also: coefficients)")
-    parser.add_argument("--min-gain", type=real(0, 1), default=None, metavar="G",
-                        help="least selection gain to select an effect (default 0.05: 5%% of a joint's mean square)")
-    parser.add_argument("--sign-velocity", type=real(0, 1e3, above=True), default=0.002, metavar="V",
-                        help="sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V) "
-                             "(default 0.002 rad/s; Coulomb's own scale is fitted)")
-    parser.add_argument("--reidentify", action="store_true",
-                        help="also re-identify physically consistent link parameters (with friction and a tilted "
-                             "base) from the fit data, and use them on the joints where they beat every effect and the "
-                             "simple model on selection data; says 'link parameters off' and writes them to "
-                             "consistent/ (experimental: see README)")
-    args = parser.parse_args(argv)
+    add_arguments(parser.add_argument_group("diagnosis"), Options)
+    return parser
+
+
+def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
+    args = diagnose_parser(prog).parse_args(argv)
     from .data import condition, read_recording
     from .data.split import parse_fractions, split_recording
     from .description import load_robot
     from .diagnosis import Options, diagnose
+    from .diagnosis.effects import check_names
     from .diagnosis.outputs import write_outputs
     from .diagnosis.report import summary_lines
     from .data.parameters_file import read_link_parameters
 
+    options = resolve(Options, args, {})
+    if options.effects == ():  # `--effects ""`: no list given, the default effects
+        options = replace(options, effects=None)
+    try:  # unknown names fail here, naming the option, before anything runs
+        check_names(options.effects or ())
+    except ValueError as err:
+        raise InputError("--effects", "", str(err)) from None
     robot = load_robot(args.robot)
     p = read_link_parameters(args.params, robot.dof)
     progress = Progress(quiet=args.quiet)
@@ -213,23 +218,13 @@ def cmd_diagnose(argv, prog="dyngen diagnose") -> int:
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = _model(args, robot, progress)
-    options = Options(effects=tuple(e.strip() for e in args.effects.split(",")) if args.effects else None,
-                      sign_velocity=args.sign_velocity, reidentify=args.reidentify,
-                      **({"min_gain": args.min_gain} if args.min_gain is not None else {}))
-    if options.effects is not None:
-        from .diagnosis.effects import library
-
-        try:  # unknown names fail here, naming the option, before anything runs
-            library(options.effects)
-        except ValueError as err:
-            raise InputError("--effects", "", str(err)) from None
     with progress.step("residual, effects, selection, test"):
         result = diagnose(robot, model, p, fit, select or None, options, test=test)
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
     sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": _conditioning_text(fit + select + test)}
     with progress.step("report, JSON, figures, updated model"):
-        paths = write_outputs(result, robot, p, out, sources, args.sign_velocity)
+        paths = write_outputs(result, robot, p, out, sources, options.sign_velocity)
     if not args.quiet:
         print(f"{robot.name}: diagnosis in {time.perf_counter() - start:.1f} s ({result.split})")
         print("\n".join(summary_lines(result)))

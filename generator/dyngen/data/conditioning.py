@@ -24,7 +24,9 @@ from typing import Callable
 import numpy as np
 from scipy import signal
 
+from ..arguments import real
 from ..errors import InputError
+from ..options import option
 from . import automatic, timeline
 from .recording import Recording
 
@@ -33,11 +35,24 @@ EDGE_PERIODS = 1.0  # trimmed at each end: this many periods of the cutoff (the 
 PAD_PERIODS = 2.0  # the recording is continued this many periods of the cutoff before filtering
 
 
+def cutoff_of(text: str):
+    """A cutoff in Hz, or AUTO (chosen from each recording) or None ("none": no filter)."""
+    if text in (AUTO, "none"):
+        return None if text == "none" else AUTO
+    return real(0, 1e6, above=True)(text)
+
+
 @dataclass(frozen=True)
 class Conditioning:
-    cutoff: float | str | None = AUTO  # low-pass cutoff [Hz]; "auto": from the data; None: no filter
-    order: int = 4  # Butterworth order
-    differentiate: bool = False  # recompute qd, qdd from q even when the file has them
+    """The signal conditioning options of the commands that read recordings (dyngen.options)."""
+
+    cutoff: float | str | None = option(
+        AUTO, "override: zero-phase Butterworth low-pass on positions and torques alike, in Hz, or 'none'. "
+        "auto: recorded qd, qdd are used as they are; otherwise q is differentiated through a cutoff chosen from "
+        "the recording (its position noise against the motion's acceleration), and the choice is reported",
+        metavar="HZ", parse=cutoff_of)
+    order: int = option(4, "Butterworth order", metavar="N", bounds=(1, 12))
+    differentiate: bool = option(False, "compute qd, qdd from q even when the file has them")
 
 
 @dataclass

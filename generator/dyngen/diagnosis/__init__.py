@@ -6,7 +6,7 @@ unmodelled effect explains it (chosen on held-out data), and how far it shrinks.
 
 Modules: effects/ (the library of candidate effects), design (moments of every candidate),
 selection (forward selection on held-out data), phases (where), run (the whole diagnosis),
-values (derived quantities), report (markdown, JSON), figures (PNG), model (the updated model).
+report (markdown, JSON), figures (PNG), model (the updated model).
 """
 
 from .run import Diagnosis, Options, diagnose

@@ -14,50 +14,43 @@ from __future__ import annotations
 import numpy as np
 
 from ..parameters import PER_LINK, dynamic_from_standard, standard_from_dynamic
+from .effects import effect_class
 
 FRICTION_FIELDS = ("Fc", "Fv", "Fs", "vs", "eps")  # templates/friction.c.j2
 
 
 def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
-    """f (5N) for <robot>_friction: Fc, Fv, Fs, vs, eps per joint."""
+    """f (5N) for <robot>_friction: Fc, Fv, Fs, vs, eps per joint (each effect's friction_terms)."""
     f = np.zeros((diagnosis.joints, len(FRICTION_FIELDS)))
     f[:, 4] = sign_velocity
     for e in diagnosis.selected:
-        if e["effect"] not in ("coulomb", "viscous", "stribeck"):
-            continue
-        j = e["joints"][0] - 1
-        if e["effect"] == "coulomb":
-            f[j, 0] = e["values"]["Fc"]
-            f[j, 4] = e["variant"]["vc"]  # the fitted velocity scale (the Stribeck term shares it)
-        elif e["effect"] == "viscous":
-            f[j, 1] = e["values"]["Fv"]
-        else:
-            f[j, 2], f[j, 3] = e["values"]["Fs"], e["variant"]["vs"]
+        for name, value in effect_class(e["effect"]).friction_terms(e["values"], e["variant"]).items():
+            f[e["joints"][0] - 1, FRICTION_FIELDS.index(name)] = value
     return f.ravel()
 
 
 def joint_dynamics(diagnosis) -> list[dict]:
-    """Per joint {"damping", "friction", "armature"} for the URDF and MJCF exports."""
+    """Per joint {"damping", "friction", "armature"} for the URDF and MJCF exports (each
+    effect's simulator attribute)."""
     out = [{} for _ in range(diagnosis.joints)]
-    names = {"coulomb": ("friction", "Fc"), "viscous": ("damping", "Fv"), "armature": ("armature", "Ia")}
     for e in diagnosis.selected:
-        if e["effect"] in names:
-            key, value = names[e["effect"]]
+        simulator = effect_class(e["effect"]).simulator
+        if simulator:
+            key, value = simulator
             out[e["joints"][0] - 1][key] = float(e["values"][value])
     return out
 
 
 def with_payload(diagnosis, p: np.ndarray) -> np.ndarray:
-    """Link parameters with a selected payload added to the last link (if its values are all
-    determined); otherwise p unchanged."""
-    payload = next((e for e in diagnosis.selected if e["effect"] == "payload"), None)
-    if payload is None or None in payload["values"].values():
-        return np.asarray(p, dtype=float)
-    from .effects.body import standard_of_payload
-
-    s = standard_from_dynamic(p)
-    s[-PER_LINK:] += standard_of_payload(payload["values"])
-    return dynamic_from_standard(s)
+    """Link parameters with what selected effects add to the last link (a payload whose values
+    are all determined); otherwise p unchanged."""
+    s = None
+    for e in diagnosis.selected:
+        added = effect_class(e["effect"]).last_link(e["values"])
+        if added is not None:
+            s = standard_from_dynamic(p) if s is None else s
+            s[-PER_LINK:] += added
+    return np.asarray(p, dtype=float) if s is None else dynamic_from_standard(s)
 
 
 def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:

@@ -10,6 +10,7 @@ effects, test_signals are used for nothing but the reported held-out residual (r
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -18,23 +19,13 @@ from . import baseline as simple_model
 from . import design as dz
 from . import joints, phases, reidentify, roles
 from .correlation import integrated_time
-from .effects import Context, library
+from .effects import Context, effect_class, library
+from .options import Options
 from .refine import refine, restricted
-from .selection import ALPHA, MIN_GAIN, forward, prune, selection_gain, solve
+from .selection import forward, prune, selection_gain, solve
 
-RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
-
-
-@dataclass(frozen=True)
-class Options:
-    effects: tuple | None = None  # effect names to try (default: all but the coefficient errors)
-    min_gain: float = MIN_GAIN
-    alpha: float = ALPHA
-    sign_velocity: float = 0.002  # rad/s: tanh smoothing of sign(qd) (Stribeck, direction)
-    block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
-    reidentify: bool = False  # consistent link parameters as a per-joint alternative (reidentify.py; opt-in)
 
 
 @dataclass
@@ -139,7 +130,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     fit_qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
     context = Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)),
                       (fit_qd.min(axis=0), fit_qd.max(axis=0)))
-    effects = library(options.effects)
+    effects = library(context, options.effects)
     design = _design(context, effects, segments, n)
 
     def correlation(chosen, fit):
@@ -328,32 +319,28 @@ def _plausible(design, chosen):
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):
-    """A payload whose fitted inertia is no body's (a negative principal moment about its centre
-    of mass) is replaced by a point mass at its fitted centre, and everything refitted: the data
-    determine m and m c, not that inertia, and an impossible inertia mispredicts other motions."""
-    from .effects.body import PointPayload, consistent_inertia
-
+    """An effect whose fitted values are possible only in part (Effect.simplified: a payload
+    whose inertia is no body's) is replaced by its simpler form, and everything refitted."""
     offset = 0
     for i, c in enumerate(chosen):
         values = final.x[offset: offset + c.size]
         offset += c.size
-        if c.effect.name != "payload" or c.size != 10 or consistent_inertia(values):
+        simpler = c.effect.simplified(values)
+        if simpler is None:
             continue
-        refused.append({"candidate": "the payload's inertia about its centre of mass (a negative principal moment; "
-                                     "the payload is kept as a point mass at its fitted centre)",
-                        "values": values[4:].tolist()})
-        replaced = chosen[:i] + [dz.Candidate(PointPayload(values[1:4] / values[0]), None, 0, 4)] + chosen[i + 1:]
+        effect, refusal = simpler
+        refused.append(refusal)
+        replaced = chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:]
         design, chosen = restricted(context, segments, design, replaced)
         return design, chosen, solve(design, chosen)
     return design, chosen, final
 
 
 def _narrow_stribeck(chosen) -> list:
-    """Stribeck terms whose velocity is less than twice the Coulomb velocity scale on their
-    joint: there the two laws trade shape with each other, and no static friction is shown."""
-    scale = {c.joint: c.effect.velocity for c in chosen if c.effect.name == "coulomb"}
-    return [c for c in chosen if c.effect.name == "stribeck" and c.joint in scale
-            and c.effect.velocity < 2 * scale[c.joint]]
+    """Per-joint effects that only reshape another on their joint (Effect.reshapes: a Stribeck
+    term no wider than the Coulomb transition)."""
+    return [c for c in chosen if c.joint is not None
+            and any(o.joint == c.joint and c.effect.reshapes(o.effect) for o in chosen)]
 
 
 def _simple_mse(segments, simple, role, n) -> np.ndarray:
@@ -400,10 +387,7 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
                        f"{', '.join(f'{predicted[j]:.3g}' for j in bad)} Nm of {', '.join(f'{d.rms_after[j]:.3g}' for j in bad)}"
                        " Nm): recorded velocities, or a lower --cutoff, would lower it")
     for e in d.selected:
-        if e["effect"] == "ripple" and not e["derived"].get("separable", True):
-            out.append(f"ripple on joint {e['joints'][0]}: its harmonics are not separable over the positions the fit "
-                       f"data cover (amplitudes {', '.join(f'{a:.3g}' for a in e['derived']['amplitude_Nm'])} Nm for "
-                       f"a torque of {e['derived']['torque_rms_Nm']:.3g} Nm RMS): only their sum is a finding")
+        out += effect_class(e["effect"]).warnings(e)
         if e.get("suspect"):
             out.append(f"{e['effect']} is a symptom, not a cause: {e['suspect']}")
     for r in d.refused:
@@ -431,15 +415,9 @@ def _correlation(segments, weights) -> float:
     return float(np.median(times))
 
 
-SUSPECT = {"gravity_scale": "no tilt changes gravity's size; every link's gravity torque scaled alike points at "
-                            "masses and centres of mass wrong by one factor, or at a torque-sensor gain"}
-
-
 def _values(described, design, chosen, final, tau_corr, robot) -> None:
     """The final values of every chosen effect, with deviations scaled for the residual's
-    correlation in time, and what follows from them (values.derived)."""
-    from .values import derived
-
+    correlation in time, and what follows from them (Effect.derived)."""
     offset = 0
     for cand, e in zip(chosen, described):
         k = slice(offset, offset + cand.size)
@@ -450,15 +428,13 @@ def _values(described, design, chosen, final, tau_corr, robot) -> None:
         e["values"] = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], identifiable)}
         e["std"] = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
         e["variant"] = cand.effect.fixed()
-        e["derived"] = derived(robot, cand.effect.name, e["values"], e["std"])
-        if cand.effect.name == "ripple" and "amplitude_Nm" in e["derived"]:
-            # Low harmonics over a short range of positions are nearly collinear: large values
-            # of opposite sign whose sum is small. Then only the sum is a finding.
-            j, x = cand.joint, final.x[k]
-            G = design.fit.G[j][np.ix_(cand.slots, cand.slots)]
-            rms = float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
-            e["derived"]["torque_rms_Nm"] = rms
-            e["derived"]["separable"] = bool(sum(e["derived"]["amplitude_Nm"]) <= RIPPLE_SEPARABLE * np.sqrt(2) * rms)
+        e["derived"] = cand.effect.derived(robot, e["values"], e["std"], partial(_torque_rms, design, cand, final.x[k]))
+
+
+def _torque_rms(design, cand, x) -> float:
+    """RMS torque of a per-joint candidate's values x on its joint over the fit samples."""
+    G = design.fit.G[cand.joint][np.ix_(cand.slots, cand.slots)]
+    return float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
 
 
 def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
@@ -480,7 +456,7 @@ def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
         "rms_before": np.sqrt(mse_without).tolist(), "rms_after": np.sqrt(mse_with).tolist(),
     }
     if cand.effect.suspect:
-        out["suspect"] = SUSPECT.get(cand.effect.name, "reported as a symptom")
+        out["suspect"] = cand.effect.suspect
     return out
 
 

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..arguments import real, whole
 from ..errors import InputError
+from ..options import add_arguments, option, resolve
 from ..progress import Progress
 
 
@@ -75,34 +76,46 @@ def figure(robot, design, t, q, qd, qdd, limits, path):
 MAX_SAMPLES = 1e7  # rows of the written CSV (about 3 hours at 1 kHz)
 
 
-def cmd_excite(argv, prog="dyngen excite") -> int:
-    parser = argparse.ArgumentParser(prog=prog, description=(
+@dataclass(frozen=True)
+class Sampling:
+    """How the designed trajectory is written (its design: design.Settings)."""
+
+    rate: float = option(1000.0, "CSV sample rate", metavar="HZ", bounds=(1, 100_000))
+    periods: int = option(1, "periods written", metavar="K", bounds=(1, 1000))
+
+
+def parser(prog="dyngen excite") -> argparse.ArgumentParser:
+    from .design import Settings
+
+    result = argparse.ArgumentParser(prog=prog, description=(
         "Design a periodic excitation trajectory (finite Fourier series, at rest at its start and end) that "
         "minimises the condition number of the identification matrix (base regressor with per-joint Coulomb, "
         "viscous, offset and rotor-inertia columns) within the YAML's joint position, velocity and acceleration "
         "limits, optionally keeping the flange inside a box. Writes a CSV (t, q, qd, qdd), a plot and a "
         "summary with the condition number of a random trajectory with the same limits beside it."))
-    parser.add_argument("robot", metavar="ROBOT.yaml")
-    parser.add_argument("-o", "--output", metavar="CSV", help="default out/<robot>/excitation.csv")
-    parser.add_argument("--rate", type=real(1, 100000), default=1000.0, metavar="HZ", help="CSV sample rate (default 1000)")
-    parser.add_argument("--period", type=real(0.1, 3600), default=10.0, metavar="S", help="period [s] (default 10)")
-    parser.add_argument("--periods", type=whole(1, 1000), default=1, metavar="K", help="periods written (default 1)")
-    parser.add_argument("--harmonics", type=whole(1, 50), default=5, metavar="L", help="harmonics per joint (default 5)")
-    parser.add_argument("--seed", type=whole(0, 2**31 - 1), default=1, help="seed of every random draw (default 1)")
-    parser.add_argument("--margin", type=real(0, 1, above=True), default=0.95, help="fraction of each limit used (default 0.95)")
-    parser.add_argument("--criterion", choices=("cond", "logdet"), default="cond")
-    parser.add_argument("--iterations", type=whole(1, 100000), default=60, help="optimiser iterations (default 60)")
-    parser.add_argument("--workspace", metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX",
+    result.add_argument("robot", metavar="ROBOT.yaml")
+    result.add_argument("-o", "--output", metavar="CSV", help="default out/<robot>/excitation.csv")
+    add_arguments(result, Sampling)
+    add_arguments(result, Settings)
+    result.add_argument("--workspace", metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX",
                         help="keep the flange (last DH frame's origin) inside this box [m]")
-    parser.add_argument("--model", metavar="DIR", help="an already generated folder of this robot")
-    parser.add_argument("-q", "--quiet", action="store_true")
-    args = parser.parse_args(argv)
-    if args.rate * args.period * args.periods > MAX_SAMPLES:
-        parser.error(f"--rate x --period x --periods gives {args.rate * args.period * args.periods:.3g} samples; "
-                     f"at most {MAX_SAMPLES:g}")
+    result.add_argument("--model", metavar="DIR", help="an already generated folder of this robot")
+    result.add_argument("-q", "--quiet", action="store_true")
+    return result
+
+
+def cmd_excite(argv, prog="dyngen excite") -> int:
+    from .design import Settings
+
+    command_line = parser(prog)
+    args = command_line.parse_args(argv)
+    sampling, settings = resolve(Sampling, args, {}), resolve(Settings, args, {})
+    samples = sampling.rate * settings.period * sampling.periods
+    if samples > MAX_SAMPLES:
+        command_line.error(f"--rate x --period x --periods gives {samples:.3g} samples; at most {MAX_SAMPLES:g}")
     from ..description import load_robot
     from ..measured_cli import _model
-    from .design import Settings, check_limits, limits_of, optimise
+    from .design import check_limits, limits_of, optimise
 
     robot = load_robot(args.robot)
     limits = limits_of(robot)  # missing limits fail before anything runs
@@ -114,19 +127,14 @@ def cmd_excite(argv, prog="dyngen excite") -> int:
             workspace = ()
         if len(workspace) != 6 or any(workspace[2 * k] >= workspace[2 * k + 1] for k in range(3)):
             raise InputError("--workspace", "", f'expected XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX with min < max, got "{args.workspace}"')
-    for name, value, ok in (("--rate", args.rate, args.rate > 0), ("--period", args.period, args.period > 0),
-                            ("--periods", args.periods, args.periods >= 1),
-                            ("--margin", args.margin, 0 < args.margin <= 1)):
-        if not ok:
-            raise InputError(name, "", f"{value} is out of range")
+        settings = replace(settings, workspace=workspace)
     progress = Progress(quiet=args.quiet)
-    progress.say(f"dyngen excite: {robot.name}, {args.harmonics} harmonics, period {args.period:g} s, seed {args.seed}")
+    progress.say(f"dyngen excite: {robot.name}, {settings.harmonics} harmonics, period {settings.period:g} s, "
+                 f"seed {settings.seed}")
     model = _model(args, robot, progress)
-    settings = Settings(seed=args.seed, period=args.period, harmonics=args.harmonics, margin=args.margin,
-                        max_iterations=args.iterations, workspace=workspace, criterion=args.criterion)
     with progress.step("optimise the Fourier coefficients"):
         design = optimise(robot, model, settings, forward_flange(robot) if workspace else None)
-    t = np.arange(int(round(args.period * args.periods * args.rate)) + 1) / args.rate
+    t = np.arange(int(round(settings.period * sampling.periods * sampling.rate)) + 1) / sampling.rate
     q, qd, qdd = design.trajectory(t)
     problems = check_limits(robot, t, q, qd, qdd)
     if workspace:
@@ -152,5 +160,5 @@ def cmd_excite(argv, prog="dyngen excite") -> int:
         print(f"  share of the limit used per joint: velocity {use(qd, limits.velocity)}; "
               f"acceleration {use(qdd, limits.acceleration)}")
         print(f"  starts and ends at rest at q = {', '.join(f'{x:.3f}' for x in q[0])}")
-        print(f"  written: {out} ({t.size} samples at {args.rate:g} Hz), {plot}")
+        print(f"  written: {out} ({t.size} samples at {sampling.rate:g} Hz), {plot}")
     return 0

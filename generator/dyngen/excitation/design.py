@@ -29,6 +29,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from ..errors import InputError
+from ..options import option
 from ..validation.excitation import FourierTrajectory
 
 GRID_PER_HARMONIC = 200  # samples per period of the highest harmonic for the peaks
@@ -36,16 +37,20 @@ GRID_PER_HARMONIC = 200  # samples per period of the highest harmonic for the pe
 
 @dataclass
 class Settings:
-    seed: int = 1
-    period: float = 10.0  # s (base frequency 1 / period)
-    harmonics: int = 5
-    margin: float = 0.95  # fraction of each limit the motion may use
+    """The excitation step's options: those declared with option(...) are `dyngen excite` flags
+    (dyngen.options), the rest the method's own settings."""
+
+    seed: int = option(1, "seed of every random draw", bounds=(0, 2**31 - 1))
+    period: float = option(10.0, "period [s] (base frequency 1 / period)", metavar="S", bounds=(0.1, 3600))
+    harmonics: int = option(5, "harmonics per joint", metavar="L", bounds=(1, 50))
+    margin: float = option(0.95, "fraction of each limit the motion may use", bounds=(0.0, 1.0), above=True)
     points: int = 200  # samples of one period in the criterion
     candidates: int = 16  # random starts; the best is refined
-    max_iterations: int = 60  # L-BFGS-B iterations
+    max_iterations: int = option(60, "optimiser (L-BFGS-B) iterations", flag="--iterations", metavar="N", bounds=(1, 100_000))
     coulomb_velocity: float = 0.01  # rad/s, tanh smoothing of the Coulomb column
     workspace: tuple | None = None  # (xmin, xmax, ymin, ymax, zmin, zmax) of the flange [m]
-    criterion: str = "cond"  # "cond" or "logdet" (maximise log det A^T A, columns unit norm)
+    criterion: str = option("cond", "cond: minimise the condition number; logdet: maximise log det A^T A "
+                            "(columns unit norm)", choices=("cond", "logdet"))
 
 
 @dataclass

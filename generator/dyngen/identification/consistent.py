@@ -42,17 +42,20 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..arguments import real
 from ..errors import InputError
 from ..extraction import driver
 from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import Stage, build_problem, consistency_margin
 from ..extraction.targets import Target
+from ..options import option
 from ..parameters import PER_LINK, dynamic_name
 from .least_squares import WEAK, Estimate
 from .tilt import tilt_columns
 
 FRICTION_KINDS = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
 DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
+CHOICES = ("coulomb", "viscous", "offset", "armature", "ripple")  # what options.friction may name
 SMOOTHING_GRID = (0.0002, 0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
 LAG_GRID = (0.0, 0.01, 0.02, 0.04)  # s, candidates for the Coulomb term's lag behind the velocity
 REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
@@ -60,21 +63,30 @@ REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
 
 @dataclass
 class ConsistentOptions:
-    friction: tuple = DEFAULT_KINDS  # which per-joint columns to include ("ripple": cos q_j, sin q_j too)
-    smoothing: float | None = None  # vs for every joint; None: chosen per joint on the fit data
-    margin: float = 1e-7  # consistency margin [kg m^2], as the extraction's
+    """Options of the consistent identification; those declared with option(...) are also
+    `dyngen identify` flags (dyngen.options), the rest the method's own settings."""
+
+    friction: tuple = option(DEFAULT_KINDS, "per-joint columns: " + ", ".join(CHOICES) + " (cos q_j, sin q_j)",
+                             metavar="LIST", listed=True)
+    smoothing: float | None = option(None, "Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint "
+                                     "(default: chosen per joint on the fit data)", metavar="V",
+                                     parse=real(0, 100, above=True))
+    margin: float = ExtractOptions.margin  # consistency margin [kg m^2]: the extraction's
     restarts: int = 2
     seed: int = 1
     threads: int = 0
     max_rounds: int = 8  # active-set rounds for the signs of the friction weights
     weighted: bool = True  # rows scaled by 1 / sigma_joint
     prior: np.ndarray | None = None  # dynamic parameters (10N); default the YAML's nominal
-    regularisation: float | None = None  # None: chosen on held-out data from REGULARISATION_GRID
+    regularisation: float | None = option(None, "weight of the prior (default: chosen by cross-validation over "
+                                          "contiguous parts of the fit data, or on --select data)", metavar="L",
+                                          parse=real(0, 1e9))  # None: chosen from REGULARISATION_GRID
     grid: tuple = REGULARISATION_GRID
     folds: int = 5  # contiguous parts for choosing the regularisation when no select data are given
     rule: str = "1se"  # "1se" (one-standard-error rule) or "min" (the best held-out score)
-    tilt: bool = False
-    friction_lag: bool = True  # Coulomb term follows the velocity with a per-joint lag from LAG_GRID  # two more columns: a horizontal gravity component dg (a tilted base), prior's masses
+    # two more columns: a horizontal gravity component dg (a tilted base), prior's masses
+    tilt: bool = option(False, "also fit a tilted base (a horizontal gravity component)")
+    friction_lag: bool = True  # Coulomb term follows the velocity with a per-joint lag from LAG_GRID
 
 
 @dataclass

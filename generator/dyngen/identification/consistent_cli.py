@@ -1,72 +1,40 @@
-"""`dyngen identify` (kind full): options and run of the physically consistent identification."""
+"""`dyngen identify` (kind full): the run of the physically consistent identification (its
+options: identification.consistent.ConsistentOptions, flags by dyngen.measured_cli)."""
 
 from __future__ import annotations
 
-import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from ..arguments import real
 from ..errors import InputError
-
-
-def add_options(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_argument_group("physically consistent identification (--kind full, the default)")
-    group.add_argument("--ols", action="store_true",
-                       help="plain least squares of the base coefficients instead (no friction, no consistency)")
-    group.add_argument("--consistent", action="store_true",
-                       help="the consistent identification (the default for --kind full; kept for scripts)")
-    group.add_argument("--prior", metavar="P.yaml",
-                       help="link parameters to regularise toward and to keep what the data do not see near "
-                            "(default: the YAML's parameters.nominal)")
-    group.add_argument("--regularisation", type=real(0, 1e9), metavar="L",
-                       help="weight of the prior (default: chosen by cross-validation over contiguous halves of "
-                            "the fit data, or on --select data)")
-    group.add_argument("--select", action="append", metavar="CSV",
-                       help="recording(s) to choose the regularisation on (never fitted)")
-    group.add_argument("--friction", default="coulomb,viscous,offset,armature", metavar="LIST",
-                       help="per-joint columns: coulomb, viscous, offset, armature, ripple (cos q_j, sin q_j) "
-                            "(default coulomb,viscous,offset,armature)")
-    group.add_argument("--tilt", action="store_true",
-                       help="also fit a tilted base (a horizontal gravity component)")
-    group.add_argument("--smoothing", type=real(0, 100, above=True), metavar="V",
-                       help="Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint (default: chosen "
-                            "per joint on the fit data)")
+from ..options import resolve
 
 
 def run_consistent(args, robot, model, signals, progress) -> int:
     from ..atomic import write_file
     from ..data.parameters_file import read_link_parameters
     from ..export import write_all
-    from .consistent import ConsistentOptions, identify_consistent
+    from ..measured_cli import _conditioning_text, _read
+    from .consistent import CHOICES, ConsistentOptions, identify_consistent
     from .consistent_output import consistent_table, consistent_yaml, summary_lines
 
-    known = {"coulomb", "viscous", "offset", "armature", "ripple"}
-    friction = tuple(x.strip() for x in args.friction.split(",") if x.strip())
-    unknown = [x for x in friction if x not in known]
+    options = resolve(ConsistentOptions, args, {})
+    unknown = [x for x in options.friction if x not in CHOICES]
     if unknown:
         raise InputError("--friction", "", f"unknown column(s) {', '.join(unknown)}; expected some of "
-                         f"{', '.join(sorted(known))}")
-    if args.regularisation is not None and not args.regularisation >= 0:
-        raise InputError("--regularisation", "", f"{args.regularisation} must be >= 0")
-    if args.smoothing is not None and not args.smoothing > 0:
-        raise InputError("--smoothing", "", f"{args.smoothing} must be > 0")
-    prior = read_link_parameters(args.prior, robot.dof) if args.prior else None
-    from ..measured_cli import _read
-
+                         f"{', '.join(sorted(CHOICES))}")
+    if args.prior:
+        options = replace(options, prior=read_link_parameters(args.prior, robot.dof))
     select = _read(args.select, robot, args) if args.select else None
-    options = ConsistentOptions(friction=friction, prior=prior, regularisation=args.regularisation,
-                                tilt=args.tilt, smoothing=args.smoothing)
     start = time.perf_counter()
     with progress.step("consistent identification (weighted least squares, barrier solver)"):
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
     sources = [Path(p).name for p in args.data]
-    from ..measured_cli import _conditioning_text
-
     write_file(out, consistent_yaml(robot, result, sources, _conditioning_text(signals)))
     table = out.with_suffix(".md")
     write_file(table, f"# {robot.name}: consistent identification from {', '.join(sources)}\n\n"

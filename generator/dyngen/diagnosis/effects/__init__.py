@@ -24,22 +24,37 @@ TIME_SHIFTS = (0.001, 0.004, 0.016, 0.064)  # s: the variants tried (factors of 
 # Errors in every base coefficient: dozens of values that fit anything a little, and over-fit
 # real data (a repeated trajectory selects 43 of them). Tried only when asked for by name.
 NOT_BY_DEFAULT = ("coefficients",)
+EFFECTS = (Offset, Coulomb, Viscous, Stribeck, Direction, Ripple, Armature, Gain, Payload, Tilt, GravityScale,
+           TimeShift, Coefficients)  # every effect class, in the library's order
+NAMES = tuple(cls.name for cls in EFFECTS)
+DEFAULT_NAMES = tuple(name for name in NAMES if name not in NOT_BY_DEFAULT)
 
 
-def library(names=None) -> list[Effect]:
-    """Every candidate effect tried by default (or those whose name is in `names`)."""
+def check_names(names) -> None:
+    """ValueError naming the unknown effect names, if any."""
+    unknown = sorted(set(names) - set(NAMES))
+    if unknown:
+        raise ValueError(f"unknown effect(s) {', '.join(unknown)}; known: {', '.join(sorted(NAMES))}")
+
+
+def effect_class(name: str) -> type:
+    """The class of the effect a report entry names (PointPayload reports as "payload")."""
+    return next(cls for cls in EFFECTS if cls.name == name)
+
+
+def library(context: Context, names=None) -> list[Effect]:
+    """Every candidate effect tried by default (or those whose name is in `names`), for the
+    diagnosis of one robot and its link parameters (context)."""
+    names = DEFAULT_NAMES if names is None else names
+    check_names(names)
     effects = [Offset(), *[Coulomb(v) for v in COULOMB_VELOCITIES], Viscous(),
                *[Stribeck(v) for v in STRIBECK_VELOCITIES], Direction(), Ripple(), Armature(), Gain(),
-               Payload(), Tilt(), GravityScale(), *[TimeShift(dt) for dt in TIME_SHIFTS], Coefficients()]
-    if names is None:
-        return [e for e in effects if e.name not in NOT_BY_DEFAULT]
-    known = {e.name for e in effects}
-    unknown = sorted(set(names) - known)
-    if unknown:
-        raise ValueError(f"unknown effect(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+               Payload.of(context), Tilt.of(context), GravityScale.of(context), *[TimeShift(dt) for dt in TIME_SHIFTS],
+               Coefficients.of(context)]
     return [e for e in effects if e.name in names]
 
 
 __all__ = ["Armature", "Coefficients", "Context", "Coulomb", "Direction", "Effect", "Gain", "GravityScale", "Offset",
-           "Payload", "Ripple", "Stribeck", "Tilt", "TimeShift", "Viscous", "gravity_matrix", "library",
-           "COULOMB_VELOCITIES", "STRIBECK_VELOCITIES", "TIME_SHIFTS"]
+           "Payload", "Ripple", "Stribeck", "Tilt", "TimeShift", "Viscous", "check_names", "effect_class",
+           "gravity_matrix", "library", "COULOMB_VELOCITIES", "DEFAULT_NAMES", "EFFECTS", "NAMES",
+           "STRIBECK_VELOCITIES", "TIME_SHIFTS"]

@@ -16,7 +16,7 @@ class Context:
     robot: object  # dyngen.description.Robot
     p: np.ndarray
     s: np.ndarray
-    sign_velocity: float = 0.002  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity)
+    sign_velocity: float  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity) (diagnosis Options)
     q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
     qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
     cache: dict = field(default_factory=dict)  # columns and shared intermediates, per recording (memo)
@@ -33,7 +33,13 @@ class Context:
 
 class Effect:
     """name: the effect's identifier in reports and JSON; scope: "joint" or "arm";
-    parameters and units: the fitted values' names and units (per joint for scope "joint")."""
+    parameters and units: the fitted values' names and units (per joint for scope "joint").
+
+    What the diagnosis needs to know of an effect lives here, as attributes and methods with
+    plain defaults: an effect says what it needs (a context-built effect is made by `of`), what
+    follows from its values (`derived`), what the updated model takes from it (`friction_terms`,
+    `simulator`, `last_link`, read from a report entry: classmethods) and when it is reported
+    with a warning (`suspect`, `warnings`)."""
 
     name = ""
     scope = "joint"
@@ -41,9 +47,15 @@ class Effect:
     units: tuple = ()
     label = ""  # a variant's setting, e.g. "vs = 0.1 rad/s"
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
-    suspect = False  # a symptom rather than a cause: always reported with a warning
+    suspect = ""  # a symptom rather than a cause: why, reported with a warning
     secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
     switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
+    simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")
+
+    @classmethod
+    def of(cls, context: Context) -> "Effect":
+        """The effect for one diagnosis (effects that need the robot or its model read them here)."""
+        return cls()
 
     def columns(self, context: Context, signals, tau_model: np.ndarray) -> np.ndarray:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the
@@ -54,7 +66,19 @@ class Effect:
         """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
         return True
 
-    setting: float = 0.0  # refinable effects: the current nonlinear setting
+    def simplified(self, values: np.ndarray):
+        """Fitted values possible only in part: (a simpler effect that keeps the first of
+        these values, the refusal to report: {"candidate", "values"}); else None."""
+        return None
+
+    def reshapes(self, other: "Effect") -> bool:
+        """Whether this effect, on the same joint as `other`, only reshapes it (and goes)."""
+        return False
+
+    @property
+    def setting(self):
+        """Refinable effects: the current nonlinear setting (what `at` takes); others None."""
+        return None
 
     def implied_setting(self, values: np.ndarray) -> float | None:
         """Refinable effects whose fitted values imply their setting (refined by fixed-point
@@ -73,6 +97,27 @@ class Effect:
     def fixed(self) -> dict:
         """Settings of a variant that are not fitted (e.g. the Stribeck velocity)."""
         return {}
+
+    def derived(self, robot, values: dict, std: dict, torque_rms) -> dict:
+        """Quantities a reader wants next to the fitted values (None where undetermined), e.g.
+        tilt angles. torque_rms(): the RMS torque of the fitted values on the fit data (per-joint
+        effects)."""
+        return {}
+
+    @classmethod
+    def warnings(cls, entry: dict) -> list[str]:
+        """Warnings on a selected effect's report entry (diagnosis.json's `selected`)."""
+        return []
+
+    @classmethod
+    def friction_terms(cls, values: dict, variant: dict) -> dict:
+        """Entries of its joint's generated <robot>_friction vector (model.FRICTION_FIELDS)."""
+        return {}
+
+    @classmethod
+    def last_link(cls, values: dict) -> np.ndarray | None:
+        """Standard parameters this effect adds to the last link (a payload); else None."""
+        return None
 
     @property
     def key(self) -> str:

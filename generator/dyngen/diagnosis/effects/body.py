@@ -21,7 +21,12 @@ class Payload(Effect):
     parameters = STANDARD_NAMES_PER_LINK
     units = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
 
-    max_mass = np.inf  # kg: the arm's own mass (set in columns); a heavier "payload" is refused
+    def __init__(self, max_mass: float):
+        self.max_mass = float(max_mass)  # kg: the arm's own mass; a heavier "payload" is refused
+
+    @classmethod
+    def of(cls, context):
+        return cls(float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0])))
 
     def plausible(self, values):
         """A body has a positive mass, not more than the arm's, and its centre of mass
@@ -29,15 +34,36 @@ class Payload(Effect):
         m = values[0]
         return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
 
+    def simplified(self, values):
+        """A fitted inertia that is no body's (a negative principal moment about its centre of
+        mass): a point mass at the fitted centre instead. The data determine m and m c, not that
+        inertia, and an impossible inertia mispredicts other motions."""
+        if consistent_inertia(values):
+            return None
+        refusal = {"candidate": "the payload's inertia about its centre of mass (a negative principal moment; "
+                                "the payload is kept as a point mass at its fitted centre)",
+                   "values": values[4:].tolist()}
+        return PointPayload(values[1:4] / values[0], self.max_mass), refusal
+
     def columns(self, context, signals, tau_model):
         n = signals.q.shape[1]
-        self.max_mass = float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0]))
         out = np.empty(signals.q.shape + (PER_LINK,))
         for k in range(PER_LINK):
             unit = np.zeros(PER_LINK * n)
             unit[PER_LINK * (n - 1) + k] = 1.0
             out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, unit)
         return out
+
+    def derived(self, robot, values, std, torque_rms):
+        m = values.get("m")
+        if m in (None, 0.0):
+            return {}
+        return {"mass_kg": m,
+                "com_m": [values[k] / m if values.get(k) is not None else None for k in ("mx", "my", "mz")]}
+
+    @classmethod
+    def last_link(cls, values):
+        return None if None in values.values() else standard_of_payload(values)
 
 
 class PointPayload(Payload):
@@ -48,20 +74,19 @@ class PointPayload(Payload):
     parameters = ("m", "mx", "my", "mz")
     units = ("kg", "kg m", "kg m", "kg m")
 
-    def __init__(self, centre):
+    def __init__(self, centre, max_mass: float):
+        super().__init__(max_mass)
         self.centre = np.asarray(centre, dtype=float)
         self.label = "point mass at c0=(" + ",".join(f"{x:.4g}" for x in self.centre) + ")"
 
     def fixed(self):
         return {"point_mass_at": [float(x) for x in self.centre]}
 
-    def plausible(self, values):
-        m = values[0]
-        return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
+    def simplified(self, values):
+        return None  # a point mass is always a body
 
     def columns(self, context, signals, tau_model):
         n = signals.q.shape[1]
-        self.max_mass = float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0]))
         c = self.centre
         I = c @ c * np.eye(3) - np.outer(c, c)  # unit mass
         units = [np.array([1.0, 0, 0, 0, I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]]),
@@ -99,15 +124,13 @@ def standard_of_payload(values: dict) -> np.ndarray:
 class Coefficients(Effect):
     name, scope = "coefficients", "arm"
 
-    def __init__(self):
-        self.parameters, self.units = (), ()
-
-    def bind(self, manifest) -> "Coefficients":
-        self.parameters = tuple(e["standard"] for e in manifest["coefficients"]["full"]["expressions"])
+    def __init__(self, parameters):
+        self.parameters = tuple(parameters)  # the standard names of the full model's base coefficients
         self.units = ("SI",) * len(self.parameters)
-        return self
+
+    @classmethod
+    def of(cls, context):
+        return cls(e["standard"] for e in context.model.manifest["coefficients"]["full"]["expressions"])
 
     def columns(self, context, signals, tau_model):
-        if not self.parameters:
-            self.bind(context.model.manifest)
         return context.model.batch(REGRESSOR.name, signals.q, signals.qd, signals.qdd)

@@ -23,6 +23,8 @@ import numpy as np
 
 from .base import Effect
 
+RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable
+
 
 class _Dissipative(Effect):
     """Friction opposes motion and a rotor inertia is positive: only positive values qualify."""
@@ -34,6 +36,7 @@ class _Dissipative(Effect):
 class Coulomb(_Dissipative):
     name, parameters, units = "coulomb", ("Fc",), ("Nm",)
     refinable = switching = True
+    simulator = ("friction", "Fc")
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)
@@ -51,6 +54,10 @@ class Coulomb(_Dissipative):
 
     def at(self, setting):
         return Coulomb(setting)
+
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"Fc": values["Fc"], "eps": variant["vc"]}  # the fitted velocity scale (the Stribeck term shares it)
 
     def columns(self, context, signals, tau_model):
         return np.tanh(signals.qd / self.velocity)[:, :, None]
@@ -80,9 +87,33 @@ class Ripple(Effect):
                 out[:, j, :] = 0.0
         return out
 
+    def derived(self, robot, values, std, torque_rms):
+        if None in values.values():
+            return {}
+        amplitudes = [float(np.hypot(values[f"a{k}"], values[f"b{k}"])) for k in self.HARMONICS]
+        # Low harmonics over a short range of positions are nearly collinear: large values of
+        # opposite sign whose sum is small. Then only the sum is a finding.
+        rms = torque_rms()
+        return {"amplitude_Nm": amplitudes, "torque_rms_Nm": rms,
+                "separable": bool(sum(amplitudes) <= RIPPLE_SEPARABLE * np.sqrt(2) * rms)}
+
+    @classmethod
+    def warnings(cls, entry):
+        d = entry["derived"]
+        if d.get("separable", True):
+            return []
+        return [f"ripple on joint {entry['joints'][0]}: its harmonics are not separable over the positions the fit "
+                f"data cover (amplitudes {', '.join(f'{a:.3g}' for a in d['amplitude_Nm'])} Nm for "
+                f"a torque of {d['torque_rms_Nm']:.3g} Nm RMS): only their sum is a finding"]
+
 
 class Viscous(_Dissipative):
     name, parameters, units = "viscous", ("Fv",), ("Nm s/rad",)
+    simulator = ("damping", "Fv")
+
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"Fv": values["Fv"]}
 
     def columns(self, context, signals, tau_model):
         return signals.qd[:, :, None]
@@ -109,6 +140,15 @@ class Stribeck(_Dissipative):
     def at(self, setting):
         return Stribeck(setting)
 
+    def reshapes(self, other):
+        """No wider than twice the joint's Coulomb velocity scale: there the two laws trade
+        shape with each other, and no static friction is shown."""
+        return isinstance(other, Coulomb) and self.velocity < 2 * other.velocity
+
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"Fs": values["Fs"], "vs": variant["vs"]}
+
     def columns(self, context, signals, tau_model):
         qd = signals.qd
         return (context.sign(qd) * np.exp(-(qd / self.velocity) ** 2))[:, :, None]
@@ -116,6 +156,7 @@ class Stribeck(_Dissipative):
 
 class Armature(_Dissipative):
     name, parameters, units = "armature", ("Ia",), ("kg m^2",)
+    simulator = ("armature", "Ia")
 
     def columns(self, context, signals, tau_model):
         return signals.qdd[:, :, None]

@@ -42,6 +42,9 @@ class Gain(Effect):
     def columns(self, context, signals, tau_model):
         return tau_model[:, :, None]
 
+    def derived(self, robot, values, std, torque_rms):
+        return {"factor": 1.0 + values["k-1"]}
+
 
 class TimeShift(Effect):
     name, scope, parameters, units = "time_shift", "arm", ("dt",), ("s",)
@@ -71,3 +74,6 @@ class TimeShift(Effect):
 
     def at(self, setting):
         return TimeShift(setting)
+
+    def derived(self, robot, values, std, torque_rms):
+        return {"dt_ms": 1e3 * values["dt"], "dt_std_ms": 1e3 * std["dt"]}

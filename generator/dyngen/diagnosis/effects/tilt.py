@@ -35,16 +35,24 @@ MAX_TILT_DEG = 10.0
 MAX_GRAVITY_SCALE = 0.1  # relative: a larger change of gravity's size is refused
 
 
+def gravity_norm(robot) -> float:
+    return float(np.linalg.norm([float(x) for x in robot.gravity]))
+
+
 class Tilt(Effect):
     name, scope = "tilt", "arm"
     parameters = ("dg1", "dg2")
     units = ("m/s^2", "m/s^2")
-    g = 9.81  # set from the robot in columns()
     refinable = True
 
-    def __init__(self, estimate=(0.0, 0.0)):
+    def __init__(self, g: float, estimate=(0.0, 0.0)):
+        self.g = float(g)  # |gravity| of the robot's model
         self.estimate = tuple(float(x) for x in estimate)  # dg1, dg2 of the second-order term
         self.label = "" if not any(self.estimate) else f"dg0=({self.estimate[0]:.6g},{self.estimate[1]:.6g})"
+
+    @classmethod
+    def of(cls, context):
+        return cls(gravity_norm(context.robot))
 
     @property
     def setting(self):
@@ -54,10 +62,9 @@ class Tilt(Effect):
         return np.array(values[:2], dtype=float) if np.any(values[:2]) else None
 
     def at(self, setting):
-        return Tilt(setting)
+        return Tilt(self.g, setting)
 
     def columns(self, context, signals, tau_model):
-        self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
         G = _gravity(context, signals)  # (T, N, 3)
         u1, u2 = tilt_directions(context.robot)
         along = G @ np.cross(u1, u2)
@@ -67,22 +74,40 @@ class Tilt(Effect):
     def plausible(self, values):
         return bool(np.hypot(*values[:2]) < self.g * np.sin(np.radians(MAX_TILT_DEG)))
 
+    def derived(self, robot, values, std, torque_rms):
+        if None in values.values():
+            return {}
+        a1, a2 = tilt_angles_deg(robot, [values["dg1"], values["dg2"]])
+        s1, s2 = tilt_angles_deg(robot, [std["dg1"], std["dg2"]])
+        return {"tilt_deg": [a1, a2], "tilt_std_deg": [abs(s1), abs(s2)], "tilt_towards": list(tilt_axes(robot)),
+                "tilt_total_deg": float(np.hypot(a1, a2))}
+
 
 class GravityScale(Effect):
     name, scope = "gravity_scale", "arm"
     parameters = ("dg",)
     units = ("m/s^2",)
-    suspect = secondary = True
-    g = 9.81
+    suspect = ("no tilt changes gravity's size; every link's gravity torque scaled alike points at masses and "
+               "centres of mass wrong by one factor, or at a torque-sensor gain")
+    secondary = True
+
+    def __init__(self, g: float):
+        self.g = float(g)  # |gravity| of the robot's model
+
+    @classmethod
+    def of(cls, context):
+        return cls(gravity_norm(context.robot))
 
     def columns(self, context, signals, tau_model):
-        self.g = float(np.linalg.norm([float(x) for x in context.robot.gravity]))
         G = _gravity(context, signals)
         u1, u2 = tilt_directions(context.robot)
         return (G @ np.cross(u1, u2))[:, :, None]
 
     def plausible(self, values):
         return bool(abs(values[0]) < MAX_GRAVITY_SCALE * self.g)
+
+    def derived(self, robot, values, std, torque_rms):
+        return {} if values.get("dg") is None else {"relative": values["dg"] / self.g}
 
 
 def _gravity(context, signals) -> np.ndarray:

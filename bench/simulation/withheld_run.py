@@ -18,8 +18,8 @@ from dyngen.data import condition, read_recording
 from dyngen.diagnosis import diagnose
 from dyngen.diagnosis.report import to_json
 
-from simulation.perfect import perfect_rms
-from simulation.withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, nominal_model, simulated_parameters
+from .perfect import perfect_rms
+from .withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, nominal_model, simulated_parameters
 from .withheld_verdict import problems, truth_text, verdict_text
 
 DIRECTIONS = {"forward": ("fit", "holdout"), "backward": ("holdout", "fit")}

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simulation.withheld_cases import standard_of_body
+from .withheld_cases import standard_of_body
 
 TOLERANCE = 0.20  # relative, on magnitudes
 NOISE_FACTOR = 1.5  # held-out RMS after, per joint, at most this many noise sigmas

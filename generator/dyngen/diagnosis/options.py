@@ -1,0 +1,28 @@
+"""The diagnosis step's options (dyngen.options): `dyngen diagnose`'s flags come from this
+class; the fields without option(...) are the method's own settings."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..options import option
+from .effects import DEFAULT_NAMES, NAMES
+from .selection import ALPHA, MIN_GAIN
+
+
+@dataclass(frozen=True)
+class Options:
+    effects: tuple | None = option(
+        None, f"comma-separated effects to try (default: {', '.join(DEFAULT_NAMES)}; also: "
+        f"{', '.join(n for n in NAMES if n not in DEFAULT_NAMES)})", metavar="LIST", listed=True)
+    min_gain: float = option(MIN_GAIN, "least selection gain to select an effect, as a share of a joint's mean "
+                             "square", metavar="G", bounds=(0.0, 1.0))
+    alpha: float = ALPHA  # significance level of the selection and the pruning (selection.py)
+    sign_velocity: float = option(0.002, "sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V), "
+                                  "V in rad/s (Coulomb's own scale is fitted)", metavar="V", bounds=(0.0, 1e3),
+                                  above=True)
+    block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
+    reidentify: bool = option(False, "also re-identify physically consistent link parameters (with friction and a "
+                              "tilted base) from the fit data, and use them on the joints where they beat every "
+                              "effect and the simple model on selection data; says 'link parameters off' and writes "
+                              "them to consistent/ (experimental: see README)")
