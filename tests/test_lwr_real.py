@@ -82,13 +82,11 @@ def test_m2_to_m3_beats_the_simple_model_on_every_joint(setup):
 
 
 def test_m1_to_m3(m1_m3):
-    """Better than the simple model on joints 1-3 and 5-7 and far better on average; joint 4 is
-    the measured exception (README: m3 moves it 55 % faster than m1, and its friction there is
-    lower than any law fitted on m1 predicts), and the report says that the test speeds exceed
-    the fit data's."""
+    """At most the simple model's test RMS on every joint, a mean of at most 0.25 Nm, and the
+    report says that the test speeds exceed the fit data's (m3 moves joint 4 55 % faster)."""
     after, simple = np.array(m1_m3.rms_after), np.array(m1_m3.rms_simple)
-    assert all(after[j] <= simple[j] + 1e-9 for j in (0, 1, 2, 4, 5, 6)), (after, simple)
-    assert np.mean(after) < 0.8 * np.mean(simple)
+    assert all(after[j] <= simple[j] + 1e-9 for j in range(7)), (after, simple)
+    assert np.mean(after) <= 0.25
     assert any("faster than any fit data" in w and "4 (" in w for w in m1_m3.warnings)
 
 
