@@ -20,13 +20,14 @@ from dyngen.data import Conditioning
 from dyngen.description import load_robot
 from dyngen.diagnosis.options import Options as DiagnosisOptions
 from dyngen.errors import InputError
-from dyngen.excitation.command import Sampling
-from dyngen.excitation.command import parser as excite_parser
+from dyngen.commands.excite import Sampling
+from dyngen.commands.excite import parser as excite_parser
 from dyngen.excitation.design import Settings
 from dyngen.extraction.options import Options
 from dyngen.identification.consistent import ConsistentOptions
 from dyngen.identification.options import Options as IdentifyOptions
-from dyngen.measured_cli import diagnose_parser, identify_parser
+from dyngen.commands.diagnose import parser as diagnose_parser
+from dyngen.commands.identify import parser as identify_parser
 from dyngen.options import add_arguments, default_of, flag_of, options_of, resolve
 
 LWR = ROOT / "examples" / "lwr.yaml"

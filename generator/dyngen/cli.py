@@ -8,7 +8,7 @@ from . import __version__, blas
 
 blas.use_one_thread()  # before numpy loads: the imports below load it
 
-from .commands import diagnose, extract, generate, identify  # noqa: E402
+from .commands import diagnose, excite, extract, generate, identify  # noqa: E402
 from .errors import DriverError, Infeasible, InputError  # noqa: E402
 
 MAIN_HELP = """\
@@ -31,14 +31,8 @@ conventions are in docs/conventions.md; examples/ has the KUKA LWR IV+ and other
 """
 
 
-def _excite(argv, prog="dyngen excite") -> int:
-    from .excitation.command import cmd_excite
-
-    return cmd_excite(argv, prog)
-
-
 COMMANDS = {"generate": generate.main, "extract": extract.main, "identify": identify.main, "diagnose": diagnose.main,
-            "excite": _excite}
+            "excite": excite.main}
 
 
 def main(argv=None) -> int:

@@ -1,9 +1,110 @@
-"""`dyngen diagnose`: where the measured-model gap lies and which effect explains it (dyngen/measured_cli.py holds the command)."""
+"""`dyngen diagnose`: where the gap between measured torques and the model lies, which
+unmodelled effects explain it, and how far it shrinks on data used for nothing else."""
 
 from __future__ import annotations
 
+import argparse
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from ..errors import InputError
+from ..options import add_arguments, resolve
+from ..progress import Progress
+from .recordings import add_data_options, check_enough, compiled_model, conditioning_of, conditioning_text, read_all
+
+
+def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
+    from ..diagnosis import Options
+
+    parser = argparse.ArgumentParser(prog=prog, description=(
+        "Diagnose the gap between measured torques and the Newton-Euler model with given link parameters: "
+        "where the residual lies (per joint, per phase of the motion), which unmodelled effects explain it "
+        "(Coulomb friction with a fitted velocity scale, viscous, Stribeck and direction-dependent friction, "
+        "position ripple, rotor inertia, sensor offset and gain, payload, tilted base, gravity scale, time "
+        "shift) and how far it shrinks. Three roles for data: --data fits the effects' values, --select chooses "
+        "the effects, --test is used only for the residual reported as held out. A simple model (per joint "
+        "offset + Coulomb + viscous) is always reported beside the result. Writes report.md, diagnosis.json, "
+        "effects.yaml, torques.png, residuals.png and, for consistent parameters, URDF and MJCF with the "
+        "selected friction."))
+    add_data_options(parser)
+    parser.add_argument("--params", required=True, metavar="P.yaml",
+                        help="link parameters: extraction output (links:), a solution file (solution:) or a robot "
+                             "YAML (parameters.nominal)")
+    parser.add_argument("--select", action="append", metavar="CSV",
+                        help="recording(s) that choose the effects (default: every third 2-s block of the --data "
+                             "recordings)")
+    parser.add_argument("--test", action="append", metavar="CSV",
+                        help="recording(s) used for nothing but the reported held-out residual; best a different "
+                             "trajectory (default: none, and the report says that nothing was held out)")
+    parser.add_argument("--holdout", action="append", metavar="CSV", help="the same as --test")
+    parser.add_argument("--split", metavar="F,S,T",
+                        help="cut every --data recording in time into fit, select and test pieces of these "
+                             "fractions (e.g. 0.6,0.2,0.2), each conditioned on its own")
+    parser.add_argument("--out", default=None, metavar="DIR", help="output folder (default out/<robot>/diagnosis)")
+    add_arguments(parser.add_argument_group("diagnosis"), Options)
+    return parser
+
 
 def main(argv, prog="dyngen diagnose") -> int:
-    from ..measured_cli import cmd_diagnose as run
+    args = parser(prog).parse_args(argv)
+    from ..data import condition, read_recording
+    from ..data.split import parse_fractions, split_recording
+    from ..description import load_robot
+    from ..diagnosis import Options, diagnose
+    from ..diagnosis.effects import check_names
+    from ..diagnosis.outputs import write_outputs
+    from ..diagnosis.report import summary_lines
+    from ..data.parameters_file import read_link_parameters
 
-    return run(argv, prog)
+    options = resolve(Options, args, {})
+    if options.effects == ():  # `--effects ""`: no list given, the default effects
+        options = replace(options, effects=None)
+    try:  # unknown names fail here, naming the option, before anything runs
+        check_names(options.effects or ())
+    except ValueError as err:
+        raise InputError("--effects", "", str(err)) from None
+    robot = load_robot(args.robot)
+    p = read_link_parameters(args.params, robot.dof)
+    progress = Progress(quiet=args.quiet)
+    start = time.perf_counter()
+    tests = (args.test or []) + (args.holdout or [])
+    # bad input fails before anything is announced or written
+    if args.split:
+        if args.select or tests:
+            raise InputError("--split", "", "cuts the --data recordings into fit, select and test: give no "
+                             "--select, --test or --holdout with it")
+        fractions = parse_fractions(args.split)
+        pieces = [split_recording(read_recording(x, robot.dof), fractions) for x in args.data]
+        for recording in (r for rs in pieces for r in rs if r is not None):
+            check_enough(recording.name, recording.t)
+        fit, select, test = ([condition(r[k], conditioning_of(args)) for r in pieces if r[k] is not None]
+                             for k in range(3))
+    else:
+        fit = read_all(args.data, robot, args)
+        select = read_all(args.select, robot, args) if args.select else []
+        test = read_all(tests, robot, args) if tests else []
+        for path, recording in zip([*args.data, *(args.select or []), *tests], [*fit, *select, *test]):
+            check_enough(Path(path).name, recording.t)
+    progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
+                 f"select and {len(test)} test recording(s)")
+    model = compiled_model(args, robot, progress)
+    with progress.step("residual, effects, selection, test"):
+        result = diagnose(robot, model, p, fit, select or None, options, test=test)
+    out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
+    sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
+               "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
+    with progress.step("report, JSON, figures, updated model"):
+        paths = write_outputs(result, robot, p, out, sources, options.sign_velocity)
+    if not args.quiet:
+        print(f"{robot.name}: diagnosis in {time.perf_counter() - start:.1f} s ({result.split})")
+        print("\n".join(summary_lines(result)))
+        written = [str(v) for k, v in paths.items() if k != "export skipped"]
+        print(f"  written: {', '.join(written)}")
+        if "export skipped" in paths:
+            print(f"  URDF/MJCF not written: {paths['export skipped']}")
+    elif result.warnings:
+        import sys
+
+        print("\n".join(f"warning: {w}" for w in result.warnings), file=sys.stderr)
+    return 0

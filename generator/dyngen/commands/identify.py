@@ -1,9 +1,84 @@
-"""`dyngen identify`: base coefficients by least squares from recordings (dyngen/measured_cli.py holds the command)."""
+"""`dyngen identify`: physically consistent link parameters with friction from recordings
+(identification/consistent.py), or base coefficients by least squares."""
 
 from __future__ import annotations
 
+import argparse
+from pathlib import Path
+
+from ..options import add_arguments, resolve
+from ..progress import Progress
+from .recordings import add_data_options, compiled_model, conditioning_text, read_all
+
+
+def parser(prog="dyngen identify") -> argparse.ArgumentParser:
+    from ..identification.consistent import ConsistentOptions
+    from ..identification.options import Options
+
+    parser = argparse.ArgumentParser(prog=prog, description=(
+        "Identify from recordings. --kind full (default): physically consistent link parameters with "
+        "per-joint friction, offset and rotor inertia (weighted least squares subject to consistency of every "
+        "link, the YAML's bounds and total mass; --ols for plain least squares), written with URDF and MJCF. "
+        "Otherwise base coefficients by least squares (the paper's eq. 11), as the `identified:` YAML block "
+        "that `dyngen extract` reads. --kind full uses torque "
+        "trajectories (Y(q, qd, qdd) pi = tau); gravity reads the torques as gravity torques g(q) (static "
+        "poses or the FRI's g(q), eq. 9); inertia reads the stacked inertia matrix from columns M11, M12, ... "
+        "(eq. 10). Reports the regressor's condition number, every coefficient's standard deviation and "
+        "the coefficients the data do not excite."))
+    add_data_options(parser)
+    add_arguments(parser.add_argument_group("identification"), Options)
+    parser.add_argument("-o", "--output", metavar="FILE",
+                        help="where to write the YAML (default out/<robot>/identified_<kind>.yaml)")
+    group = parser.add_argument_group("physically consistent identification (--kind full, the default)")
+    group.add_argument("--prior", metavar="P.yaml",
+                       help="link parameters to regularise toward and to keep what the data do not see near "
+                            "(default: the YAML's parameters.nominal)")
+    group.add_argument("--select", action="append", metavar="CSV",
+                       help="recording(s) to choose the regularisation on (never fitted)")
+    add_arguments(group, ConsistentOptions)
+    return parser
+
 
 def main(argv, prog="dyngen identify") -> int:
-    from ..measured_cli import cmd_identify as run
+    args = parser(prog).parse_args(argv)
+    from ..identification.consistent_cli import run_consistent
+    from ..identification.options import Options
 
-    return run(argv, prog)
+    options = resolve(Options, args, {})
+    from ..description import load_robot
+    from ..identification import identified_yaml, identify, summary_table
+    from ..identification.samples import stacked_inertia_columns
+
+    robot = load_robot(args.robot)
+    progress = Progress(quiet=args.quiet)
+    kind = options.kind
+    required = tuple(_inertia_names(robot)) if kind == "inertia" else ()
+    # Bad input fails before anything is announced or written.
+    signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required)
+    progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
+    model = compiled_model(args, robot, progress)
+    if kind == "full" and not options.ols:
+        return run_consistent(args, robot, model, signals, progress)
+    if kind == "inertia":
+        assert stacked_inertia_columns(model.manifest) == list(required)
+    with progress.step("least squares"):
+        estimate = identify(model, signals, kind)
+    out = Path(args.output) if args.output else Path("out") / robot.name / f"identified_{kind}.yaml"
+    from ..atomic import write_file
+
+    write_file(out, identified_yaml(robot.name, {kind: estimate}, [Path(p).name for p in args.data],
+                                    conditioning_text(signals)))
+    if not args.quiet:
+        print(f"{robot.name}: {len(estimate.names)} {kind} coefficients from {estimate.rows} equations; "
+              f"condition number {estimate.condition:.3g} (columns scaled {estimate.scaled_condition:.3g}); "
+              f"residual RMS {estimate.residual_rms:.4g}")
+        print("\n".join("  " + line for line in summary_table(kind, estimate).splitlines()))
+        for w in [*estimate.warnings(), *(w for s in signals for w in s.warnings)]:
+            print(f"  warning: {w}")
+        print(f"  written: {out}")
+    return 0
+
+
+def _inertia_names(robot):
+    n = robot.dof
+    return [f"M{j + 1}{k + 1}" for j in range(n) for k in range(j, n)]

@@ -1,5 +1,5 @@
 """`dyngen identify` (kind full): the run of the physically consistent identification (its
-options: identification.consistent.ConsistentOptions, flags by dyngen.measured_cli)."""
+options: identification.consistent.ConsistentOptions, flags by dyngen.commands.identify)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     from ..atomic import write_file
     from ..data.parameters_file import read_link_parameters
     from ..export import write_all
-    from ..measured_cli import _conditioning_text, _read
+    from ..commands.recordings import conditioning_text, read_all
     from .consistent import CHOICES, ConsistentOptions, identify_consistent
     from .consistent_output import consistent_table, consistent_yaml, summary_lines
 
@@ -28,14 +28,14 @@ def run_consistent(args, robot, model, signals, progress) -> int:
                          f"{', '.join(sorted(CHOICES))}")
     if args.prior:
         options = replace(options, prior=read_link_parameters(args.prior, robot.dof))
-    select = _read(args.select, robot, args) if args.select else None
+    select = read_all(args.select, robot, args) if args.select else None
     start = time.perf_counter()
     with progress.step("consistent identification (weighted least squares, barrier solver)"):
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
     sources = [Path(p).name for p in args.data]
-    write_file(out, consistent_yaml(robot, result, sources, _conditioning_text(signals)))
+    write_file(out, consistent_yaml(robot, result, sources, conditioning_text(signals)))
     table = out.with_suffix(".md")
     write_file(table, f"# {robot.name}: consistent identification from {', '.join(sources)}\n\n"
                + "\n".join(summary_lines(robot, result)) + "\n\n" + consistent_table(result) + "\n")

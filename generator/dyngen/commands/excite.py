@@ -85,7 +85,7 @@ class Sampling:
 
 
 def parser(prog="dyngen excite") -> argparse.ArgumentParser:
-    from .design import Settings
+    from ..excitation.design import Settings
 
     result = argparse.ArgumentParser(prog=prog, description=(
         "Design a periodic excitation trajectory (finite Fourier series, at rest at its start and end) that "
@@ -104,8 +104,8 @@ def parser(prog="dyngen excite") -> argparse.ArgumentParser:
     return result
 
 
-def cmd_excite(argv, prog="dyngen excite") -> int:
-    from .design import Settings
+def main(argv, prog="dyngen excite") -> int:
+    from ..excitation.design import Settings
 
     command_line = parser(prog)
     args = command_line.parse_args(argv)
@@ -114,8 +114,8 @@ def cmd_excite(argv, prog="dyngen excite") -> int:
     if samples > MAX_SAMPLES:
         command_line.error(f"--rate x --period x --periods gives {samples:.3g} samples; at most {MAX_SAMPLES:g}")
     from ..description import load_robot
-    from ..measured_cli import _model
-    from .design import check_limits, limits_of, optimise
+    from .recordings import compiled_model
+    from ..excitation.design import check_limits, limits_of, optimise
 
     robot = load_robot(args.robot)
     limits = limits_of(robot)  # missing limits fail before anything runs
@@ -131,7 +131,7 @@ def cmd_excite(argv, prog="dyngen excite") -> int:
     progress = Progress(quiet=args.quiet)
     progress.say(f"dyngen excite: {robot.name}, {settings.harmonics} harmonics, period {settings.period:g} s, "
                  f"seed {settings.seed}")
-    model = _model(args, robot, progress)
+    model = compiled_model(args, robot, progress)
     with progress.step("optimise the Fourier coefficients"):
         design = optimise(robot, model, settings, forward_flange(robot) if workspace else None)
     t = np.arange(int(round(settings.period * sampling.periods * sampling.rate)) + 1) / sampling.rate

@@ -1,0 +1,69 @@
+"""What the commands that take measured data share: the recording and conditioning flags,
+reading and conditioning the recordings, and the compiled model (commands identify, diagnose,
+excite)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import InputError
+from ..options import add_arguments, resolve
+
+MIN_DIAGNOSIS_SAMPLES = 50
+
+
+def add_data_options(parser: argparse.ArgumentParser) -> None:
+    from ..data import Conditioning
+
+    parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
+    parser.add_argument("--data", action="append", required=True, metavar="CSV",
+                        help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
+    add_arguments(parser.add_argument_group("signal conditioning"), Conditioning)
+    parser.add_argument("--model", metavar="DIR",
+                        help="an already generated folder of this robot (default: generate it first)")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")
+
+
+def check_enough(name: str, t) -> None:
+    if len(t) < MIN_DIAGNOSIS_SAMPLES:
+        raise InputError(name, "", f"{len(t)} samples; a diagnosis needs at least {MIN_DIAGNOSIS_SAMPLES} "
+                         "(seconds of motion at the recording's rate)")
+
+
+def conditioning_of(args):
+    from ..data import Conditioning
+
+    return resolve(Conditioning, args, {})
+
+
+def conditioning_text(signals) -> str:
+    """What conditioning did, per recording (the automatic choice differs between recordings)."""
+    notes = sorted({s.note for s in signals})
+    return notes[0] if len(notes) == 1 else "; ".join(f"{s.name}: {s.note}" for s in signals)
+
+
+def compiled_model(args, robot, progress):
+    """The compiled model: the given folder, or one generated now into a temporary folder."""
+    from ..runtime import load
+
+    if args.model:
+        folder = Path(args.model)
+        if not (folder / "manifest.json").exists():
+            raise InputError(str(folder), "", "not a generated folder (no manifest.json)")
+        model = load(folder)
+        if model.manifest["robot"] != robot.name or model.manifest["dof"] != robot.dof:
+            raise InputError(str(folder), "manifest.json", f"the folder is for {model.manifest['robot']}, "
+                             f"not {robot.name} ({robot.dof} joints)")
+        return model
+    from ..generate import generate
+
+    generated = generate(robot, None, progress)  # into the per-user cache, not the user's folders
+    with progress.step("compile the generated C"):
+        return load(generated.folder)
+
+
+def read_all(paths, robot, args, require_torques=True, required=()):
+    from ..data import condition, read_recording
+
+    return [condition(read_recording(p, robot.dof, require_torques, required), conditioning_of(args)) for p in paths]
