@@ -22,15 +22,20 @@ def add_options(parser: argparse.ArgumentParser) -> None:
                        help="link parameters to regularise toward and to keep what the data do not see near "
                             "(default: the YAML's parameters.nominal)")
     group.add_argument("--regularisation", type=real(0, 1e9), metavar="L",
-                       help="weight of the prior (default: chosen by cross-validation over contiguous halves of "
+                       help="weight of the prior (default: chosen by cross-validation over contiguous parts of "
                             "the fit data, or on --select data)")
     group.add_argument("--select", action="append", metavar="CSV",
-                       help="recording(s) to choose the regularisation on (never fitted)")
+                       help="recording(s) to choose the regularisation and the --candidates on (never fitted)")
     group.add_argument("--friction", default="coulomb,viscous,offset,armature", metavar="LIST",
                        help="per-joint columns: coulomb, viscous, offset, armature, ripple (cos q_j, sin q_j) "
                             "(default coulomb,viscous,offset,armature)")
     group.add_argument("--tilt", action="store_true",
-                       help="also fit a tilted base (a horizontal gravity component)")
+                       help="always fit a tilted base (a rotation of gravity; by default a candidate, see --candidates)")
+    group.add_argument("--candidates", default="ripple,tilt,falling", metavar="LIST",
+                       help="optional parts of the model, each kept only where held-out stretches of the fit data "
+                            "ask for it: ripple (cos q_j, sin q_j per joint), tilt (a tilted base), falling (friction "
+                            "falling with speed per joint: viscous below 0, still opposing motion up to the velocity "
+                            "limit); 'none' for none (default ripple,tilt,falling)")
     group.add_argument("--smoothing", type=real(0, 100, above=True), metavar="V",
                        help="Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint (default: chosen "
                             "per joint on the fit data)")
@@ -43,12 +48,9 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     from .consistent import ConsistentOptions, identify_consistent
     from .consistent_output import consistent_table, consistent_yaml, summary_lines
 
-    known = {"coulomb", "viscous", "offset", "armature", "ripple"}
-    friction = tuple(x.strip() for x in args.friction.split(",") if x.strip())
-    unknown = [x for x in friction if x not in known]
-    if unknown:
-        raise InputError("--friction", "", f"unknown column(s) {', '.join(unknown)}; expected some of "
-                         f"{', '.join(sorted(known))}")
+    friction = _names("--friction", args.friction, {"coulomb", "viscous", "offset", "armature", "ripple"})
+    candidates = () if args.candidates.strip() == "none" else \
+        _names("--candidates", args.candidates, {"ripple", "tilt", "falling"})
     if args.regularisation is not None and not args.regularisation >= 0:
         raise InputError("--regularisation", "", f"{args.regularisation} must be >= 0")
     if args.smoothing is not None and not args.smoothing > 0:
@@ -57,8 +59,9 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     from ..measured_cli import _read
 
     select = _read(args.select, robot, args) if args.select else None
-    options = ConsistentOptions(friction=friction, prior=prior, regularisation=args.regularisation,
-                                tilt=args.tilt, smoothing=args.smoothing)
+    options = ConsistentOptions(friction=friction, candidates=candidates, prior=prior,
+                                regularisation=args.regularisation, tilt=True if args.tilt else None,
+                                smoothing=args.smoothing)
     start = time.perf_counter()
     with progress.step("consistent identification (weighted least squares, barrier solver)"):
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
@@ -78,6 +81,14 @@ def run_consistent(args, robot, model, signals, progress) -> int:
             print(f"  warning: {w}")
         print(f"  {seconds:.1f} s; written: {out}, {table}, " + ", ".join(str(p) for p in exported))
     return 0
+
+
+def _names(flag: str, text: str, known: set) -> tuple:
+    names = tuple(x.strip() for x in text.split(",") if x.strip())
+    unknown = [x for x in names if x not in known]
+    if unknown:
+        raise InputError(flag, "", f"unknown name(s) {', '.join(unknown)}; expected some of {', '.join(sorted(known))}")
+    return names
 
 
 def held_out_rms(model, result, signals) -> np.ndarray:
