@@ -8,9 +8,9 @@ with z_j, o_j joint j's axis and origin and p_ci link i's centre of mass, all in
 (tilt_columns: these torques for given directions of dg). A rotation gives gravity components
 a = (a1, a2) across it (along u1, u2, the base x and y for gravity along -z) and shortens it
 along itself by |g| - sqrt(|g|^2 - |a|^2), so its size is kept (change); the identification fits
-a with that shortening linearised at its previous estimate (rotation_columns), first with the
-prior's link parameters, then with the identified ones. A tilt above MAX_TILT_DEG is no mounting
-error. The kinematics are the export's (DH placements), independent of the generated C.
+a with that shortening linearised at its previous estimate (rotation_columns), with the prior's
+link parameters (identification/consistent.py says why). A tilt above MAX_TILT_DEG is no
+mounting error. The kinematics are the export's (DH placements), independent of the generated C.
 """
 
 from __future__ import annotations
