@@ -100,7 +100,7 @@ def summary_lines(robot, c) -> list[str]:
                    "in the base frame)")
     if c.groups:
         out.append("  optional parts chosen on held-out stretches of the fit data (kept where they gain more than a "
-                   "standard error): " + _groups(c.groups))
+                   "standard error): " + groups_text(c.groups))
     out.append("  every link consistent: lambda_min(tr(I)/2 E - I) = " + ", ".join(f"{x:.2e}" for x in c.lambda_min))
     if c.ols.unexcited:
         out.append(f"  {len(c.ols.unexcited)} coefficient(s) not excited by the data (set by the prior and "
@@ -118,7 +118,7 @@ def summary_lines(robot, c) -> list[str]:
     return out
 
 
-def _groups(groups) -> str:
+def groups_text(groups) -> str:
     """e.g. "base tilt kept; position ripple on joint(s) 5, 7 (not 1, 3, 4, 6); ..."."""
     parts = []
     title = {"tilt": "base tilt", "ripple": "position ripple", "falling": "friction allowed to fall with speed"}
