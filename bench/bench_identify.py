@@ -169,7 +169,8 @@ def sdp(W, v, problem, r_map, margin):
 
 def speed(lines):
     from dyngen.extraction import driver
-    from dyngen.extraction.problem import Stage
+    from dyngen.extraction.problem import Options as ExtractOptions
+    from dyngen.extraction.problem import Stage, build_problem
     from dyngen.extraction.targets import Target
     from dyngen.identification import consistent as C
     from dyngen.parameters import dynamic_from_standard, standard_from_dynamic
@@ -201,11 +202,11 @@ def speed(lines):
     Y = model.batch("regressor", s.q, s.qd, s.qdd).reshape(-1, r)
     W = np.linalg.cholesky(Y.T @ Y / Y.shape[0]).T
     v = np.linalg.solve(W.T, Y.T @ s.tau.reshape(-1) / Y.shape[0])
-    problem = C.build_problem(C.robot_with_default_bounds(robot), C.ExtractOptions(global_algorithm="none", restarts=2))
+    problem = build_problem(C.robot_with_default_bounds(robot), ExtractOptions(global_algorithm="none", restarts=2))
     exe = driver.build(FOLDER)
     start = time.perf_counter()
     result = driver.run(exe, problem, Stage("x", [Target("full", W, v)], np.ones(70, bool), problem.reference.copy()),
-                        C.ExtractOptions(global_algorithm="none", restarts=2))
+                        ExtractOptions(global_algorithm="none", restarts=2))
     t_barrier = time.perf_counter() - start
     s0 = standard_from_dynamic(problem.center)
     K = np.column_stack([model("pi_full", dynamic_from_standard(s0 + np.eye(70)[k])) - model("pi_full", dynamic_from_standard(s0))

@@ -123,7 +123,8 @@ def piece(model, signals, part: np.ndarray | int) -> Piece:
     Y = model.batch("regressor", signals.q[keep], signals.qd[keep], signals.qdd[keep])
     n = Y.shape[0]
     part = np.full(n, part, dtype=int) if np.ndim(part) == 0 else np.asarray(part, dtype=int)
-    return Piece(signals, keep, np.ascontiguousarray(Y.transpose(1, 0, 2)), np.asarray(signals.tau[keep], dtype=float), part, {})
+    Yj = np.ascontiguousarray(Y.transpose(1, 0, 2))
+    return Piece(signals, keep, Yj, np.asarray(signals.tau[keep], dtype=float), part, {})
 
 
 def contiguous_parts(signals, folds: int) -> np.ndarray:

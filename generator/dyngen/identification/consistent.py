@@ -38,8 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..extraction.problem import Options as ExtractOptions  # noqa: F401  (the benchmark's import)
-from ..extraction.problem import build_problem, consistency_margin  # noqa: F401
+from ..extraction.problem import consistency_margin
 from ..parameters import PER_LINK, dynamic_name
 from . import selection, tilt
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
