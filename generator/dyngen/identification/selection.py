@@ -63,7 +63,7 @@ def scores(solver, normal, folds: Folds, labels_idx, lam: float, free=None, work
         x, f, _, _ = solver.solve(G, g, labels, lam, restarts=1, free=None if free is None else free[k], cone=cone)
         sse = normal.sse(x, held, keep).sum(axis=0)
         n = normal.n[held].sum(axis=0)
-        return float(sse @ w2 / n.sum()), sse / np.maximum(n, 1), f
+        return float(sse @ w2 / max(n.sum(), 1.0)), sse / np.maximum(n, 1), f
 
     if workers > 1 and len(folds.splits) > 1:
         with ThreadPoolExecutor(max_workers=workers) as pool:
