@@ -21,15 +21,16 @@ from .errors import shorten
 
 def option(default, help: str, *, flag: str = "", metavar: str = "", choices: tuple = (),
            bounds: tuple | None = None, above: bool = False, repeat: bool = False, listed: bool = False,
-           parse=None):
+           parse=None, const=None):
     """A dataclass field with what argparse and the YAML check need. flag: the command-line
     flag (default --name-with-dashes); bounds: (lowest, highest) for numbers, the lowest
     itself excluded with above; repeat: a tuple of strings given by repeating the flag (a YAML
     list); listed: a tuple of names given as one comma-separated argument; parse: the
     argparse type of an option that is none of these (e.g. a number or a word). A bool
-    default makes an on/off flag."""
+    default makes an on/off flag; const, a flag without argument that sets this value (for a
+    default None meaning "decided from the data", e.g. --tilt)."""
     metadata = {"help": help, "flag": flag, "metavar": metavar, "choices": tuple(choices), "bounds": bounds,
-                "above": above, "repeat": repeat, "listed": listed, "parse": parse}
+                "above": above, "repeat": repeat, "listed": listed, "parse": parse, "const": const}
     if isinstance(default, (list, tuple)):
         return field(default_factory=lambda: tuple(default), metadata=metadata)
     return field(default=default, metadata=metadata)
@@ -55,7 +56,9 @@ def add_arguments(group, cls) -> None:
         kwargs = {"dest": f.name, "default": argparse.SUPPRESS, "help": m["help"] + _shown(default)}
         if m["metavar"]:
             kwargs["metavar"] = m["metavar"]
-        if isinstance(default, bool):
+        if m["const"] is not None:
+            kwargs["action"], kwargs["const"] = "store_const", m["const"]
+        elif isinstance(default, bool):
             kwargs["action"] = "store_true"
         elif m["repeat"]:
             kwargs["action"] = "append"

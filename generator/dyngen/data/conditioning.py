@@ -188,6 +188,7 @@ def _lowpass(name: str, rate: float, cutoff: float, order: int):
         out = signal.sosfiltfilt(sos, extended, axis=-1, padlen=0)[:, pad:pad + T]
         return np.ascontiguousarray(out.T).reshape(x.shape)
 
+    apply.rate = rate  # what it was designed for (samples decimated later need another)
     return apply
 
 

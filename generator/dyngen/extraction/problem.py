@@ -29,6 +29,9 @@ class Stage:
     # the next stage's targets: among this stage's best fits, the driver returns the one that fits
     # these best (the next stage keeps part of it fixed)
     next_blocks: list[Target] = field(default_factory=list)
+    # among this stage's equally good fits, return the one nearest the reference (off: the fit
+    # itself, which is all a cross-validation's fits need, at a third of the time)
+    nearest: bool = True
 
 
 @dataclass

@@ -28,7 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-MAGIC, VERSION = "dyngen-extraction", 2
+MAGIC, VERSION = "dyngen-extraction", 3
 
 
 @dataclass(frozen=True)
@@ -64,6 +64,7 @@ SCHEMA = (
     Field("mass_hi", "real", lambda problem, stage, options: (problem.total_mass or (0.0, 0.0))[1]),
     Field("blocks", "blocks", lambda problem, stage, options: stage.blocks),
     Field("next_blocks", "blocks", lambda problem, stage, options: stage.next_blocks),
+    Field("nearest", "integer", lambda problem, stage, options: int(getattr(stage, "nearest", True)), "bool"),
     Field("equalities", "terms", lambda problem, stage, options: problem.equalities),
     _opt("margin", "real"),
     _opt("restarts", "integer"),

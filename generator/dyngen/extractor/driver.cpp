@@ -1115,7 +1115,7 @@ int main(int argc, char **argv) {
         return 0;
     }
     const Outcome fit = outcomes[best];
-    const Outcome chosen = P.next_blocks.empty() ? prefer_reference(P, fit) : hand_off(P, barrier, fit);
+    const Outcome chosen = !P.nearest ? fit : P.next_blocks.empty() ? prefer_reference(P, fit) : hand_off(P, barrier, fit);
     R.status = "ok";
     R.best_restart = best;
     R.fit_cost = fit.cost;

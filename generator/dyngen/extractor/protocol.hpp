@@ -21,6 +21,7 @@ struct Problem {
     double mass_hi{};
     std::vector<Block> blocks{};
     std::vector<Block> next_blocks{};
+    bool nearest{};
     std::vector<std::vector<Term>> equalities{};
     double margin{};
     int restarts{};
@@ -40,7 +41,7 @@ Problem read_problem(const std::string &path) {
     Reader r(path);
     Problem P;
     r.expect("dyngen-extraction");
-    r.expect("2");
+    r.expect("3");
     r.expect("parameters");
     if (r.integer() != kParameters) throw std::runtime_error("parameter count does not match this robot");
     r.expect("lower");
@@ -68,6 +69,8 @@ Problem read_problem(const std::string &path) {
     P.blocks = read_blocks(r);
     r.expect("next_blocks");
     P.next_blocks = read_blocks(r);
+    r.expect("nearest");
+    P.nearest = static_cast<bool>(r.integer());
     r.expect("equalities");
     P.equalities = read_terms(r);
     r.expect("margin");
@@ -101,7 +104,7 @@ Problem read_problem(const std::string &path) {
 void write_problem(const std::string &path, const Problem &P) {
     std::ofstream out(path);
     out << std::setprecision(17);
-    out << "dyngen-extraction 2\nparameters " << kParameters << '\n';
+    out << "dyngen-extraction 3\nparameters " << kParameters << '\n';
     out << "lower";
     for (int k = 0; k < kParameters; ++k) out << ' ' << P.lower[k];
     out << '\n';
@@ -151,6 +154,8 @@ void write_problem(const std::string &path, const Problem &P) {
         for (int i = 0; i < b.v.size(); ++i) out << (i ? " " : "") << b.v[i];
         out << '\n';
     }
+    out << "nearest";
+    out << ' ' << P.nearest << '\n';
     out << "equalities";
     out << ' ' << P.equalities.size() << '\n';
     for (const std::vector<Term> &poly : P.equalities) {
@@ -229,7 +234,7 @@ void write_field(std::ostream &out, const char *key, const T &value) {
 void write_result(const std::string &path, const Result &R) {
     std::ofstream out(path);
     out << std::setprecision(17);
-    out << "dyngen-extraction-result 2\nlinks " << kLinks << '\n';
+    out << "dyngen-extraction-result 3\nlinks " << kLinks << '\n';
     write_field(out, "restarts", R.restarts);
     write_field(out, "consistent", R.consistent);
     write_field(out, "restart_costs", R.restart_costs);
@@ -261,7 +266,7 @@ Result read_result(const std::string &path) {
     Reader r(path);
     Result R;
     r.expect("dyngen-extraction-result");
-    r.expect("2");
+    r.expect("3");
     r.expect("links");
     if (r.integer() != kLinks) throw std::runtime_error("link count does not match this robot");
     r.expect("restarts");

@@ -24,8 +24,11 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
         f"# Conditioning: {conditioning}. Rows weighted by 1 / sigma_j (per-joint noise below); "
         f"regularisation toward the prior: {c.regularisation:g}.",
         "# Torque model: Y(q, qd, qdd) pi(links) + Fc tanh(qd / vs) + Fv qd + offset + Ia qdd"
-        + (" + tilt columns dg" if c.tilt_model is not None else "") + ".",
-        "# std: of the unconstrained weighted least squares of the same columns (uncorrelated residuals assumed).",
+        + (" + ripple a cos q + b sin q" if np.any(np.isfinite(c.friction["ripple_cos"])) else "")
+        + (" + the torque of gravity turned by the base tilt" if c.tilt_model is not None else "")
+        + "; Fc >= 0, Ia >= 0, Fv >= 0 (or Fc + Fv v_max >= 0 where friction falls with speed).",
+        "# std: of the unconstrained weighted least squares of the same columns, a sandwich estimate over blocks of "
+        "the residual's correlation time (holds for correlated residuals).",
         f"robot: {robot.name}",
         "links:",
     ]
@@ -45,9 +48,9 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
                      f"sigma: {_f(c.sigma[j])}}}   # joint {j + 1}; std Fc {std('coulomb')}, Fv {std('viscous')}, "
                      f"offset {std('offset')}, Ia {std('armature')}")
     if c.tilt_model is not None:
-        dg = c.friction["tilt"]
-        lines.append(f"tilt: {{dg: [{_f(dg[0])}, {_f(dg[1])}, 0]}}   # m/s^2, horizontal gravity in the base frame "
-                     f"({np.degrees(np.arctan2(np.hypot(*dg), 9.81)):.2f} deg)")
+        dg = tilt_change(c)
+        lines.append(f"tilt: {{dg: [{_f(dg[0])}, {_f(dg[1])}, {_f(dg[2])}], angle_deg: {_f(c.tilt_deg())}}}   "
+                     "# m/s^2: the change of the gravity vector in the base frame (a rotation: its size is kept)")
     lines.append(f"identified:\n  full:   # base coefficients of the links above; condition number {ols.condition:.3g} "
                  f"(weighted, with the friction columns; columns scaled {ols.scaled_condition:.3g})")
     for i in range(r):
@@ -55,6 +58,14 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
             else f"std {ols.std[i]:.3g}, unconstrained fit {ols.values[i]:.6g}"
         lines.append(f'    - {{coefficient: "{c.names[i]}", value: {float(c.pi[i])!r}}}   # {note}')
     return "\n".join(lines) + "\n"
+
+
+def tilt_change(c) -> np.ndarray:
+    """The tilt's change of the gravity vector in the base frame [m/s^2]."""
+    from .tilt import change, directions, gravity_of
+
+    g = gravity_of(c.tilt_model[0])
+    return directions(g).T @ change(g, c.friction["tilt"])
 
 
 def consistent_table(c) -> str:
@@ -84,9 +95,12 @@ def summary_lines(robot, c) -> list[str]:
         + (f" Ia {c.friction['armature'][j]:.3g}" if np.isfinite(c.friction['armature'][j]) else "")
         for j in range(n)))
     if c.tilt_model is not None:
-        dg = c.friction["tilt"]
-        out.append(f"  base tilt: dg = ({dg[0]:+.3g}, {dg[1]:+.3g}, 0) m/s^2 "
-                   f"({np.degrees(np.arctan2(np.hypot(*dg), 9.81)):.2f} deg)")
+        dg = tilt_change(c)
+        out.append(f"  base tilt: {c.tilt_deg():.2f} deg (gravity changed by ({dg[0]:+.3g}, {dg[1]:+.3g}, {dg[2]:+.2g}) m/s^2 "
+                   "in the base frame)")
+    if c.groups:
+        out.append("  optional parts chosen on held-out stretches of the fit data (kept where they gain more than a "
+                   "standard error): " + groups_text(c.groups))
     out.append("  every link consistent: lambda_min(tr(I)/2 E - I) = " + ", ".join(f"{x:.2e}" for x in c.lambda_min))
     if c.ols.unexcited:
         out.append(f"  {len(c.ols.unexcited)} coefficient(s) not excited by the data (set by the prior and "
@@ -97,6 +111,24 @@ def summary_lines(robot, c) -> list[str]:
         out.append(f"  parameters at a bound of the YAML: {', '.join(c.at_bounds)}")
     negative = [j + 1 for j in range(n) if c.friction["viscous"][j] < 0]
     if negative:
-        out.append(f"  viscous friction below 0 on joint(s) {', '.join(map(str, negative))} (Coulomb friction falling with "
-                   "speed, still opposing motion up to the velocity limit); left out of the MJCF/URDF damping")
+        out.append(f"  viscous friction below 0 on joint(s) {', '.join(map(str, negative))} (friction falling with "
+                   "speed, chosen on held-out data; it still opposes motion up to the velocity limit); left out of the "
+                   "MJCF/URDF damping")
+    out += [f"  note: {note}" for note in c.notes]
     return out
+
+
+def groups_text(groups) -> str:
+    """e.g. "base tilt kept; position ripple on joint(s) 5, 7 (not 1, 3, 4, 6); ..."."""
+    parts = []
+    title = {"tilt": "base tilt", "ripple": "position ripple", "falling": "friction allowed to fall with speed"}
+    for name in dict.fromkeys(g[0] for g in groups):
+        rows = [g for g in groups if g[0] == name]
+        if rows[0][1] is None:
+            parts.append(f"{title.get(name, name)} {'kept' if rows[0][4] else 'left out'}")
+            continue
+        kept = [str(g[1]) for g in rows if g[4]]
+        out = [str(g[1]) for g in rows if not g[4]]
+        parts.append(f"{title.get(name, name)} on joint(s) {', '.join(kept) or 'none'}"
+                     + (f" (not {', '.join(out)})" if kept and out else ""))
+    return "; ".join(parts)

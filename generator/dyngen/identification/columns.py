@@ -1,0 +1,149 @@
+"""The identification's columns beside the rigid body's base regressor, per recording.
+
+Per joint j (its rows only):
+  coulomb      tanh(qd_j(t - lag_j) / vs_j)   Coulomb friction, smoothed, following the velocity
+               with a lag; a switching signal, so it is passed through the recording's own
+               low-pass, like the torque it explains (a filtered friction step is compared with
+               a filtered step, not a sharp one; as the diagnosis does, diagnosis/design.py)
+  viscous      qd_j
+  offset       1
+  armature     qdd_j (rotor inertia, where the rigid body does not carry it already)
+  ripple_cos   cos q_j   }  a first harmonic of position (cables, gear ripple):
+  ripple_sin   sin q_j   }  the optional group "ripple"
+and for the arm, the optional group "tilt": ("tilt", 0) and ("tilt", 1), the torques of a
+horizontal gravity component (identification/tilt.py), in every joint's rows.
+The smooth columns are functions of the filtered motion, filtered already.
+
+A label is (kind, j): j the joint (0-based), or for the tilt the direction (0, 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+PER_JOINT = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
+GROUPS = {"ripple": ("ripple_cos", "ripple_sin"), "tilt": ("tilt",)}  # optional groups and their kinds
+BOUNDED = ("coulomb", "viscous", "armature")  # kinds whose value is held >= 0 (see consistent.py)
+
+
+def kinds_of(names) -> tuple:
+    """Column kinds of user names: "ripple" stands for cos q_j and sin q_j."""
+    wanted = set(names)
+    for group, kinds in GROUPS.items():
+        if group in wanted:
+            wanted |= set(kinds)
+    return tuple(k for k in PER_JOINT if k in wanted)
+
+
+def group_of(label) -> str | None:
+    kind = label[0]
+    return next((g for g, kinds in GROUPS.items() if kind in kinds), None)
+
+
+def name_of(label) -> str:
+    kind, j = label
+    return f"tilt dg_{'xy'[j]}" if kind == "tilt" else f"{kind} j{j + 1}"
+
+
+def lagged(t, x, lag: float) -> np.ndarray:
+    """x(t - lag), held at x(t_0) before the start."""
+    return x if lag <= 0 else np.interp(t - lag, t, x)
+
+
+def switching_filter(signals):
+    """The filter the recording's torques went through, for columns that switch with the sign of
+    the velocity: the recording's own low-pass, redesigned for this sampling rate where the
+    samples were decimated after filtering (the diagnosis's pieces); identity without one."""
+    lowpass = getattr(signals, "lowpass", None)
+    cutoff = getattr(signals, "cutoff", None)
+    if lowpass is None or cutoff is None or len(signals.t) < 16:
+        return lambda x: x
+    rate = signals.rate
+    designed = getattr(lowpass, "rate", None)
+    if designed is None or abs(designed - rate) <= 1e-3 * rate:
+        return signals.filtered
+    if not cutoff < 0.45 * rate:
+        return lambda x: x
+    sos = signal.butter(4, cutoff, btype="low", fs=rate, output="sos")
+    return lambda x: signal.sosfiltfilt(sos, x, axis=0)
+
+
+def coulomb_matrix(signals, smoothing, lags) -> np.ndarray:
+    """(T, N): tanh(qd_j(t - lag_j) / vs_j), through the recording's filter."""
+    qd = signals.qd
+    lags = np.zeros(qd.shape[1]) if lags is None else lags
+    raw = np.column_stack([np.tanh(lagged(signals.t, qd[:, j], lags[j]) / smoothing[j]) for j in range(qd.shape[1])])
+    return switching_filter(signals)(raw)
+
+
+def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
+    """(T,): the column of (kind, j) in joint j's rows (coulomb: from coulomb_matrix)."""
+    if kind == "coulomb":
+        return coulomb[:, j]
+    if kind == "viscous":
+        return signals.qd[:, j]
+    if kind == "offset":
+        return np.ones(len(signals.t))
+    if kind == "armature":
+        return signals.qdd[:, j]
+    if kind == "ripple_cos":
+        return np.cos(signals.q[:, j])
+    if kind == "ripple_sin":
+        return np.sin(signals.q[:, j])
+    raise ValueError(kind)
+
+
+@dataclass
+class Piece:
+    """One recording as the fit sees it: its data samples only (the filter's start-up cut at
+    both ends), the regressor evaluated once, and which part (fold) each sample belongs to."""
+
+    signals: object  # the conditioned recording, whole (columns are computed on it, then cut)
+    keep: slice  # the data samples
+    Yj: np.ndarray  # (N, T, r) base regressor at the kept samples, joint by joint
+    tau: np.ndarray  # (T, N)
+    part: np.ndarray  # (T,) fold index
+    columns: dict  # label -> (T,) for a joint's label (its rows), (T, N) for an arm label
+
+    def column(self, label, coulomb_full=None, tilt=None) -> np.ndarray:
+        kind, j = label
+        if kind == "tilt":
+            return tilt[..., j]
+        return joint_column(self.signals, kind, j, coulomb_full)[self.keep]
+
+
+def piece(model, signals, part: np.ndarray | int) -> Piece:
+    """The recording's regressor and torques at its data samples; part: per sample or one for all."""
+    T = len(signals.t)
+    k = int(getattr(signals, "trim", 0) or 0)
+    keep = slice(k, T - k) if 0 < k and 2 * k < T else slice(0, T)
+    Y = model.batch("regressor", signals.q[keep], signals.qd[keep], signals.qdd[keep])
+    n = Y.shape[0]
+    part = np.full(n, part, dtype=int) if np.ndim(part) == 0 else np.asarray(part, dtype=int)
+    Yj = np.ascontiguousarray(Y.transpose(1, 0, 2))
+    return Piece(signals, keep, Yj, np.asarray(signals.tau[keep], dtype=float), part, {})
+
+
+def contiguous_parts(signals, folds: int) -> np.ndarray:
+    """Per data sample, its part 0 .. folds - 1: contiguous stretches of equal duration. Held-out
+    parts are other stretches of motion, not samples interleaved with the fit (which the fit
+    would predict almost as well as its own, favouring no regularisation)."""
+    T = len(signals.t)
+    k = int(getattr(signals, "trim", 0) or 0)
+    t = signals.t[k:T - k] if 0 < k and 2 * k < T else signals.t
+    u = (t - t[0]) / max(t[-1] - t[0], 1e-300)
+    return np.minimum((u * folds).astype(int), folds - 1)
+
+
+def fill(pieces, labels, smoothing, lags, tilt_values=None) -> None:
+    """Every piece's column values for labels (tilt_values(signals at the kept samples) ->
+    (T, N, 2) for the tilt labels)."""
+    for p in pieces:
+        coulomb = coulomb_matrix(p.signals, smoothing, lags) if any(k == "coulomb" for k, _ in labels) else None
+        tilt = None
+        if any(k == "tilt" for k, _ in labels):
+            tilt = tilt_values(p.signals.q[p.keep])
+        p.columns = {lab: p.column(lab, coulomb, tilt) for lab in labels}

@@ -1,0 +1,135 @@
+"""Normal equations per part (fold) and joint: everything the identification needs from ~10^5
+rows, in matrices of ~10^2 x 10^2, formed once.
+
+For part p and joint j (the rows of joint j at the samples of part p), with A the columns there
+(the base regressor's row of joint j, then every label's column, global order: coefficients,
+then labels) and b the measured torques:
+
+    G[p, j] = A^T A,   g[p, j] = A^T b,   bb[p, j] = b^T b,   n[p, j] = rows
+
+A joint's friction column meets only that joint's rows, so A has the coefficients, the joint's
+own labels and the arm's (tilt) labels. Any fit on any union of parts with per-joint weights is
+then a sum of these blocks, and its residual on any part is bb - 2 x^T g + x^T G x: the
+cross-validation's folds, the noise estimate and every candidate model come from them without
+touching the rows again.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .least_squares import WEAK
+
+
+def segments(part: np.ndarray) -> list:
+    """(part, slice) of every run of equal part values (parts are contiguous stretches)."""
+    if part.size == 0:
+        return []
+    cuts = np.flatnonzero(np.diff(part)) + 1
+    starts, stops = np.r_[0, cuts], np.r_[cuts, part.size]
+    return [(int(part[a]), slice(int(a), int(b))) for a, b in zip(starts, stops)]
+
+
+def local_labels(labels, j: int) -> list[int]:
+    """Indices of the labels whose column is non-zero in joint j's rows."""
+    return [k for k, (kind, jj) in enumerate(labels) if kind == "tilt" or jj == j]
+
+
+def _in_rows(v: np.ndarray, j: int) -> np.ndarray:
+    """A label's column in joint j's rows ((T,) for a joint's label, (T, N) for the arm's)."""
+    return v[:, j] if v.ndim == 2 else v
+
+
+def joint_design(piece, labels, j: int, ks) -> np.ndarray:
+    """(T, r + len(ks)): joint j's rows of the piece, coefficients then labels ks."""
+    return np.hstack([piece.Yj[j]] + [_in_rows(piece.columns[labels[k]], j)[:, None] for k in ks])
+
+
+class Normal:
+    def __init__(self, r: int, labels: list, parts: int, dof: int):
+        self.r, self.labels, self.dof = r, list(labels), dof
+        c = r + len(labels)
+        self.G = np.zeros((parts, dof, c, c))
+        self.g = np.zeros((parts, dof, c))
+        self.bb = np.zeros((parts, dof))
+        self.n = np.zeros((parts, dof))
+
+    @classmethod
+    def build(cls, pieces, labels, r: int, parts: int, dof: int) -> "Normal":
+        out = cls(r, labels, parts, dof)
+        for piece in pieces:
+            for j in range(dof):
+                ks = local_labels(labels, j)
+                idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]
+                A = joint_design(piece, labels, j, ks)
+                b = piece.tau[:, j]
+                for p, sl in segments(piece.part):
+                    Am, bm = A[sl], b[sl]
+                    out.G[p, j][np.ix_(idx, idx)] += Am.T @ Am
+                    out.g[p, j][idx] += Am.T @ bm
+                    out.bb[p, j] += bm @ bm
+                    out.n[p, j] += bm.size
+        return out
+
+    def replaced(self, pieces, changes: dict) -> "Normal":
+        """A copy in which label k's column is values(piece) ((T,) or (T, N), as piece.columns)
+        for every k: values of changes (the pieces' columns are updated)."""
+        out = Normal.__new__(Normal)
+        out.r, out.labels, out.dof = self.r, self.labels, self.dof
+        out.G, out.g, out.bb, out.n = self.G.copy(), self.g.copy(), self.bb, self.n
+        for k, values in changes.items():  # one after the other: each row meets the columns as they are now
+            i = self.r + k
+            out.G[:, :, i, :] = out.G[:, :, :, i] = 0.0
+            out.g[:, :, i] = 0.0
+            label = self.labels[k]
+            joints = range(self.dof) if label[0] == "tilt" else [label[1]]
+            for piece in pieces:
+                piece.columns[label] = values(piece)
+                for j in joints:
+                    out._row(piece, j, k)
+        return out
+
+    def _row(self, piece, j: int, k: int) -> None:
+        """Adds label k's row and column of joint j's blocks (zero before) from the piece."""
+        i = self.r + k
+        ks = local_labels(self.labels, j)
+        idx = self.r + np.asarray(ks, dtype=int)
+        others = [_in_rows(piece.columns[self.labels[kk]], j) for kk in ks]
+        c = others[ks.index(k)]
+        for p, sl in segments(piece.part):
+            cs = c[sl]
+            cross_y = piece.Yj[j][sl].T @ cs
+            cross_f = np.array([o[sl] @ cs for o in others])
+            for G in (self.G[p, j][:, i], self.G[p, j][i, :]):
+                G[:self.r] += cross_y
+                G[idx] += cross_f
+            self.G[p, j][i, i] -= cs @ cs  # added twice above
+            self.g[p, j][i] += cs @ piece.tau[sl, j]
+
+    def total(self, parts, weights=None, keep=None) -> tuple[np.ndarray, np.ndarray]:
+        """(A^T W A, A^T W b) over the given parts, joint j's rows weighted by weights[j]^2,
+        restricted to the columns `keep` (indices, default all)."""
+        w2 = np.ones(self.dof) if weights is None else np.asarray(weights, dtype=float) ** 2
+        G = np.einsum("pjab,j->ab", self.G[parts], w2)
+        g = np.einsum("pja,j->a", self.g[parts], w2)
+        if keep is not None:
+            G, g = G[np.ix_(keep, keep)], g[keep]
+        return G, g
+
+    def sse(self, x, parts, keep=None) -> np.ndarray:
+        """(len(parts), N): sum of squared residuals of x (over the columns keep) per part and joint."""
+        if keep is not None:
+            full = np.zeros(self.G.shape[-1])
+            full[keep] = x
+            x = full
+        G, g, bb = self.G[parts], self.g[parts], self.bb[parts]
+        return np.maximum(bb - 2 * np.einsum("pja,a->pj", g, x) + np.einsum("pjab,a,b->pj", G, x, x), 0.0)
+
+
+def solve_unconstrained(G, g, weak: float = WEAK) -> np.ndarray:
+    """Least squares through the normal equations of unit-norm columns, the pseudo-inverse cut at
+    weak^2 of the largest eigenvalue (directions the data do not excite get no value)."""
+    scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
+    ev, V = np.linalg.eigh(G / np.outer(scale, scale))
+    keep = ev > weak ** 2 * ev[-1]
+    return (V[:, keep] @ ((V[:, keep].T @ (g / scale)) / ev[keep])) / scale
