@@ -33,7 +33,7 @@ def render_inertia_regressor(prefix: str, joint_models, motions, base, doc: str)
     real = f"{prefix}_real"
     code = straight_line(prefix, joint_models, motions, motions.outputs)
     body = code.body + [
-        f"/* S[i(i+1)/2 + j]: angular and linear acceleration of link i+1 (frame i+1, at its origin)",
+        "/* S[i(i+1)/2 + j]: angular and linear acceleration of link i+1 (frame i+1, at its origin)",
         " * when joint j+1 accelerates at 1 and nothing else moves (no gravity) */",
         f"const {real} S[{len(motions.outputs) // 6}][6] = {{"]
     for i in range(n):
@@ -45,7 +45,7 @@ def render_inertia_regressor(prefix: str, joint_models, motions, base, doc: str)
     body.append("};")
     links, kinds = column_links_and_kinds(base.pivots)
     body += [
-        f"/* Y: entry (M[j][k], column c) is phi over S_j, S_k of link column_link[c] for",
+        "/* Y: entry (M[j][k], column c) is phi over S_j, S_k of link column_link[c] for",
         " * j <= k <= column_link[c], else 0; phi by the column's standard parameter (derivation/inertia.py) */",
         f"const unsigned char column_link[{rank}] = {{{', '.join(map(str, links))}}};",
         f"const unsigned char column_kind[{rank}] = {{{', '.join(map(str, kinds))}}};"
