@@ -110,7 +110,7 @@ STEPS = {"identify": (identify_parser, (IdentifyOptions, ConsistentOptions, Cond
          "excite": (excite_parser, (Settings, Sampling))}
 # A value other than the default for every option of these steps, as typed on the command line.
 TYPED = {"kind": ("gravity", "gravity"), "ols": (None, True), "consistent": (None, True),
-         "friction": ("coulomb, ripple", ("coulomb", "ripple")), "smoothing": ("0.01", 0.01),
+         "friction": ("coulomb, ripple", ("coulomb", "ripple")), "candidates": ("tilt", ("tilt",)), "smoothing": ("0.01", 0.01),
          "regularisation": ("3", 3.0), "tilt": (None, True), "cutoff": ("none", None), "order": ("2", 2),
          "differentiate": (None, True), "effects": ("offset,gain", ("offset", "gain")), "min_gain": ("0.1", 0.1),
          "sign_velocity": ("0.01", 0.01), "reidentify": (None, True), "seed": ("7", 7), "period": ("5", 5.0),
@@ -157,6 +157,8 @@ def test_the_help_of_every_step_shows_the_dataclass_defaults(step):
 
 @pytest.mark.parametrize("step, option", [("identify", ["--order", "0"]), ("identify", ["--cutoff", "nan"]),
                                           ("identify", ["--smoothing", "0"]), ("identify", ["--kind", "all"]),
+                                          ("identify", ["--candidates", "tilt,wobble"]),
+                                          ("identify", ["--friction", "coulomb,stiction"]),
                                           ("diagnose", ["--min-gain", "2"]), ("diagnose", ["--sign-velocity", "0"]),
                                           ("excite", ["--margin", "0"]), ("excite", ["--iterations", "0"]),
                                           ("excite", ["--seed", "-1"])])

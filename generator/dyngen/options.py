@@ -25,7 +25,8 @@ def option(default, help: str, *, flag: str = "", metavar: str = "", choices: tu
     """A dataclass field with what argparse and the YAML check need. flag: the command-line
     flag (default --name-with-dashes); bounds: (lowest, highest) for numbers, the lowest
     itself excluded with above; repeat: a tuple of strings given by repeating the flag (a YAML
-    list); listed: a tuple of names given as one comma-separated argument; parse: the
+    list); listed: a tuple of names given as one comma-separated argument (with choices: each
+    one of them); parse: the
     argparse type of an option that is none of these (e.g. a number or a word). A bool
     default makes an on/off flag; const, a flag without argument that sets this value (for a
     default None meaning "decided from the data", e.g. --tilt)."""
@@ -62,7 +63,7 @@ def add_arguments(group, cls) -> None:
             kwargs["action"] = "store_true"
         elif m["repeat"]:
             kwargs["action"] = "append"
-        elif m["choices"]:
+        elif m["choices"] and not m["listed"]:
             kwargs["choices"] = m["choices"]
         else:
             kwargs["type"] = _parser(f)
@@ -86,7 +87,7 @@ def _parser(f):
     if m["parse"]:
         return m["parse"]
     if m["listed"]:
-        return names
+        return _names_of(m["choices"]) if m["choices"] else names
     kind, bounds = type(default_of(f)), m["bounds"] or (-math.inf, math.inf)
     return whole(*bounds) if kind is int else real(*bounds, above=m["above"])
 
@@ -94,6 +95,19 @@ def _parser(f):
 def names(text: str) -> tuple:
     """A comma-separated list of names, e.g. "coulomb, viscous" (empty entries left out)."""
     return tuple(x.strip() for x in text.split(",") if x.strip())
+
+
+def _names_of(known: tuple):
+    """names(), each one of `known` (an unknown one is refused with the flag named)."""
+    def parse(text: str) -> tuple:
+        given = names(text)
+        unknown = [x for x in given if x not in known]
+        if unknown:
+            raise argparse.ArgumentTypeError(f"unknown name(s) {', '.join(unknown)}; expected some of "
+                                             f"{', '.join(known)}")
+        return given
+
+    return parse
 
 
 def _what(kind, bounds) -> str:
@@ -137,6 +151,10 @@ def check_yaml(cls, block: dict, fail, prefix: str) -> dict:
         elif m["listed"]:
             if not (isinstance(value, list) and all(isinstance(x, str) for x in value)):
                 fail(where, f"expected a list of names, got {shorten(repr(value), 40)}")
+            unknown = [x for x in value if m["choices"] and x not in m["choices"]]
+            if unknown:
+                fail(where, f"unknown name(s) {shorten(', '.join(unknown), 40)}; expected some of "
+                     f"{', '.join(m['choices'])}")
             value = tuple(value)
         elif m["choices"]:
             if value not in m["choices"]:

@@ -65,12 +65,12 @@ class ConsistentOptions:
     `dyngen identify` flags (dyngen.options), the rest the method's own settings."""
 
     friction: tuple = option(DEFAULT_KINDS, "per-joint columns always in: " + ", ".join(CHOICES)
-                             + " (ripple: cos q_j, sin q_j)", metavar="LIST", listed=True)
+                             + " (ripple: cos q_j, sin q_j)", metavar="LIST", listed=True, choices=CHOICES)
     candidates: tuple = option(CANDIDATES, "optional parts of the model, each kept only where held-out stretches "
                                "of the fit data ask for it: ripple (cos q_j, sin q_j per joint), tilt (a tilted "
                                "base), falling (friction falling with speed per joint: viscous below 0, still "
                                "opposing motion up to the velocity limit); 'none' for none", metavar="LIST",
-                               listed=True)
+                               listed=True, choices=CANDIDATES + ("none",))
     smoothing: float | None = option(None, "Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint "
                                      "(default: chosen per joint on the fit data)", metavar="V",
                                      parse=real(0, 100, above=True))

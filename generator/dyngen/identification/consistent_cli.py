@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
 from ..options import resolve
 
 
@@ -18,18 +17,12 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     from ..data.parameters_file import read_link_parameters
     from ..export import write_all
     from ..commands.recordings import conditioning_text, read_all
-    from .consistent import CANDIDATES, CHOICES, ConsistentOptions, identify_consistent
+    from .consistent import ConsistentOptions, identify_consistent
     from .consistent_output import consistent_table, consistent_yaml, summary_lines
 
     options = resolve(ConsistentOptions, args, {})
-    if options.candidates == ("none",):
+    if "none" in options.candidates:  # names were checked by the parser (options.py)
         options = replace(options, candidates=())
-    for flag, given, known in (("--friction", options.friction, CHOICES),
-                               ("--candidates", options.candidates, CANDIDATES)):
-        unknown = [x for x in given if x not in known]
-        if unknown:
-            raise InputError(flag, "", f"unknown name(s) {', '.join(unknown)}; expected some of "
-                             f"{', '.join(sorted(known))}")
     if args.prior:
         options = replace(options, prior=read_link_parameters(args.prior, robot.dof))
     select = read_all(args.select, robot, args) if args.select else None
