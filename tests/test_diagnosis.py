@@ -189,6 +189,15 @@ def test_direction_dependent_coulomb_and_position_ripple(lwr):
     assert near_noise(d, 1.5)
 
 
+def test_without_test_data_the_selection_data_are_judged(lwr):
+    """No test recording: the figures are the selection data's, and the report says so."""
+    model, robot, arm, p, trajectories = lwr
+    t, at, q, qd, qdd, tau = trajectories["fit"]
+    d = diagnose(robot, model, p, [signals("fit", t, q, qd, qdd, noisy(tau + 0.3, NOISE, 0))])
+    assert d.judged_on == "selection" and any("no test recording" in w for w in d.warnings)
+    assert max(d.rms_after) < 1.3 * NOISE and len(d.rms_simple) == 7
+
+
 @pytest.mark.parametrize("name", ["lwr", "panda", "stanford"])
 def test_gravity_matrix_against_pinocchio(name):
     """The tilt effect's G(q) (numpy forward kinematics) times gravity equals Pinocchio's g(q),

@@ -190,7 +190,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     judged_moments = design.test if judged == "test" else design.select
     before = judged_moments.c / max(judged_moments.count, 1)
     effects_mse = judged_moments.mse(final.slots, final.x) if chosen else before.copy()
-    simple_mse = _simple_mse(segments, simple, judged, n)
+    simple_mse = _simple_mse(segments, simple, "test" if judged == "test" else "select", n)
     completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
     mask = (lambda seg: seg.test) if judged == "test" else (lambda seg: seg.select)
     used = [seg for seg in segments if mask(seg).any()]
