@@ -18,7 +18,7 @@ from ..catalogue import STANDARD_FROM_DYNAMIC
 from . import baseline as simple_model
 from . import design as dz
 from . import joints, phases, reidentify, roles
-from .correlation import integrated_time
+from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
 from .refine import refine, restricted

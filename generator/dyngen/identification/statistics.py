@@ -15,7 +15,7 @@ means) estimate
     Cov(x) = H^-1 S H^-1,   H = A^T W A,   S = sum_b s_b s_b^T,   s_b = sum_{t in block b} a_t w_t e_t
 
 over contiguous blocks b of BLOCK_TIMES integrated autocorrelation times of the residual
-(diagnosis/correlation.py's estimate, the largest over joints), at least MIN_BLOCKS of them:
+(data/correlation.py's estimate, the largest over joints), at least MIN_BLOCKS of them:
 the scores' variance as the data show it, whatever the residual's correlation, its change of
 size along the motion, or a model error that comes and goes with the motion (a sticking joint at
 rest). Where the data are too short for MIN_BLOCKS such blocks, the textbook deviation scaled by
@@ -27,28 +27,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..data.correlation import integrated_time
 from .least_squares import WEAK, Estimate
 from .normal import joint_design, local_labels
 
 BLOCK_TIMES = 20  # block length in integrated autocorrelation times of the residual
 MIN_BLOCKS = 10
-
-
-def integrated_time(x: np.ndarray, max_lag: int | None = None) -> float:
-    """1 + 2 sum_k rho_k, summed until rho first drops below 0.05 (diagnosis/correlation.py)."""
-    x = np.asarray(x, dtype=float)
-    x = x - x.mean()
-    n = x.size
-    if n < 4 or not np.any(x):
-        return 1.0
-    size = 1 << int(np.ceil(np.log2(2 * n)))
-    spectrum = np.fft.rfft(x, size)
-    acf = np.fft.irfft(spectrum * np.conj(spectrum), size)[:n]
-    rho = acf / acf[0]
-    limit = min(n - 1, max_lag or n // 4)
-    below = np.flatnonzero(rho[1:limit + 1] < 0.05)
-    stop = below[0] + 1 if below.size else limit + 1
-    return float(max(1.0, 1.0 + 2.0 * rho[1:stop].sum()))
 
 
 def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int) -> list:
