@@ -268,3 +268,19 @@ def test_diagnose_cli_writes_report_json_figures_and_model(lwr, tmp_path):
     assert r.returncode != 0 and r.stderr.strip().count("\n") == 0, r.stderr
     assert "bad.csv: line 10, column q4: nan (NaN or infinite value)" in r.stderr
     assert not (tmp_path / "none").exists()
+
+
+def test_a_per_joint_effect_pays_for_what_it_spoils_elsewhere():
+    """selection_gain: a per-joint effect is credited with its own joint's relative decrease of
+    the selection mean square only, and charged for any increase on the other joints (through
+    the arm-wide values refitted with it); an arm-wide effect gets the sum over joints."""
+    from types import SimpleNamespace
+
+    from dyngen.diagnosis.selection import selection_gain
+
+    before = np.array([1.0, 4.0, 2.0])
+    after = np.array([1.1, 2.0, 1.0])  # joint 1 10 % worse, joint 2 and 3 halved
+    assert selection_gain(SimpleNamespace(joint=1), before, after) == pytest.approx(0.5 - 0.1)
+    assert selection_gain(SimpleNamespace(joint=2), before, after) == pytest.approx(0.5 - 0.1)
+    assert selection_gain(SimpleNamespace(joint=0), before, after) == pytest.approx(-0.1)
+    assert selection_gain(SimpleNamespace(joint=None), before, after) == pytest.approx(-0.1 + 0.5 + 0.5)

@@ -5,8 +5,8 @@ are fitted on the fit samples and compared on the selection samples:
 
   effects    the selected effects as fitted together (the diagnosis's findings);
   simple     b + Fc tanh(qd/0.02) + Fv qd alone;
-  completed  the effects acting on the joint plus the simple model's three columns, refitted on
-             that joint (the arm-wide effects' torque kept as it is): a joint whose effects
+  completed  the effects acting on the joint as fitted, plus the simple model's three columns
+             fitted to what they leave on that joint: a joint whose effects
              were each chosen for a large gain may still lack an offset or a plain friction
              term that none of them covers.
 
@@ -20,6 +20,12 @@ more values on the joint must gain `min_gain` of the mean square per extra value
 effect must gain to be selected at all), so that three numbers fitting noise do not replace a
 one-value finding, and six ripple harmonics do not displace the simple model on a whim. The decision is made with the values fitted on the fit samples only;
 `apply` then sets each joint's correction with the final values.
+
+With selection on blocks of the fit data, the errors are summed over the three cuts
+(run._decide_on_folds), so every fit sample is judged once and the sums are far less noisy
+than one selection set's: there an extra value must gain FOLDS_PER_VALUE (2 %) instead. Values
+that fit noise change a held-out error by about 2 sqrt(k) / N_eff of it (N_eff: independent
+samples, a few hundred in 25 s at 200 Hz), so 2 % per value is still several times that.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ from . import baseline
 from . import design as dz
 
 EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple", "consistent parameters"
+FOLDS_PER_VALUE = 0.02  # least gain per extra value on errors summed over the three cuts (see above)
 
 
 def _split(chosen, x):
@@ -54,17 +61,23 @@ def _parts(context, chosen, x, seg, j):
 
 
 def _completed_fit(context, chosen, x, segments, j):
-    """Least squares of [per-joint effects on j, simple columns] to the residual left by the
-    arm-wide effects, on the fit samples; returns the values."""
+    """Values of [per-joint effects on j, simple columns]: the effects' as fitted (x), the
+    simple columns' by least squares to what all the effects leave on joint j, on the fit
+    samples. (Refitting the effects with the simple columns let an offset and a position
+    ripple's low harmonics, nearly collinear over a short range, take large values of
+    opposite sign.)"""
+    own = [v for c, v in zip(chosen, _split(chosen, x)) if c.joint == j]
+    own = np.concatenate(own) if own else np.zeros(0)
     rows, targets = [], []
     for seg in segments:
         if not seg.fit.any():
             continue
         arm, columns = _parts(context, chosen, x, seg, j)
-        A = np.column_stack(columns + [baseline.columns(seg.signals)[:, j, :]])
-        rows.append(A[seg.fit])
-        targets.append((seg.residual[:, j] - arm)[seg.fit])
-    return np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]
+        effects = np.column_stack(columns) @ own if columns else 0.0
+        rows.append(baseline.columns(seg.signals)[seg.fit, j, :])
+        targets.append((seg.residual[:, j] - arm - effects)[seg.fit])
+    simple = np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]
+    return np.concatenate([own, simple])
 
 
 def _completed_predict(context, chosen, x, values, seg, j):

@@ -22,7 +22,7 @@ from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
 from .refine import refine, restricted
-from .selection import forward, prune, selection_gain, solve
+from .selection import forward, orphans, prune, selection_gain, solve
 
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
@@ -139,20 +139,15 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         return _correlation(segments, design.weights)
 
     selection = forward(design, options.min_gain, options.alpha)
-    # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
-    # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
-    design, chosen = refine(context, segments, design, selection.chosen)
-    chosen, tau_corr, dropped = prune(design, chosen, correlation, options.alpha)
-    narrow = _narrow_stribeck(chosen)
-    chosen = [c for c in chosen if c not in narrow]
-    dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
-    if dropped:
-        design, chosen = refine(context, segments, design, chosen)
-    chosen, final, refused = _plausible(design, chosen)
-    design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
+    design, chosen, final, dropped, refused = _settled(context, segments, design, selection.chosen, correlation,
+                                                       options)
     if chosen:
-        design = _reweighted(design, final)
-        final = solve(design, chosen)
+        # Once more with each joint weighted by what the effects leave of its residual: an
+        # effect kept only to make up for another fitted with the nominal weights goes now.
+        design, chosen, final, dropped_now, refused_now = _settled(
+            context, segments, _reweighted(design, final), chosen, correlation, options)
+        dropped += dropped_now
+        refused += refused_now
     correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
     # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
     # compared on the selection samples (joints.py).
@@ -232,6 +227,23 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     return result
 
 
+def _settled(context, segments, design, chosen, correlation, options):
+    """The selected effects with their settings refined, those that no longer pay for their
+    values pruned, implausible ones refused: (design, chosen, final fit, dropped, refused)."""
+    # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
+    # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
+    design, chosen = refine(context, segments, design, chosen)
+    chosen, _, dropped = prune(design, chosen, correlation, options.alpha, options.min_gain)
+    narrow = _narrow_stribeck(chosen)
+    chosen = [c for c in chosen if c not in narrow]
+    dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
+    if dropped:
+        design, chosen = refine(context, segments, design, chosen)
+    chosen, final, refused = _plausible(design, chosen)
+    design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
+    return design, chosen, final, dropped, refused
+
+
 def _decide_on_folds(context, segments, design, chosen, final, options) -> list[str]:
     """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS ways of
     cutting the fit recordings into fit and selection blocks, each model refitted per fold. One
@@ -257,7 +269,7 @@ def _decide_on_folds(context, segments, design, chosen, final, options) -> list[
     finally:
         for seg, (fit, select, correction) in zip(segments, saved):
             seg.fit, seg.select, seg.correction = fit, select, correction
-    return joints.choose(totals, chosen, options.min_gain)
+    return joints.choose(totals, chosen, joints.FOLDS_PER_VALUE)
 
 
 def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):
@@ -316,6 +328,9 @@ def _plausible(design, chosen):
         offset = sum(c.size for c in chosen[:chosen.index(worst)])
         refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
         chosen = [c for c in chosen if c is not worst]
+        gone = orphans(chosen)  # a Stribeck term whose Coulomb was refused goes with it
+        refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone]
+        chosen = [c for c in chosen if c not in gone]
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):

@@ -15,8 +15,13 @@ value before the step, on the candidate's own joint (per-joint effects) or summe
     sensor gain lies within 50 % of one: Effect.plausible), so a column that merely happens
     to resemble the residual is not claimed as that effect.
 
-Then prune() drops, one by one, selected effects whose values are not significant once the
-deviations are scaled for the correlation in time of the residual they leave.
+An effect that only adds to another on its joint (Effect.extends: Stribeck's static friction
+above the Coulomb level) is tried once that one is selected, and goes when it goes.
+
+Then prune() drops, one by one, selected effects that no longer pay their way with all the
+others in (settings refined, run.py): first those whose selection gain has fallen below the
+price they paid to enter, then those whose values are not significant once the deviations are
+scaled for the correlation in time of the residual they leave.
 
 Among candidates within 10 % of the best gain, the one with fewest values wins (a payload is
 preferred to the 43 coefficient errors that could also express it), and a secondary effect
@@ -144,10 +149,14 @@ def selection_mse(design, chosen) -> np.ndarray:
 
 def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
     """Relative decrease of the selection mean square: on the candidate's own joint for a
-    per-joint effect (a refit of arm-wide effects must not lend it credit from other joints),
-    summed over joints for an arm-wide effect."""
+    per-joint effect, less any increase it causes on other joints (a refit of arm-wide effects
+    must not lend it credit from other joints, but it is charged for what that refit spoils
+    there); summed over joints for an arm-wide effect."""
     relative = (before - after) / np.maximum(before, 1e-300)
-    return float(relative[candidate.joint] if candidate.joint is not None else relative.sum())
+    if candidate.joint is None:
+        return float(relative.sum())
+    others = np.delete(relative, candidate.joint)
+    return float(relative[candidate.joint] + np.minimum(others, 0.0).sum())
 
 
 def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps: int = 30) -> Selection:
@@ -160,7 +169,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
         families = {c.family for c in selection.chosen}
         trials = []
         for cand in design.candidates:
-            if cand.family in families:
+            if cand.family in families or not _based(cand, selection.chosen):
                 continue
             chosen = selection.chosen + [cand]
             fit = solve(design, chosen, covariance=False)
@@ -186,9 +195,21 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
     return selection
 
 
-def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list, float, list]:
-    """Backward elimination: drop an effect whose selection gain, with all the others kept, is
-    not positive; then, with deviations scaled by the correlation time of the residual the
+def _based(candidate, chosen) -> bool:
+    """Whether the effect a candidate extends (Effect.extends) is chosen on its joint."""
+    base = candidate.effect.extends
+    return not base or any(c.effect.name == base and c.joint == candidate.joint for c in chosen)
+
+
+def orphans(chosen) -> list:
+    """Chosen candidates whose base effect (Effect.extends) is not chosen on their joint."""
+    return [c for c in chosen if not _based(c, chosen)]
+
+
+def prune(design, chosen: list, correlation, alpha: float = ALPHA, min_gain: float = 0.0) -> tuple[list, float, list]:
+    """Backward elimination: drop the effect whose selection gain, with all the others kept, is
+    furthest below `min_gain` per value (the price of entry in forward(); 0: below nothing but
+    zero); then, with deviations scaled by the correlation time of the residual the
     chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
     effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
     chosen, dropped = list(chosen), []
@@ -198,13 +219,19 @@ def prune(design, chosen: list, correlation, alpha: float = ALPHA) -> tuple[list
         if not chosen:
             return chosen, tau, dropped
         with_all = design.select.mse(fit.slots, fit.x)
-        # An effect that no longer helps on selection data once the others are in goes first.
+        # An effect that no longer pays on selection data once the others are in goes first.
         gains = [selection_gain(c, selection_mse(design, [o for o in chosen if o is not c]), with_all) for c in chosen]
-        if min(gains) <= 0:
-            dropped.append(chosen.pop(int(np.argmin(gains))).key)
+        margin = [g - min_gain * np.sqrt(c.size) for g, c in zip(gains, chosen)]  # over the price of entry
+        worst = int(np.argmin(margin))
+        if margin[worst] < 0 or gains[worst] <= 0:
+            dropped.append(chosen.pop(worst).key)
+            for c in orphans(chosen):
+                dropped.append(chosen.pop(chosen.index(c)).key)
             continue
         pvalues = [p_value(fit, c, chosen, tau) for c in chosen]
         worst = int(np.argmax(pvalues))
         if pvalues[worst] <= alpha:
             return chosen, tau, dropped
         dropped.append(chosen.pop(worst).key)
+        for c in orphans(chosen):
+            dropped.append(chosen.pop(chosen.index(c)).key)

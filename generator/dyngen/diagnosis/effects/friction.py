@@ -122,6 +122,10 @@ class Viscous(_Dissipative):
 class Stribeck(_Dissipative):
     name, parameters, units = "stribeck", ("Fs",), ("Nm",)
     refinable = switching = True
+    # Static friction above the Coulomb level. Alone, it would be friction that vanishes at
+    # speed, which no joint has, and the viscous law would then take the Coulomb level's place
+    # (extrapolating steeply beyond the fit speeds).
+    extends = "coulomb"
 
     def __init__(self, velocity: float):
         self.velocity = float(velocity)
