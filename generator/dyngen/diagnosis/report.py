@@ -160,7 +160,7 @@ def markdown(d, sources: dict) -> str:
 
             lines += ["```"] + consistent_summary(SimpleNamespace(name=d.robot, dof=d.joints), d.reidentified) \
                 + ["```", ""]
-    lines += ["## Candidates tried alone (selection gain)", "",
+    lines += ["## Candidates tried alone (selection gain; Stribeck beside its Coulomb term)", "",
               ", ".join(f"{c['candidate']} {c['selection_gain']:+.3f}" for c in d.candidates[:15]), ""]
     return "\n".join(lines)
 

@@ -9,6 +9,7 @@ effects, test_signals are used for nothing but the reported held-out residual (r
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -176,6 +177,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         for seg in segments:
             seg.fit = seg.fit | seg.select
         simple = simple_model.fit(segments)
+        # position laws now known over every fit sample's positions
+        context = dataclasses.replace(context, q_range=_fit_range(segments), cache={})
         if chosen:
             design, chosen = restricted(context, segments, design, chosen)
             final = solve(design, chosen)
@@ -264,18 +267,27 @@ def _decide_on_folds(context, segments, design, chosen, final, options) -> list[
             for seg, mine in zip(segments, own):
                 if mine:
                     seg.fit, seg.select = roles.blocks(seg.signals, options.block_seconds, phase)
+            # Position laws are known only over the positions this cut's fit blocks cover, as the
+            # final model's are over all the fit data (else a ripple would be judged on guesses).
+            fold = dataclasses.replace(context, q_range=_fit_range(segments), cache={})
             x = np.zeros(0)
             if chosen:
-                fold_design, fold_chosen = restricted(context, segments, design, chosen)
+                fold_design, fold_chosen = restricted(fold, segments, design, chosen)
                 x = solve(fold_design, fold_chosen, covariance=False).x
             for seg in segments:
-                seg.correction = predict(context, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
-            sse = joints.errors(context, segments, chosen, x, simple_model.fit(segments))
+                seg.correction = predict(fold, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
+            sse = joints.errors(fold, segments, chosen, x, simple_model.fit(segments))
             totals = sse if totals is None else [{k: a[k] + b[k] for k in a} for a, b in zip(totals, sse)]
     finally:
         for seg, (fit, select, correction) in zip(segments, saved):
             seg.fit, seg.select, seg.correction = fit, select, correction
     return joints.choose(totals, chosen, joints.FOLDS_PER_VALUE)
+
+
+def _fit_range(segments) -> tuple:
+    """(low, high) per joint of the positions the segments' fit samples cover."""
+    q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
+    return q.min(axis=0), q.max(axis=0)
 
 
 def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):

@@ -62,6 +62,7 @@ class Selection:
     chosen: list  # Candidate, in the order selected
     steps: list = field(default_factory=list)  # per step: {"candidate", "gain", "score"}
     first_gains: dict = field(default_factory=dict)  # candidate key -> gain when tried alone
+    # (an extension, Effect.extends: when first tried, beside its base effect)
 
 
 def solve(design, chosen, block: slice | None = None, covariance: bool = True) -> Fit:
@@ -175,7 +176,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             fit = solve(design, chosen, covariance=False)
             mse = design.select.mse(fit.slots, fit.x)
             gain = selection_gain(cand, current, mse)
-            if not selection.chosen:
+            if not selection.chosen or (cand.effect.extends and cand.key not in selection.first_gains):
                 selection.first_gains[cand.key] = gain
             if gain >= min_gain * np.sqrt(cand.size) and cand.effect.plausible(fit.x[-cand.size:]):
                 size = len(fit.x)
