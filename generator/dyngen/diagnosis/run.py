@@ -145,10 +145,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     if chosen:
         # Once more with each joint weighted by what the effects leave of its residual: an
         # effect kept only to make up for another fitted with the nominal weights goes now.
-        # The settings stay unless an effect goes (refined again, a Coulomb scale and a Stribeck
-        # velocity on one joint drift together until the two laws merge).
         design, chosen, final, dropped_now, refused_now = _settled(
-            context, segments, _reweighted(design, final), chosen, correlation, options, settings=False)
+            context, segments, _reweighted(design, final), chosen, correlation, options)
         dropped += dropped_now
         refused += refused_now
     correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
@@ -232,16 +230,12 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     return result
 
 
-def _settled(context, segments, design, chosen, correlation, options, settings=True):
-    """The selected effects with their settings refined (with `settings`; else kept as they
-    are, unless an effect goes), those that no longer pay for their values pruned, implausible
-    ones refused: (design, chosen, final fit, dropped, refused)."""
+def _settled(context, segments, design, chosen, correlation, options):
+    """The selected effects with their settings refined, those that no longer pay for their
+    values pruned, implausible ones refused: (design, chosen, final fit, dropped, refused)."""
     # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
     # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
-    if settings:
-        design, chosen = refine(context, segments, design, chosen)
-    else:
-        design, chosen = restricted(context, segments, design, chosen)
+    design, chosen = refine(context, segments, design, chosen)
     chosen, _, dropped = prune(design, chosen, correlation, options.alpha, options.min_gain)
     narrow = _narrow_stribeck(chosen)
     chosen = [c for c in chosen if c not in narrow]
