@@ -141,7 +141,9 @@ def _refine_one(state, index) -> None:
             if step <= REFINE_TOLERANCE * max(np.linalg.norm(setting), 1e-12):
                 return
         return
-    interval = effect.search_interval(state.values(index))
+    joint = state.chosen[index].joint
+    beside = tuple(c.effect for i, c in enumerate(state.chosen) if i != index and joint is not None and c.joint == joint)
+    interval = effect.search_interval(state.values(index), beside)
     if interval is None:
         return
 

@@ -86,9 +86,10 @@ class Effect:
         iteration): that setting; others None."""
         return None
 
-    def search_interval(self, values: np.ndarray) -> tuple[float, float] | None:
+    def search_interval(self, values: np.ndarray, beside: tuple = ()) -> tuple[float, float] | None:
         """Refinable effects whose setting is independent of their values: where to search
-        it (refined by scalar search); others None."""
+        it (refined by scalar search), given the other effects on its joint (`beside`); others
+        None."""
         return None
 
     def at(self, setting: float) -> "Effect":

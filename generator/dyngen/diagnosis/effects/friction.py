@@ -23,6 +23,9 @@ import numpy as np
 
 from .base import Effect
 
+# A Stribeck velocity below this many Coulomb velocity scales only reshapes the Coulomb law:
+# tanh(3) = 0.995, so beyond it the Coulomb law has switched before static friction decays.
+STRIBECK_WIDER = 3.0
 RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable
 
 
@@ -49,8 +52,12 @@ class Coulomb(_Dissipative):
     def setting(self):
         return self.velocity
 
-    def search_interval(self, values):
-        return self.velocity / 4, self.velocity * 4  # reaches the neighbouring variants
+    def search_interval(self, values, beside=()):
+        # Reaches the neighbouring variants; below a Stribeck velocity on the joint (static
+        # friction breaks away within the Coulomb transition and decays after it; a Coulomb scale
+        # refined freely drifts up to the Stribeck velocity until the two laws merge).
+        hi = min([self.velocity * 4] + [e.velocity / STRIBECK_WIDER for e in beside if isinstance(e, Stribeck)])
+        return min(self.velocity / 4, hi), hi
 
     def at(self, setting):
         return Coulomb(setting)
@@ -138,16 +145,20 @@ class Stribeck(_Dissipative):
     def setting(self):
         return self.velocity
 
-    def search_interval(self, values):
-        return self.velocity / 3, self.velocity * 3  # reaches the neighbouring variants
+    def search_interval(self, values, beside=()):
+        # Reaches the neighbouring variants; no narrower than STRIBECK_WIDER times the joint's
+        # Coulomb scale (see reshapes).
+        lo = max([self.velocity / 3] + [STRIBECK_WIDER * e.velocity for e in beside if isinstance(e, Coulomb)])
+        return lo, max(self.velocity * 3, lo)
 
     def at(self, setting):
         return Stribeck(setting)
 
     def reshapes(self, other):
-        """No wider than twice the joint's Coulomb velocity scale: there the two laws trade
-        shape with each other, and no static friction is shown."""
-        return isinstance(other, Coulomb) and self.velocity < 2 * other.velocity
+        """No wider than STRIBECK_WIDER times the joint's Coulomb velocity scale (up to the
+        search's 1 % tolerance: refined onto that bound): there the two laws trade shape with
+        each other, and no static friction is shown."""
+        return isinstance(other, Coulomb) and self.velocity < 1.02 * STRIBECK_WIDER * other.velocity
 
     @classmethod
     def friction_terms(cls, values, variant):
