@@ -176,7 +176,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
             seg.fit = seg.fit | seg.select
         simple = simple_model.fit(segments)
         # position laws now known over every fit sample's positions
-        context = dataclasses.replace(context, q_range=_fit_range(segments), cache={})
+        context = _ranged(context, segments, chosen)
         if chosen:
             design, chosen = restricted(context, segments, design, chosen)
             final = solve(design, chosen)
@@ -263,7 +263,7 @@ def _decide_on_folds(context, segments, design, chosen, final, options) -> list[
                     seg.fit, seg.select = roles.blocks(seg.signals, options.block_seconds, phase)
             # Position laws are known only over the positions this cut's fit blocks cover, as the
             # final model's are over all the fit data (else a ripple would be judged on guesses).
-            fold = dataclasses.replace(context, q_range=_fit_range(segments), cache={})
+            fold = _ranged(context, segments, chosen)
             x = np.zeros(0)
             if chosen:
                 fold_design, fold_chosen = restricted(fold, segments, design, chosen)
@@ -278,10 +278,13 @@ def _decide_on_folds(context, segments, design, chosen, final, options) -> list[
     return joints.choose(totals, chosen, joints.FOLDS_PER_VALUE)
 
 
-def _fit_range(segments) -> tuple:
-    """(low, high) per joint of the positions the segments' fit samples cover."""
+def _ranged(context, segments, chosen):
+    """The context with the positions the segments' fit samples cover (Context.q_range), if a
+    chosen effect depends on them (Effect.ranged); else the context itself (and its cache)."""
+    if not any(c.effect.ranged for c in chosen):
+        return context
     q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
-    return q.min(axis=0), q.max(axis=0)
+    return dataclasses.replace(context, q_range=(q.min(axis=0), q.max(axis=0)), cache={})
 
 
 def _reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):

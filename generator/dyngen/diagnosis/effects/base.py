@@ -49,6 +49,7 @@ class Effect:
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
     suspect = ""  # a symptom rather than a cause: why, reported with a warning
     secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
+    ranged = False  # its columns depend on the positions the fit data cover (Context.q_range)
     extends = ""  # name of the effect this one only adds to, on the same joint (selected first, dropped with it)
     switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
     simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")

@@ -81,6 +81,7 @@ class Direction(Effect):
 class Ripple(Effect):
     HARMONICS = (1, 2, 3)
     name = "ripple"
+    ranged = True
     parameters = tuple(f"{ab}{k}" for k in HARMONICS for ab in ("a", "b"))
     units = ("Nm",) * (2 * len(HARMONICS))
 
