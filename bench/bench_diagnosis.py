@@ -122,7 +122,8 @@ def main():
         "# Diagnosis speed (bench/bench_diagnosis.py)", "",
         f"LWR (7 joints), paper's parameters; a fit and a test recording of {DURATION:g} s at {RATE:g} Hz "
         f"({samples} samples each; selection on blocks of the fit recording); friction on joint 2, offset on "
-        f"joint 5, white noise {NOISE} Nm; {len(d.candidates)} candidate effects. Twice: with exact qd, qdd "
+        f"joint 5, white noise {NOISE} Nm; {len(d.candidates)} candidate effects tried (Stribeck only beside its "
+        f"joint's Coulomb term). Twice: with exact qd, qdd "
         "columns (no filter), and with positions from a 20-bit encoder with 1e-5 rad noise and no qd, qdd "
         f"(cutoff chosen from the data: {efit.cutoff:.3g} Hz; every effect column filtered like the torque).", "",
         "| step | time [s] |", "|---|---:|",

@@ -142,7 +142,8 @@ def _refine_one(state, index) -> None:
                 return
         return
     joint = state.chosen[index].joint
-    beside = tuple(c.effect for i, c in enumerate(state.chosen) if i != index and joint is not None and c.joint == joint)
+    beside = tuple(c.effect for i, c in enumerate(state.chosen)
+                   if i != index and joint is not None and c.joint == joint)
     interval = effect.search_interval(state.values(index), beside)
     if interval is None:
         return
