@@ -18,7 +18,7 @@ from oracles.random_params import random_parameters
 from synthetic import fourier, noisy, rigid_torques, signals
 
 from dyngen.description import load_robot
-from dyngen.diagnosis import diagnose
+from dyngen.diagnosis import Options, diagnose
 from dyngen.diagnosis.effects import gravity_matrix
 from dyngen.runtime import load
 
@@ -151,6 +151,30 @@ def test_time_shift(lwr):
     assert [e["effect"] for e in d.selected] == ["time_shift"]
     assert d.selected[0]["values"]["dt"] == pytest.approx(dt, rel=0.1)
     assert near_noise(d)
+
+
+def test_one_late_joint_is_no_time_shift_of_the_arm(lwr):
+    """Only joint 2's torque recorded 8 ms late: the arm's torque channel is not shifted. With
+    the time shift the only candidate (it gains on joint 2 alone), nothing is claimed: an
+    arm-wide effect must show on more than one joint. All joints late: it is claimed."""
+    model, robot, arm, p, trajectories = lwr
+    dt = 0.008
+    only_shift = Options(effects=("time_shift",))
+
+    def measured(late_joints):
+        data = []
+        for k, name in enumerate(("fit", "held")):
+            t, at, q, qd, qdd, tau = trajectories[name]
+            out = tau.copy()
+            out[:, late_joints] = rigid_torques(arm, p, *at(t - dt))[:, late_joints]
+            data.append(signals(name, t, q, qd, qdd, noisy(out, NOISE, k)))
+        return data
+
+    fit, held = measured([1])
+    assert diagnose(robot, model, p, [fit], None, only_shift, test=[held]).selected == []
+    fit, held = measured(list(range(7)))
+    d = diagnose(robot, model, p, [fit], None, only_shift, test=[held])
+    assert [e["effect"] for e in d.selected] == ["time_shift"]
 
 
 def test_rotor_inertia_and_gain(lwr):

@@ -15,6 +15,9 @@ value before the step, on the candidate's own joint (per-joint effects) or summe
     sensor gain lies within 50 % of one: Effect.plausible), so a column that merely happens
     to resemble the residual is not claimed as that effect.
 
+An arm-wide effect must gain `min_gain` on at least two joints' selection data: a time shift,
+tilt or payload loads every joint, and one joint's gain is that joint's own business.
+
 An effect that only adds to another on its joint (Effect.extends: Stribeck's static friction
 above the Coulomb level) is tried once that one is selected, and goes when it goes.
 
@@ -178,7 +181,8 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
             gain = selection_gain(cand, current, mse)
             if not selection.chosen or (cand.effect.extends and cand.key not in selection.first_gains):
                 selection.first_gains[cand.key] = gain
-            if gain >= min_gain * np.sqrt(cand.size) and cand.effect.plausible(fit.x[-cand.size:]):
+            if gain >= min_gain * np.sqrt(cand.size) and cand.effect.plausible(fit.x[-cand.size:]) \
+                    and _shown(cand, current, mse, min_gain):
                 size = len(fit.x)
                 fit = solve(design, chosen, block=slice(size - cand.size, size))
                 trials.append((gain, cand, mse, fit, chosen))
@@ -194,6 +198,16 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
         selection.steps.append({"candidate": cand.key, "gain": gain, "selection_rms": np.sqrt(mse).tolist()})
         current = mse
     return selection
+
+
+def _shown(candidate, before, after, min_gain) -> bool:
+    """An arm-wide effect (a time shift, a tilt, a payload) acts on every joint it loads: it
+    must gain min_gain on at least two joints' selection data (on one, that joint's own
+    effects are the plainer explanation)."""
+    if candidate.joint is None:
+        relative = (before - after) / np.maximum(before, 1e-300)
+        return int(np.sum(relative >= min_gain)) >= min(2, len(relative))
+    return True
 
 
 def _based(candidate, chosen) -> bool:
