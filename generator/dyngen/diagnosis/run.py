@@ -23,7 +23,7 @@ from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
 from .refine import refine, restricted
-from .selection import forward, orphans, prune, selection_gain, solve
+from .selection import forward, prune, selection_gain, solve, without
 
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
@@ -342,10 +342,8 @@ def _plausible(design, chosen):
         worst = bad[0]
         offset = sum(c.size for c in chosen[:chosen.index(worst)])
         refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
-        chosen = [c for c in chosen if c is not worst]
-        gone = orphans(chosen)  # a Stribeck term whose Coulomb was refused goes with it
-        refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone]
-        chosen = [c for c in chosen if c not in gone]
+        chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
+        refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone[1:]]
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):

@@ -156,7 +156,7 @@ def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
     per-joint effect, less any increase it causes on other joints (a refit of arm-wide effects
     must not lend it credit from other joints, but it is charged for what that refit spoils
     there); summed over joints for an arm-wide effect."""
-    relative = (before - after) / np.maximum(before, 1e-300)
+    relative = _relative(before, after)
     if candidate.joint is None:
         return float(relative.sum())
     others = np.delete(relative, candidate.joint)
@@ -205,9 +205,14 @@ def _shown(candidate, before, after, min_gain) -> bool:
     must gain min_gain on at least two joints' selection data (on one, that joint's own
     effects are the plainer explanation)."""
     if candidate.joint is None:
-        relative = (before - after) / np.maximum(before, 1e-300)
+        relative = _relative(before, after)
         return int(np.sum(relative >= min_gain)) >= min(2, len(relative))
     return True
+
+
+def _relative(before: np.ndarray, after: np.ndarray) -> np.ndarray:
+    """Per joint relative decrease of the selection mean square."""
+    return (before - after) / np.maximum(before, 1e-300)
 
 
 def _based(candidate, chosen) -> bool:
@@ -216,9 +221,12 @@ def _based(candidate, chosen) -> bool:
     return not base or any(c.effect.name == base and c.joint == candidate.joint for c in chosen)
 
 
-def orphans(chosen) -> list:
-    """Chosen candidates whose base effect (Effect.extends) is not chosen on their joint."""
-    return [c for c in chosen if not _based(c, chosen)]
+def without(chosen, cand) -> tuple[list, list]:
+    """(chosen less cand and the effects that extend it on its joint (Effect.extends), the
+    candidates removed: cand first)."""
+    kept = [c for c in chosen if c is not cand]
+    gone = [c for c in kept if not _based(c, kept)]
+    return [c for c in kept if c not in gone], [cand] + gone
 
 
 def prune(design, chosen: list, correlation, alpha: float = ALPHA, min_gain: float = 0.0) -> tuple[list, float, list]:
@@ -228,6 +236,12 @@ def prune(design, chosen: list, correlation, alpha: float = ALPHA, min_gain: flo
     chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
     effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
     chosen, dropped = list(chosen), []
+
+    def drop(index):
+        nonlocal chosen
+        chosen, gone = without(chosen, chosen[index])
+        dropped.extend(c.key for c in gone)
+
     while True:
         fit = solve(design, chosen)
         tau = correlation(chosen, fit)
@@ -239,14 +253,10 @@ def prune(design, chosen: list, correlation, alpha: float = ALPHA, min_gain: flo
         margin = [g - min_gain * np.sqrt(c.size) for g, c in zip(gains, chosen)]  # over the price of entry
         worst = int(np.argmin(margin))
         if margin[worst] < 0 or gains[worst] <= 0:
-            dropped.append(chosen.pop(worst).key)
-            for c in orphans(chosen):
-                dropped.append(chosen.pop(chosen.index(c)).key)
+            drop(worst)
             continue
         pvalues = [p_value(fit, c, chosen, tau) for c in chosen]
         worst = int(np.argmax(pvalues))
         if pvalues[worst] <= alpha:
             return chosen, tau, dropped
-        dropped.append(chosen.pop(worst).key)
-        for c in orphans(chosen):
-            dropped.append(chosen.pop(chosen.index(c)).key)
+        drop(worst)
