@@ -303,8 +303,25 @@ def test_a_per_joint_effect_pays_for_what_it_spoils_elsewhere():
     from dyngen.diagnosis.selection import selection_gain
 
     before = np.array([1.0, 4.0, 2.0])
-    after = np.array([1.1, 2.0, 1.0])  # joint 1 10 % worse, joint 2 and 3 halved
-    assert selection_gain(SimpleNamespace(joint=1), before, after) == pytest.approx(0.5 - 0.1)
-    assert selection_gain(SimpleNamespace(joint=2), before, after) == pytest.approx(0.5 - 0.1)
-    assert selection_gain(SimpleNamespace(joint=0), before, after) == pytest.approx(-0.1)
-    assert selection_gain(SimpleNamespace(joint=None), before, after) == pytest.approx(-0.1 + 0.5 + 0.5)
+    after = np.array([1.25, 2.0, 1.0])  # joint 1 worse by a fifth of its new error, joints 2 and 3 halved
+    assert selection_gain(SimpleNamespace(joint=1), before, after) == pytest.approx(0.5 - 0.2)
+    assert selection_gain(SimpleNamespace(joint=2), before, after) == pytest.approx(0.5 - 0.2)
+    assert selection_gain(SimpleNamespace(joint=0), before, after) == pytest.approx(-0.2)
+    assert selection_gain(SimpleNamespace(joint=None), before, after) == pytest.approx(-0.2 + 0.5 + 0.5)
+
+
+def test_undoing_a_step_scores_minus_the_step():
+    """Pruning judges an effect by removing it, selection by adding it: the two must agree. An
+    arm-wide effect that removes 90 % of joint 1's error and doubles joint 2's (the real LWR's
+    tilt on measurement 2: joint 1 against joint 4) gains 0.9 - 0.5 either way, not 0.9 - 1 on
+    the way in and 1 - 0.5 ... on the way out."""
+    from types import SimpleNamespace
+
+    from dyngen.diagnosis.selection import selection_gain
+
+    without, with_it = np.array([1.0, 0.01]), np.array([0.1, 0.02])
+    arm = SimpleNamespace(joint=None)
+    assert selection_gain(arm, without, with_it) == pytest.approx(0.9 - 0.5)
+    assert selection_gain(arm, with_it, without) == pytest.approx(-(0.9 - 0.5))
+    # a joint made 100 times worse costs at most its whole error, as one made perfect gains it
+    assert selection_gain(arm, np.array([1.0, 1.0]), np.array([0.0, 100.0])) == pytest.approx(1.0 - 0.99)

@@ -3,8 +3,9 @@
 Fit: weighted least squares on the fit samples, every joint's rows divided by the RMS of
 its nominal residual there (so a joint with a large residual does not drown the others).
 Gain: on the selection samples, the decrease of the residual's mean square relative to its
-value before the step, on the candidate's own joint (per-joint effects) or summed over joints
-(arm-wide effects). A step adds the candidate with the largest selection gain if
+value before the step (an increase relative to its value after: undoing a step scores minus
+the step), on the candidate's own joint (per-joint effects) or summed over joints (arm-wide
+effects). A step adds the candidate with the largest selection gain if
 
   - the gain is at least `min_gain` per fitted value (default 0.05: 5 % of one joint's current
     selection mean square for a one-value effect, 30 % for the six values of a position
@@ -211,8 +212,12 @@ def _shown(candidate, before, after, min_gain) -> bool:
 
 
 def _relative(before: np.ndarray, after: np.ndarray) -> np.ndarray:
-    """Per joint relative decrease of the selection mean square."""
-    return (before - after) / np.maximum(before, 1e-300)
+    """Per joint relative change of the selection mean square, a decrease positive: the change
+    over the larger of the two, so that undoing a step scores exactly minus the step (over
+    `before` alone, an effect that halves one joint and doubles another would gain 0.5 - 1 on
+    the way in, 1 - 0.5 on the way out, and pruning would judge what selection did not), and
+    no joint counts for more than its whole error either way."""
+    return (before - after) / np.maximum(np.maximum(before, after), 1e-300)
 
 
 def _based(candidate, chosen) -> bool:
