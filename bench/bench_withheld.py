@@ -89,12 +89,14 @@ def main(argv=None) -> int:
     ap.add_argument("--rates", default="200,500,1000", help="encoder recordings at these rates [Hz]")
     ap.add_argument("--noise-free-rate", type=float, default=1000.0, help="rate of the noise-free variant (0: none)")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--bits", type=int, default=20, help="encoder resolution: steps of 2 pi / 2^bits rad")
+    ap.add_argument("--position-noise", type=float, default=1e-5, help="encoder noise [rad] before quantisation")
     ap.add_argument("--results", type=Path, default=ROOT / "bench" / "results" / "withheld.md")
     args = ap.parse_args(argv)
     robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(ROOT / "generated" / "lwr")
     sections = []
     start = time.perf_counter()
-    variants = [(float(r), Encoder()) for r in args.rates.split(",") if r]
+    variants = [(float(r), Encoder(noise=args.position_noise, bits=args.bits)) for r in args.rates.split(",") if r]
     if args.noise_free_rate:
         variants.append((args.noise_free_rate, None))
     with tempfile.TemporaryDirectory(prefix="withheld-") as tmp:
@@ -106,7 +108,8 @@ def main(argv=None) -> int:
                 doc = write_cases(folder, rate_hz=rate, seed=args.seed, cases=cases, encoder=encoder)
                 rows += run_folder(robot, model, folder, doc, label)
             seconds = [r["seconds"] for r in main_rows]
-            how = ("positions from a 20-bit encoder with 1e-5 rad noise, no qd or qdd columns" if encoder else
+            how = (f"positions from a {args.bits}-bit encoder with {args.position_noise:g} rad noise, no qd or qdd columns"
+                   if encoder else
                    "exact positions, velocities and accelerations in the files (the noise-free variant)")
             sections += [f"## {label}: {how}", "",
                          f"**{summary(main_rows)}** ({len(CASES) + len(TRACKED_CASES)} cases x 2 directions; the "
@@ -118,7 +121,8 @@ def main(argv=None) -> int:
     text = "\n".join([
         "# Diagnosis on withheld effects, recorded as real arms record (bench/bench_withheld.py)", "",
         f"`python bench/bench_withheld.py --rates {args.rates} --noise-free-rate {args.noise_free_rate:g} "
-        f"--seed {args.seed}` ({time.perf_counter() - start:.0f} s). Default options of `dyngen diagnose`: the "
+        f"--seed {args.seed} --bits {args.bits} --position-noise {args.position_noise:g}` "
+        f"({time.perf_counter() - start:.0f} s). Default options of `dyngen diagnose`: the "
         "conditioning decides the filter from each recording; fit on one trajectory with selection on blocks of it; "
         "test on the other trajectory, which plays no other part. Pass: exactly the injected effects on their joints, "
         "magnitudes within 20 %, test RMS after within 1.5 x the perfect model's test RMS on the same conditioned data "

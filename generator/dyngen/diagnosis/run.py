@@ -23,7 +23,7 @@ from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
 from .refine import refine, restricted
-from .selection import forward, prune, selection_gain, solve, without
+from .selection import forward, prune, relative_change, selection_gain, solve, without
 
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
@@ -472,7 +472,7 @@ def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
     rest = solve(design, others)
     mse_without = design.select.mse(rest.slots, rest.x) if others else design.select.c / max(design.select.count, 1)
     mse_with = design.select.mse(final.slots, final.x)
-    gain_per_joint = (mse_without - mse_with) / np.maximum(mse_without, 1e-300)
+    gain_per_joint = relative_change(mse_without, mse_with)
     gain = selection_gain(cand, mse_without, mse_with)
     joints = [cand.joint + 1] if cand.joint is not None else \
         [j + 1 for j in range(len(gain_per_joint)) if gain_per_joint[j] >= min_gain]

@@ -157,7 +157,7 @@ def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
     per-joint effect, less any increase it causes on other joints (a refit of arm-wide effects
     must not lend it credit from other joints, but it is charged for what that refit spoils
     there); summed over joints for an arm-wide effect."""
-    relative = _relative(before, after)
+    relative = relative_change(before, after)
     if candidate.joint is None:
         return float(relative.sum())
     others = np.delete(relative, candidate.joint)
@@ -206,12 +206,12 @@ def _shown(candidate, before, after, min_gain) -> bool:
     must gain min_gain on at least two joints' selection data (on one, that joint's own
     effects are the plainer explanation)."""
     if candidate.joint is None:
-        relative = _relative(before, after)
+        relative = relative_change(before, after)
         return int(np.sum(relative >= min_gain)) >= min(2, len(relative))
     return True
 
 
-def _relative(before: np.ndarray, after: np.ndarray) -> np.ndarray:
+def relative_change(before: np.ndarray, after: np.ndarray) -> np.ndarray:
     """Per joint relative change of the selection mean square, a decrease positive: the change
     over the larger of the two, so that undoing a step scores exactly minus the step (over
     `before` alone, an effect that halves one joint and doubles another would gain 0.5 - 1 on
