@@ -185,7 +185,7 @@ def test_the_valid_corpus_base_is_accepted(tmp_path, cache):
     assert (tmp_path / "gen" / "tiny" / "manifest.json").exists()
 
 
-@pytest.mark.parametrize("delay", [0.4, 1.0, 2.0])
+@pytest.mark.parametrize("delay", [0.15, 0.4, 1.0, 2.0])
 def test_interrupt_is_one_line_and_leaves_nothing(delay, tmp_path, cache):
     """Ctrl-C at any point after the interpreter has started (docs/untrusted-input.md: the first
     ~0.1 s are Python's own start-up)."""

@@ -159,3 +159,23 @@ def test_cli_on_a_two_effect_case(folder, diagnosed, tmp_path):
     assert np.allclose(d["rms_after"], api["rms_after"], rtol=1e-9)
     report = (tmp_path / "diag" / "report.md").read_text()
     assert "## Test residual" in report and "simple model b + Fc tanh(qd/0.02) + Fv qd" in report
+
+
+COARSE = Encoder(noise=5e-5, bits=17)  # a 17-bit encoder (steps of 4.8e-5 rad), as many arms have
+
+
+def test_a_coarse_encoder_at_100_hz_claims_no_static_friction_spike(tmp_path):
+    """17-bit positions at 100 Hz, Coulomb friction on joints 1 and 6, fit on Table V: the filter
+    (3.3 Hz, chosen from the data) rounds the reversals, and a Stribeck term of 9.8 Nm at
+    0.006 rad/s beside the 1-Nm Coulomb level stood in for that rounding (and took joint 6's
+    Coulomb term with it). Static friction above STATIC_EXCESS Coulomb levels is no joint's:
+    refused."""
+    from dyngen.diagnosis.effects.friction import STATIC_EXCESS
+
+    case = next(c for c in CASES if c.name == "coulomb")
+    robot, model = load_robot(LWR), load(ROOT / "generated" / "lwr")
+    doc = write_cases(tmp_path, rate_hz=100.0, cases=[case], encoder=COARSE)
+    r = run(robot, model, tmp_path, doc, "coulomb", "backward")
+    assert r["problems"] == [], "\n".join(r["problems"])
+    refused = [x for x in r["diagnosis"]["refused"] if x["candidate"].startswith("stribeck")]
+    assert refused and all(x["values"][0] > STATIC_EXCESS * 1.0 for x in refused)

@@ -2,14 +2,33 @@
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
 
 from . import __version__, blas
+
+
+def _interrupted_while_loading(signum, frame):
+    # Ctrl-C while the modules below load: a KeyboardInterrupt raised inside the import
+    # machinery can leave a module lock held, and the traceback Python then prints needs an
+    # import itself: the process hung, silent (loaded CI machine, Ctrl-C at 1 s). Nothing has
+    # been written yet, so leaving at once is clean.
+    os.write(2, b"dyngen: interrupted\n")
+    os._exit(130)
+
+
+_LOADING = signal.getsignal(signal.SIGINT) is signal.default_int_handler  # not when SIGINT is ignored
+if _LOADING:
+    signal.signal(signal.SIGINT, _interrupted_while_loading)
 
 blas.use_one_thread()  # before numpy loads: the imports below load it
 
 from .commands import diagnose, excite, extract, generate, identify  # noqa: E402
 from .errors import DriverError, Infeasible, InputError  # noqa: E402
+
+if _LOADING:  # from here on, Ctrl-C unwinds (main below): partial outputs are removed on the way
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 MAIN_HELP = """\
 dyngen: robot dynamic models as exact, standalone C from a DH table.

@@ -54,6 +54,15 @@ class Moments:
         return np.maximum(sse, 0.0) / max(self.count, 1)
 
 
+def split_values(chosen, x) -> list[np.ndarray]:
+    """Fitted values x (in chosen order) cut into each chosen candidate's values."""
+    out, offset = [], 0
+    for c in chosen:
+        out.append(x[offset: offset + c.size])
+        offset += c.size
+    return out
+
+
 def candidates_of(effects, n_joints: int, sizes: dict) -> list[Candidate]:
     """sizes: effect key -> number of fitted values (known once its columns were computed)."""
     out, start = [], 0

@@ -39,19 +39,11 @@ EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple"
 FOLDS_PER_VALUE = 0.02  # least gain per extra value on errors summed over the three cuts (see above)
 
 
-def _split(chosen, x):
-    out, offset = [], 0
-    for c in chosen:
-        out.append(x[offset: offset + c.size])
-        offset += c.size
-    return out
-
-
 def _parts(context, chosen, x, seg, j):
     """(arm-wide effects' torque on joint j, columns of the per-joint effects on joint j)."""
     arm = np.zeros(seg.residual.shape[0])
     columns = []
-    for c, v in zip(chosen, _split(chosen, x)):
+    for c, v in zip(chosen, dz.split_values(chosen, x)):
         cols = dz.columns_of(c.effect, context, seg)[:, j, :]
         if c.joint is None:
             arm += cols @ v
@@ -66,7 +58,7 @@ def _completed_fit(context, chosen, x, segments, j):
     samples. (Refitting the effects with the simple columns let an offset and a position
     ripple's low harmonics, nearly collinear over a short range, take large values of
     opposite sign.)"""
-    own = [v for c, v in zip(chosen, _split(chosen, x)) if c.joint == j]
+    own = [v for c, v in zip(chosen, dz.split_values(chosen, x)) if c.joint == j]
     own = np.concatenate(own) if own else np.zeros(0)
     rows, targets = [], []
     for seg in segments:
@@ -126,7 +118,9 @@ def choose(sse_per_joint: list[dict], chosen, min_gain: float, consistent_values
     modes = []
     for j, sse in enumerate(sse_per_joint):
         own = sum(c.size for c in chosen if c.joint == j)  # values of the effects on this joint
-        size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES)}
+        # the completed model's independent values: an offset or viscous effect is a simple term
+        shared = sum(1 for c in chosen if c.joint == j and c.effect.simple_term)
+        size = {EFFECTS: own, SIMPLE: len(baseline.NAMES), COMPLETED: own + len(baseline.NAMES) - shared}
         best = EFFECTS
         for other in (SIMPLE, COMPLETED) if COMPLETED in sse else (SIMPLE,):
             if _better(sse[other], size[other], sse[best], size[best], min_gain):

@@ -331,12 +331,9 @@ def _plausible(design, chosen):
     refused = []
     while True:
         final = solve(design, chosen)
-        bad = []
-        offset = 0
-        for c in chosen:
-            if not c.effect.plausible(final.x[offset: offset + c.size]):
-                bad.append(c)
-            offset += c.size
+        values = dict(zip(map(id, chosen), dz.split_values(chosen, final.x)))
+        bad = [c for c in chosen if not c.effect.plausible(values[id(c)])
+               or any(not c.effect.plausible_beside(values[id(c)], values[id(base)]) for base in _bases(c, chosen))]
         if not bad:
             return chosen, final, refused
         worst = bad[0]
@@ -344,6 +341,12 @@ def _plausible(design, chosen):
         refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
         chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
         refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone[1:]]
+
+
+def _bases(candidate, chosen) -> list:
+    """The effects a candidate extends on its joint (Effect.extends)."""
+    name = candidate.effect.extends
+    return [c for c in chosen if name and c.effect.name == name and c.joint == candidate.joint]
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):

@@ -51,6 +51,7 @@ class Effect:
     secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
     ranged = False  # its columns depend on the positions the fit data cover (Context.q_range)
     extends = ""  # name of the effect this one only adds to, on the same joint (selected first, dropped with it)
+    simple_term = ""  # the simple model's term (baseline.NAMES) this effect is, if it is one (b, Fv)
     switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
     simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")
 
@@ -66,6 +67,11 @@ class Effect:
 
     def plausible(self, values: np.ndarray) -> bool:
         """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
+        return True
+
+    def plausible_beside(self, values: np.ndarray, base: np.ndarray) -> bool:
+        """Whether fitted values can be this effect beside those of the effect it extends on
+        its joint (Effect.extends)."""
         return True
 
     def simplified(self, values: np.ndarray):
