@@ -84,6 +84,7 @@ def main() -> int:
               f"worse on {worse}; --reidentify {np.round(r_after, 3)} mean {r_after.mean():.3f} worse on {r_worse}, "
               f"link parameters off {r.consistent['joints'] if r.consistent else None}", flush=True)
     lines += positions_only(robot, model, p)
+    lines += block_lengths(robot, model, p, recording)
     write_file(ROOT / "bench" / "results" / "lwr_real.md", "\n".join(lines))
     return 0
 
@@ -111,6 +112,30 @@ def positions_only(robot, model, p) -> list[str]:
                   "| | simple model | " + " | ".join(f"{x:.3f}" for x in simple) + f" | {simple.mean():.3f} |"]
         print(f"positions only, {name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple "
               f"{np.round(simple, 3)}; worse on {worse}; {cut}", flush=True)
+    return lines + [""]
+
+
+BLOCKS = (1.5, 2.0, 2.5, 3.0)  # s: selection block lengths (Options.block_seconds; 2 s the default)
+
+
+def block_lengths(robot, model, p, recording) -> list[str]:
+    """The same fits with other selection block lengths: how much the result owes to one way of
+    cutting the fit data into fit and selection blocks."""
+    lines = ["## Other selection block lengths (diagnosis Options.block_seconds; 2 s by default)", "",
+             "Test RMS on m3 [Nm]: mean over joints; and each joint worse than the simple model, with the "
+             "simple model's RMS.", "",
+             "| fit | " + " | ".join(f"{b:g} s" for b in BLOCKS) + " |", "|---|" + "---|" * len(BLOCKS)]
+    for fit, _ in RUNS[:3]:
+        cells = []
+        for seconds in BLOCKS:
+            d = diagnose(robot, model, p, [recording(k) for k in fit], None, Options(block_seconds=seconds),
+                         test=[recording(3)])
+            after, simple = np.array(d.rms_after), np.array(d.rms_simple)
+            worse = [j + 1 for j in range(7) if after[j] > simple[j] + 1e-9]
+            cells.append(f"{after.mean():.3f}" + "".join(f"; J{j} {after[j - 1]:.3f} > {simple[j - 1]:.3f}"
+                                                         for j in worse))
+        lines.append(f"| m{'+m'.join(map(str, fit))} | " + " | ".join(cells) + " |")
+        print(f"block lengths {BLOCKS}, fit {fit}: {cells}", flush=True)
     return lines + [""]
 
 
