@@ -179,3 +179,4 @@ def test_a_coarse_encoder_at_100_hz_claims_no_static_friction_spike(tmp_path):
     assert r["problems"] == [], "\n".join(r["problems"])
     refused = [x for x in r["diagnosis"]["refused"] if x["candidate"].startswith("stribeck")]
     assert refused and all(x["values"][0] > STATIC_EXCESS * 1.0 for x in refused)
+    assert all(x["reason"].startswith("beside coulomb") for x in refused)  # the report says beside what

@@ -332,13 +332,19 @@ def _plausible(design, chosen):
     while True:
         final = solve(design, chosen)
         values = dict(zip(map(id, chosen), dz.split_values(chosen, final.x)))
-        bad = [c for c in chosen if not c.effect.plausible(values[id(c)])
-               or any(not c.effect.plausible_beside(values[id(c)], values[id(base)]) for base in _bases(c, chosen))]
+        reasons = {}
+        for c in chosen:
+            if not c.effect.plausible(values[id(c)]):
+                reasons[id(c)] = ""
+            for base in _bases(c, chosen):
+                if not c.effect.plausible_beside(values[id(c)], values[id(base)]):
+                    reasons[id(c)] = f"beside {base.key} at {', '.join(f'{v:.3g}' for v in values[id(base)])}"
+        bad = [c for c in chosen if id(c) in reasons]
         if not bad:
             return chosen, final, refused
         worst = bad[0]
-        offset = sum(c.size for c in chosen[:chosen.index(worst)])
-        refused.append({"candidate": worst.key, "values": final.x[offset: offset + worst.size].tolist()})
+        refused.append({"candidate": worst.key, "values": values[id(worst)].tolist()}
+                       | ({"reason": reasons[id(worst)]} if reasons[id(worst)] else {}))
         chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
         refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone[1:]]
 
@@ -422,8 +428,9 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
         if e.get("suspect"):
             out.append(f"{e['effect']} is a symptom, not a cause: {e['suspect']}")
     for r in d.refused:
-        out.append(f"{r['candidate']}: refused, its fitted values are not physically possible "
-                   f"({', '.join(f'{v:.3g}' for v in r['values'][:4])})")
+        shown = ", ".join(f"{v:.3g}" for v in r["values"][:4])
+        because = "; ".join(x for x in (shown, r.get("reason", "")) if x)
+        out.append(f"{r['candidate']}: refused, its fitted values are not physically possible ({because})")
     if d.consistent:
         c = d.consistent
         out.append("link parameters off: on joint(s) " + ", ".join(map(str, c["joints"])) + " physically consistent "
