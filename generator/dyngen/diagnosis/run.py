@@ -23,7 +23,7 @@ from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
 from .refine import refine, restricted
-from .selection import forward, prune, relative_change, selection_gain, solve, without
+from .selection import bases, forward, prune, relative_change, selection_gain, selection_mse, solve, without
 
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance
@@ -336,7 +336,7 @@ def _plausible(design, chosen):
         for c in chosen:
             if not c.effect.plausible(values[id(c)]):
                 reasons[id(c)] = ""
-            for base in _bases(c, chosen):
+            for base in bases(c, chosen):
                 if not c.effect.plausible_beside(values[id(c)], values[id(base)]):
                     reasons[id(c)] = f"beside {base.key} at {', '.join(f'{v:.3g}' for v in values[id(base)])}"
         bad = [c for c in chosen if id(c) in reasons]
@@ -347,12 +347,6 @@ def _plausible(design, chosen):
                        | ({"reason": reasons[id(worst)]} if reasons[id(worst)] else {}))
         chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
         refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone[1:]]
-
-
-def _bases(candidate, chosen) -> list:
-    """The effects a candidate extends on its joint (Effect.extends)."""
-    name = candidate.effect.extends
-    return [c for c in chosen if name and c.effect.name == name and c.joint == candidate.joint]
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):
@@ -478,9 +472,7 @@ def _torque_rms(design, cand, x) -> float:
 def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
     """What an effect does on the selection data (its gain, the joints it helps); its values
     are filled in by _values once the final fit is made."""
-    others = [c for c in chosen if c is not cand]
-    rest = solve(design, others)
-    mse_without = design.select.mse(rest.slots, rest.x) if others else design.select.c / max(design.select.count, 1)
+    mse_without = selection_mse(design, [c for c in chosen if c is not cand])
     mse_with = design.select.mse(final.slots, final.x)
     gain_per_joint = relative_change(mse_without, mse_with)
     gain = selection_gain(cand, mse_without, mse_with)

@@ -148,8 +148,12 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
 
 
 def selection_mse(design, chosen) -> np.ndarray:
-    fit = solve(design, chosen)
-    return design.select.mse(fit.slots, fit.x) if chosen else design.select.c / max(design.select.count, 1)
+    """Per joint mean square the chosen candidates, fitted on the fit samples, leave on the
+    selection samples."""
+    if not chosen:
+        return design.select.c / max(design.select.count, 1)
+    fit = solve(design, chosen, covariance=False)  # the values only: no deviations needed here
+    return design.select.mse(fit.slots, fit.x)
 
 
 def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
@@ -220,10 +224,15 @@ def relative_change(before: np.ndarray, after: np.ndarray) -> np.ndarray:
     return (before - after) / np.maximum(np.maximum(before, after), 1e-300)
 
 
+def bases(candidate, chosen) -> list:
+    """The chosen effects on the candidate's joint that it extends (Effect.extends)."""
+    name = candidate.effect.extends
+    return [c for c in chosen if name and c.effect.name == name and c.joint == candidate.joint]
+
+
 def _based(candidate, chosen) -> bool:
-    """Whether the effect a candidate extends (Effect.extends) is chosen on its joint."""
-    base = candidate.effect.extends
-    return not base or any(c.effect.name == base and c.joint == candidate.joint for c in chosen)
+    """Whether the effect a candidate extends (if any) is chosen on its joint."""
+    return not candidate.effect.extends or bool(bases(candidate, chosen))
 
 
 def without(chosen, cand) -> tuple[list, list]:
