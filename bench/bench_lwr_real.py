@@ -76,6 +76,7 @@ def main() -> int:
                   f"With `--reidentify`: worse than the simple model on {r_worse or 'none'}; link parameters off: "
                   f"{r.consistent['joints'] if r.consistent else 'not claimed'}"
                   + (f" (regularisation {r.consistent['regularisation']:g})" if r.consistent else "") + ".", "",
+                  within_fit_speeds(d),
                   f"Joints where the final model is worse than the simple model: {worse or 'none'}. Per joint "
                   f"model: {', '.join(f'J{j + 1} {m}' for j, m in enumerate(d.joint_models))}.", "",
                   "Selected: " + "; ".join(f"{e['effect']} {e['joints']}" for e in d.selected) + ".", ""]
@@ -87,6 +88,18 @@ def main() -> int:
     lines += block_lengths(robot, model, p, recording)
     write_file(ROOT / "bench" / "results" / "lwr_real.md", "\n".join(lines))
     return 0
+
+
+def within_fit_speeds(d) -> str:
+    """The table's rows at the joint velocities the fit data covered (Diagnosis.within_fit_speeds)."""
+    w = d.within_fit_speeds
+    worse = [j + 1 for j, (a, s) in enumerate(zip(w["rms_after"], w["rms_simple"]))
+             if a is not None and a > s + 1e-9]
+    return ("At the joint velocities the fit data covered (share of test samples beyond them per joint: "
+            + ", ".join(f"{x:.0%}" for x in w["share_beyond"]) + "): final model "
+            + " ".join("-" if a is None else f"{a:.3f}" for a in w["rms_after"]) + ", simple model "
+            + " ".join("-" if a is None else f"{a:.3f}" for a in w["rms_simple"])
+            + f"; worse than the simple model on {worse or 'none'}.\n")
 
 
 def positions_only(robot, model, p) -> list[str]:
@@ -122,8 +135,8 @@ def block_lengths(robot, model, p, recording) -> list[str]:
     """The same fits with other selection block lengths: how much the result owes to one way of
     cutting the fit data into fit and selection blocks."""
     lines = ["## Other selection block lengths (diagnosis Options.block_seconds; 2 s by default)", "",
-             "Test RMS on m3 [Nm]: mean over joints; and each joint worse than the simple model, with the "
-             "simple model's RMS.", "",
+             "Test RMS on m3 [Nm]: mean over joints; each joint worse than the simple model, with the "
+             "simple model's RMS; and the joints worse at the velocities the fit data covered.", "",
              "| fit | " + " | ".join(f"{b:g} s" for b in BLOCKS) + " |", "|---|" + "---|" * len(BLOCKS)]
     for fit, _ in RUNS[:3]:
         cells = []
@@ -132,8 +145,12 @@ def block_lengths(robot, model, p, recording) -> list[str]:
                          test=[recording(3)])
             after, simple = np.array(d.rms_after), np.array(d.rms_simple)
             worse = [j + 1 for j in range(7) if after[j] > simple[j] + 1e-9]
+            w = d.within_fit_speeds
+            inside = [j + 1 for j, (a, s) in enumerate(zip(w["rms_after"], w["rms_simple"]))
+                      if a is not None and a > s + 1e-9]
             cells.append(f"{after.mean():.3f}" + "".join(f"; J{j} {after[j - 1]:.3f} > {simple[j - 1]:.3f}"
-                                                         for j in worse))
+                                                         for j in worse)
+                         + f"; within the fit speeds worse on {', '.join(f'J{j}' for j in inside) or 'none'}")
         lines.append(f"| m{'+m'.join(map(str, fit))} | " + " | ".join(cells) + " |")
         print(f"block lengths {BLOCKS}, fit {fit}: {cells}", flush=True)
     return lines + [""]

@@ -344,3 +344,56 @@ def test_a_viscous_finding_is_not_counted_twice_beside_the_simple_model():
     # an effect the simple model does not hold (a position ripple) is counted in full
     ripple = SimpleNamespace(joint=0, size=6, effect=SimpleNamespace(simple_term=""))
     assert joints.choose(sse, [ripple], joints.FOLDS_PER_VALUE) == [joints.SIMPLE]
+
+
+def test_selection_over_every_cut_is_a_refit_per_cut():
+    """selection.selection_mse with block groups: each group judges the candidates fitted (joint
+    rows weighted) on the other groups. Checked against weighted least squares on the raw
+    samples with numpy, cut by cut."""
+    from types import SimpleNamespace
+
+    from dyngen.diagnosis import design as dz
+    from dyngen.diagnosis.run import Design
+    from dyngen.diagnosis.selection import selection_mse
+
+    rng = np.random.default_rng(4)
+    n, size, per_group = 2, 3, 40
+    truth = np.array([0.5, -1.0, 2.0])
+    samples = []  # per group: per joint (A, r)
+    for _ in range(3):
+        joints = []
+        for j in range(n):
+            A = rng.standard_normal((per_group, size))
+            joints.append((A, A @ truth + (j + 1) * 0.3 * rng.standard_normal(per_group)))
+        samples.append(joints)
+    groups = []
+    for joints in samples:
+        m = dz.empty(n, size)
+        for j, (A, r) in enumerate(joints):
+            dz.accumulate(m, A, np.arange(size), r, j)
+        m.count = per_group
+        groups.append(m)
+    weights = np.array([1.0, 0.4])
+    design = Design([], groups[0], groups[1], dz.empty(n, size), weights, groups)
+    chosen = [SimpleNamespace(slots=np.array([0, 2]))]  # two of the three columns
+    expected = np.zeros(n)
+    for k in range(3):
+        rows = [(w * A[:, [0, 2]], w * r) for g in range(3) if g != k for (A, r), w in zip(samples[g], weights)]
+        x = np.linalg.lstsq(np.vstack([a for a, _ in rows]), np.concatenate([b for _, b in rows]), rcond=None)[0]
+        for j, (A, r) in enumerate(samples[k]):
+            expected[j] += np.sum((r - A[:, [0, 2]] @ x) ** 2)
+    assert selection_mse(design, chosen) == pytest.approx(expected / (3 * per_group), rel=1e-10)
+
+
+def test_static_friction_is_refused_outside_what_a_joint_shows():
+    """Stribeck.refusal_beside, on the values met in the withheld benchmark: 9.8 Nm of static
+    friction beside a 1-Nm Coulomb level (a spike standing in for a 3.3-Hz filter's rounding),
+    0.08 Nm beside 0.9 Nm (friction that sticks, seen through the filter), and the injected
+    0.8 Nm beside 0.8 Nm, which stays."""
+    from dyngen.diagnosis.effects.friction import Stribeck
+
+    law = Stribeck(0.1)
+    assert "no joint's" in law.refusal_beside(np.array([9.8]), np.array([1.0]))
+    assert "not told apart" in law.refusal_beside(np.array([0.08]), np.array([0.9]))
+    assert law.refusal_beside(np.array([0.8]), np.array([0.8])) == ""
+    assert law.refusal_beside(np.array([0.3]), np.array([1.0])) == ""  # 0.3 of the level: shown

@@ -83,7 +83,7 @@ class _State:
         new = cand.slots
         design = self.design
         moments = [dz.Moments(m.G.copy(), m.b.copy(), m.c.copy(), m.count)
-                   for m in (design.fit, design.select, design.test)]
+                   for m in (design.fit, design.select, design.test, *design.groups)]
         joints = range(self.weights.size) if cand.joint is None else [cand.joint]
         for m in moments:
             for j in joints:
@@ -95,14 +95,14 @@ class _State:
                 acting = [c for c in chosen if c.joint is None or c.joint == j]
                 A, slots = dz.joint_matrix(acting, cols, j)
                 B = cols[cand.effect.key][:, j, :]
-                for m, mask in zip(moments, (seg.fit, seg.select, seg.test)):
+                for m, mask in zip(moments, (seg.fit, seg.select, seg.test, *_groups(seg, design))):
                     if mask.any():
                         cross = A[mask].T @ B[mask]
                         m.G[j][np.ix_(slots, new)] += cross
                         m.G[j][np.ix_(new, slots)] += cross.T
                         m.G[j][np.ix_(new, new)] -= B[mask].T @ B[mask]  # counted twice above
                         m.b[j][new] += B[mask].T @ seg.residual[mask, j]
-        return type(self.template)(chosen, *moments, self.weights)
+        return type(self.template)(chosen, *moments[:3], self.weights, moments[3:])
 
     def accept(self, trial):
         self.chosen, self.columns, self.design = trial
@@ -112,20 +112,22 @@ class _State:
         n = self.weights.size
         size = sum(c.size for c in chosen)
         fit, select, test = dz.empty(n, size), dz.empty(n, size), dz.empty(n, size)
+        groups = [dz.empty(n, size) for _ in self.template.groups]
         for seg, cols in zip(self.segments, columns):
+            roles = [(fit, seg.fit), (select, seg.select), (test, seg.test),
+                     *zip(groups, _groups(seg, self.template))]
             for j in range(n):
                 acting = [c for c in chosen if c.joint is None or c.joint == j]
                 if acting:
                     A, slots = dz.joint_matrix(acting, cols, j)
                 else:
                     A, slots = np.zeros((seg.residual.shape[0], 0)), np.zeros(0, dtype=int)
-                for moments, mask in ((fit, seg.fit), (select, seg.select), (test, seg.test)):
+                for moments, mask in roles:
                     if mask.any():
                         dz.accumulate(moments, A[mask], slots, seg.residual[mask, j], j)
-            fit.count += int(seg.fit.sum())
-            select.count += int(seg.select.sum())
-            test.count += int(seg.test.sum())
-        return type(self.template)(chosen, fit, select, test, self.weights)
+            for moments, mask in roles:
+                moments.count += int(mask.sum())
+        return type(self.template)(chosen, fit, select, test, self.weights, groups)
 
 
 def _refine_one(state, index) -> None:
@@ -173,3 +175,10 @@ def _weighted_sse(design, fit) -> float:
     G = m.G[:, fit.slots][:, :, fit.slots]
     sse = m.c - 2 * m.b[:, fit.slots] @ fit.x + np.einsum("k,jkl,l->j", fit.x, G, fit.x)
     return float(design.weights ** 2 @ np.maximum(sse, 0.0))
+
+
+def _groups(seg, design) -> list:
+    """The segment's block-group masks where the design keeps group moments (none else)."""
+    if not design.groups:
+        return []
+    return seg.groups or [np.zeros(seg.residual.shape[0], dtype=bool)] * len(design.groups)

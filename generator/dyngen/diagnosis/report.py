@@ -23,7 +23,7 @@ def to_json(d, sources: dict) -> str:
         "candidates": d.candidates, "steps": d.steps, "dropped": d.dropped, "warnings": d.warnings,
         "recordings": d.conditioning, "joint_models": d.joint_models,
         "completed": {str(j): values for j, values in d.completed.items()},
-        "link_parameters_off": d.consistent,
+        "link_parameters_off": d.consistent, "within_fit_speeds": d.within_fit_speeds,
     }
     return json.dumps(_plain(doc), indent=1) + "\n"
 
@@ -107,6 +107,14 @@ def markdown(d, sources: dict) -> str:
               _row(f"RMS, {simple}", d.rms_simple),
               _row("peak, nominal model", d.peak_before),
               _row("white-noise estimate", d.noise_rms), ""]
+    w = d.within_fit_speeds
+    if w and any(x > 0 for x in w["share_beyond"]):
+        dash = lambda xs: " | ".join("-" if x is None else f"{x:.3f}" for x in xs)  # noqa: E731
+        lines += ["At the joint velocities the fit data covered (beyond them velocity laws are extrapolated, "
+                  "and the selection data could not judge them):", "", f"| | {head} |", rule,
+                  "| share of samples beyond | " + " | ".join(f"{x:.0%}" for x in w["share_beyond"]) + " |",
+                  f"| RMS, final model, within | {dash(w['rms_after'])} |",
+                  f"| RMS, simple model, within | {dash(w['rms_simple'])} |", ""]
     if test:
         lines += ["Selection data (they chose the effects; not held out):", "", f"| | {head} |", rule,
                   _row("RMS, nominal model", d.selection_before),

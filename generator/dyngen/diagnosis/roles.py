@@ -37,6 +37,7 @@ class Segment:
     select: np.ndarray
     test: np.ndarray
     correction: np.ndarray | None = None  # the final model's correction (effects, or the simple model per joint)
+    groups: list | None = None  # bool (T,) per block group (selection on blocks): each cut selects on one
 
 
 def segments(model, s, fit_signals, select_signals, test_signals, block_seconds: float) -> tuple[list, str]:
@@ -59,6 +60,7 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
         for sig in fit_signals:
             fit, select = blocks(sig, block_seconds)
             out.append(segment(sig, fit, select, none(sig)))
+            out[-1].groups = [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]
         split = f"selection on blocks of {block_seconds:g} s of the fit data (every third)"
     for sig in test_signals or []:
         out.append(segment(sig, none(sig), none(sig), sig.inner()))

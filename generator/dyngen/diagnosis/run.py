@@ -60,6 +60,9 @@ class Diagnosis:
     completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
     conditioning: list = field(default_factory=list)  # per recording: what was done to it
     segments: list = field(default_factory=list)  # roles.Segment, for figures
+    # per joint on the judged data at the joint velocities the fit data covered: share of samples
+    # beyond them, RMS of the final and of the simple model there (velocity laws extrapolate beyond)
+    within_fit_speeds: dict = field(default_factory=dict)
     consistent: dict | None = None  # "link parameters off": reidentify.finding, where the consistent model won
     reidentified: object = None  # its identification.consistent.Consistent (for the written parameters)
 
@@ -71,6 +74,7 @@ class Design:
     select: dz.Moments
     test: dz.Moments
     weights: np.ndarray  # per joint: 1 / RMS of the nominal fit residual
+    groups: list = field(default_factory=list)  # dz.Moments per block group (selection on blocks)
     H: np.ndarray = None  # weighted normal matrix of every slot: sum_j w_j^2 G_j (fit samples)
     g: np.ndarray = None  # sum_j w_j^2 b_j
 
@@ -88,19 +92,25 @@ def _design(context, effects, segments, n) -> Design:
             candidates = dz.candidates_of(effects, n, {k: v.shape[2] for k, v in columns.items()})
             size = candidates[-1].start + candidates[-1].size
             moments = [dz.empty(n, size) for _ in range(3)]
+            groups = [dz.empty(n, size) for _ in range(roles.FOLDS)]
         masks = (seg.fit, seg.select, seg.test)
         for j in range(n):
             A, slots = dz.joint_matrix(candidates, columns, j)
             for m, mask in zip(moments, masks):
                 if mask.any():
                     dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
+            for m, mask in zip(groups, seg.groups or []):
+                if mask.any():
+                    dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
         for m, mask in zip(moments, masks):
+            m.count += int(mask.sum())
+        for m, mask in zip(groups, seg.groups or []):
             m.count += int(mask.sum())
     if moments[0].count == 0:
         raise ValueError("no fit samples (recordings too short for the filter's start-up?)")
     rms = np.sqrt(moments[0].c / max(moments[0].count, 1))
     weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
-    return Design(candidates, *moments, weights)
+    return Design(candidates, *moments, weights, groups if any(m.count for m in groups) else [])
 
 
 def predict(context, chosen, x, segment) -> np.ndarray:
@@ -153,8 +163,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # Per joint: the effects, the simple model or both, all fitted on the fit samples only and
     # compared on the selection samples (joints.py).
     simple = simple_model.fit(segments)
-    sel_before = design.select.c / max(design.select.count, 1)
-    sel_effects = design.select.mse(final.slots, final.x) if chosen else sel_before.copy()
+    sel_before = selection_mse(design, [])
+    sel_effects = selection_mse(design, chosen)
     sel_simple = _simple_mse(segments, simple, "select", n)
     if not design.select.count:
         modes = [joints.EFFECTS] * n
@@ -219,6 +229,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         simple.values.tolist(), np.abs(held_before).max(axis=0).tolist(), noise.tolist(), where, candidates,
         selection.steps, dropped, refused, superseded, tau_corr, segments=segments)
     result.joint_models = modes
+    result.within_fit_speeds = _within_fit_speeds(segments, simple, used, mask)
     result.completed = completed
     if reid is not None:
         result.consistent = reidentify.finding(robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT])
@@ -322,7 +333,7 @@ def _reweighted(design, final) -> Design:
     it were noise, and the arm-wide values would be set by the other joints alone."""
     rms = np.sqrt(design.fit.mse(final.slots, final.x))
     weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
-    return Design(design.candidates, design.fit, design.select, design.test, weights)
+    return Design(design.candidates, design.fit, design.select, design.test, weights, design.groups)
 
 
 def _plausible(design, chosen):
@@ -337,8 +348,9 @@ def _plausible(design, chosen):
             if not c.effect.plausible(values[id(c)]):
                 reasons[id(c)] = ""
             for base in bases(c, chosen):
-                if not c.effect.plausible_beside(values[id(c)], values[id(base)]):
-                    reasons[id(c)] = f"beside {base.key} at {', '.join(f'{v:.3g}' for v in values[id(base)])}"
+                why = c.effect.refusal_beside(values[id(c)], values[id(base)])
+                if why:
+                    reasons[id(c)] = f"beside {base.key} at {', '.join(f'{v:.3g}' for v in values[id(base)])}: {why}"
         bad = [c for c in chosen if id(c) in reasons]
         if not bad:
             return chosen, final, refused
@@ -372,6 +384,33 @@ def _narrow_stribeck(chosen) -> list:
     term no wider than the Coulomb transition)."""
     return [c for c in chosen if c.joint is not None
             and any(o.joint == c.joint and c.effect.reshapes(o.effect) for o in chosen)]
+
+
+def _within_fit_speeds(segments, simple, used, mask) -> dict:
+    """Per joint on the judged samples whose velocity lies within the range the fit samples
+    covered: {"share_beyond": share of judged samples outside it, "rms_after", "rms_simple"
+    (None where no sample is within)}. Beyond the fit speeds a velocity law is extrapolated, and
+    the selection data, drawn from the fit recordings, cannot show how well."""
+    qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
+    lo, hi = qd.min(axis=0), qd.max(axis=0)
+    out = {"share_beyond": [], "rms_after": [], "rms_simple": []}
+    simple_torque = [simple_model.predict(simple, seg) for seg in used]
+    for j in range(lo.size):
+        sse_after = sse_simple = 0.0
+        inside = total = 0
+        for seg, tau_simple in zip(used, simple_torque):
+            m = mask(seg)
+            v = seg.signals.qd[m, j]
+            k = (v >= lo[j]) & (v <= hi[j])
+            r = seg.residual[m, j][k]
+            sse_after += float(np.sum((r - seg.correction[m, j][k]) ** 2))
+            sse_simple += float(np.sum((r - tau_simple[m, j][k]) ** 2))
+            inside += int(k.sum())
+            total += int(m.sum())
+        out["share_beyond"].append(1.0 - inside / max(total, 1))
+        out["rms_after"].append(float(np.sqrt(sse_after / inside)) if inside else None)
+        out["rms_simple"].append(float(np.sqrt(sse_simple / inside)) if inside else None)
+    return out
 
 
 def _simple_mse(segments, simple, role, n) -> np.ndarray:
@@ -424,7 +463,8 @@ def _warnings(d, model, s, fit_signals, select_signals, test_signals, used) -> l
     for r in d.refused:
         shown = ", ".join(f"{v:.3g}" for v in r["values"][:4])
         because = "; ".join(x for x in (shown, r.get("reason", "")) if x)
-        out.append(f"{r['candidate']}: refused, its fitted values are not physically possible ({because})")
+        what = "" if r.get("reason") else ", its fitted values are not physically possible"
+        out.append(f"{r['candidate']}: refused{what} ({because})")
     if d.consistent:
         c = d.consistent
         out.append("link parameters off: on joint(s) " + ", ".join(map(str, c["joints"])) + " physically consistent "
@@ -473,7 +513,7 @@ def _describe(robot, design, chosen, final, cand, min_gain) -> dict:
     """What an effect does on the selection data (its gain, the joints it helps); its values
     are filled in by _values once the final fit is made."""
     mse_without = selection_mse(design, [c for c in chosen if c is not cand])
-    mse_with = design.select.mse(final.slots, final.x)
+    mse_with = selection_mse(design, chosen)
     gain_per_joint = relative_change(mse_without, mse_with)
     gain = selection_gain(cand, mse_without, mse_with)
     joints = [cand.joint + 1] if cand.joint is not None else \

@@ -69,10 +69,10 @@ class Effect:
         """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
         return True
 
-    def plausible_beside(self, values: np.ndarray, base: np.ndarray) -> bool:
-        """Whether fitted values can be this effect beside those of the effect it extends on
-        its joint (Effect.extends)."""
-        return True
+    def refusal_beside(self, values: np.ndarray, base: np.ndarray) -> str:
+        """Why fitted values cannot be this effect beside those of the effect it extends on its
+        joint (Effect.extends); "" if they can."""
+        return ""
 
     def simplified(self, values: np.ndarray):
         """Fitted values possible only in part: (a simpler effect that keeps the first of
