@@ -124,6 +124,19 @@ def test_m1_to_m3(m1_m3):
     assert any("faster than any fit data" in w and "4 (" in w for w in m1_m3.warnings)
 
 
+def test_the_terminal_says_where_the_simple_model_is_better(m1_m3):
+    """The joint that ends above the simple model is named with both figures, and with both at
+    the velocities the fit data covered (where the final model is the better one)."""
+    from dyngen.diagnosis.report import summary_lines
+
+    line = next(x for x in summary_lines(m1_m3) if "worse than the simple model" in x)
+    after, simple = m1_m3.rms_after[4], m1_m3.rms_simple[4]
+    assert f"joint(s) 5 ({after:.3f} vs {simple:.3f})" in line
+    w = m1_m3.within_fit_speeds
+    assert f"covered {w['rms_after'][4]:.3f} vs {w['rms_simple'][4]:.3f}" in line
+    assert not any(f"joint(s) {j}" in line for j in (1, 2, 3, 4, 6, 7))
+
+
 def test_share_of_test_samples_beyond_the_fit_speeds(m1_m3):
     """within_fit_speeds.share_beyond against numpy on the recordings: m3 samples whose joint
     velocity lies outside the range m1's velocities span (m1's filter start-up trimmed; the

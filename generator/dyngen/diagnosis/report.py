@@ -107,6 +107,8 @@ def markdown(d, sources: dict) -> str:
               _row(f"RMS, {simple}", d.rms_simple),
               _row("peak, nominal model", d.peak_before),
               _row("white-noise estimate", d.noise_rms), ""]
+    if worse_than_simple(d):
+        lines += [f"The final model is {worse_than_simple(d)}.", ""]
     w = d.within_fit_speeds
     if w and any(x > 0 for x in w["share_beyond"]):
         dash = lambda xs: " | ".join("-" if x is None else f"{x:.3f}" for x in xs)  # noqa: E731
@@ -173,12 +175,31 @@ def markdown(d, sources: dict) -> str:
     return "\n".join(lines)
 
 
+def worse_than_simple(d) -> str:
+    """The joints where the final model ends above the simple model on the judged data, with
+    both figures there and at the velocities the fit data covered; "" if none."""
+    worse = [j for j in range(d.joints) if d.rms_after[j] > d.rms_simple[j]]
+    if not worse:
+        return ""
+    text = "worse than the simple model on joint(s) " + ", ".join(
+        f"{j + 1} ({d.rms_after[j]:.3f} vs {d.rms_simple[j]:.3f})" for j in worse)
+    w = d.within_fit_speeds
+    inside = [j for j in worse if w and w["rms_after"][j] is not None and w["share_beyond"][j] > 0]
+    if inside:
+        text += "; at the joint velocities the fit data covered " + ", ".join(
+            f"{w['rms_after'][j]:.3f} vs {w['rms_simple'][j]:.3f}" for j in inside) + \
+            " (beyond them velocity laws are extrapolated)"
+    return text
+
+
 def summary_lines(d) -> list[str]:
     """A short table for the terminal."""
     where = "test" if d.judged_on == "test" else "selection (no test data)"
     out = [f"  {where} RMS per joint: nominal {' '.join(f'{x:.3f}' for x in d.rms_before)}",
            f"  {' ' * len(where)}               after   {' '.join(f'{x:.3f}' for x in d.rms_after)}",
            f"  {' ' * len(where)}        simple model   {' '.join(f'{x:.3f}' for x in d.rms_simple)}"]
+    if worse_than_simple(d):
+        out.append(f"  {worse_than_simple(d)}")
     if not d.selected:
         out.append("  no significant unmodelled effect")
     for e in d.selected:
