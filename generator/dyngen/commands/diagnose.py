@@ -32,8 +32,8 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="link parameters: extraction output (links:), a solution file (solution:) or a robot "
                              "YAML (parameters.nominal)")
     parser.add_argument("--select", action="append", metavar="CSV",
-                        help="recording(s) that choose the effects (default: every third 2-s block of the --data "
-                             "recordings)")
+                        help="recording(s) that choose the effects (default: 2-s blocks of the --data recordings, "
+                             "every third block judging what the others fit, each third in turn)")
     parser.add_argument("--test", action="append", metavar="CSV",
                         help="recording(s) used for nothing but the reported held-out residual; best a different "
                              "trajectory (default: none, and the report says that nothing was held out)")

@@ -21,7 +21,7 @@ class Options:
     sign_velocity: float = option(0.002, "sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V), "
                                   "V in rad/s (Coulomb's own scale is fitted)", metavar="V", bounds=(0.0, 1e3),
                                   above=True)
-    block_seconds: float = 2.0  # without selection recordings: blocks of this length, every third selects
+    block_seconds: float = 2.0  # without selection recordings: blocks of this length, each third selects in turn
     reidentify: bool = option(False, "also re-identify physically consistent link parameters (with friction and a "
                               "tilted base) from the fit data, and use them on the joints where they beat every "
                               "effect and the simple model on selection data; says 'link parameters off' and writes "

@@ -4,8 +4,9 @@
   select  chooses which effects are kept (their gain on these samples, never fitted to them);
   test    is used for nothing but the residual reported as held out.
 
-Without select recordings, selection uses blocks of the fit recordings (every third block of
-`block_seconds`), with a guard of the filter's length around every block boundary that belongs
+Without select recordings, selection uses blocks of the fit recordings (`block_seconds` long,
+in three groups: every third block; each group in turn judges what the other two fit,
+Segment.groups), with a guard of the filter's length around every block boundary that belongs
 to neither role (a zero-phase filter spreads each sample over its neighbours). Without test
 recordings nothing is reported as held out: the report then labels its figures as selection
 figures.
@@ -61,7 +62,7 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
             fit, select = blocks(sig, block_seconds)
             out.append(segment(sig, fit, select, none(sig)))
             out[-1].groups = [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]
-        split = f"selection on blocks of {block_seconds:g} s of the fit data (every third)"
+        split = f"selection on blocks of {block_seconds:g} s of the fit data (each third of them in turn)"
     for sig in test_signals or []:
         out.append(segment(sig, none(sig), none(sig), sig.inner()))
     return out, split
