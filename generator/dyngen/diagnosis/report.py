@@ -107,8 +107,9 @@ def markdown(d, sources: dict) -> str:
               _row(f"RMS, {simple}", d.rms_simple),
               _row("peak, nominal model", d.peak_before),
               _row("white-noise estimate", d.noise_rms), ""]
-    if worse_than_simple(d):
-        lines += [f"The final model is {worse_than_simple(d)}.", ""]
+    worse = worse_than_simple(d)
+    if worse:
+        lines += [f"The final model is {worse}.", ""]
     w = d.within_fit_speeds
     if w and any(x > 0 for x in w["share_beyond"]):
         dash = lambda xs: " | ".join("-" if x is None else f"{x:.3f}" for x in xs)  # noqa: E731
@@ -198,8 +199,9 @@ def summary_lines(d) -> list[str]:
     out = [f"  {where} RMS per joint: nominal {' '.join(f'{x:.3f}' for x in d.rms_before)}",
            f"  {' ' * len(where)}               after   {' '.join(f'{x:.3f}' for x in d.rms_after)}",
            f"  {' ' * len(where)}        simple model   {' '.join(f'{x:.3f}' for x in d.rms_simple)}"]
-    if worse_than_simple(d):
-        out.append(f"  {worse_than_simple(d)}")
+    worse = worse_than_simple(d)
+    if worse:
+        out.append(f"  {worse}")
     if not d.selected:
         out.append("  no significant unmodelled effect")
     for e in d.selected:

@@ -93,18 +93,13 @@ def _design(context, effects, segments, n) -> Design:
             size = candidates[-1].start + candidates[-1].size
             moments = [dz.empty(n, size) for _ in range(3)]
             groups = [dz.empty(n, size) for _ in range(roles.FOLDS)]
-        masks = (seg.fit, seg.select, seg.test)
+        roles_here = [*zip(moments, (seg.fit, seg.select, seg.test)), *zip(groups, seg.groups or [])]
         for j in range(n):
             A, slots = dz.joint_matrix(candidates, columns, j)
-            for m, mask in zip(moments, masks):
+            for m, mask in roles_here:
                 if mask.any():
                     dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
-            for m, mask in zip(groups, seg.groups or []):
-                if mask.any():
-                    dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
-        for m, mask in zip(moments, masks):
-            m.count += int(mask.sum())
-        for m, mask in zip(groups, seg.groups or []):
+        for m, mask in roles_here:
             m.count += int(mask.sum())
     if moments[0].count == 0:
         raise ValueError("no fit samples (recordings too short for the filter's start-up?)")

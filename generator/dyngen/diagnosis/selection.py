@@ -78,11 +78,8 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
     that block of it is computed (the forward selection tests one candidate at a time); with
     covariance False, none."""
     slots = np.concatenate([c.slots for c in chosen]) if chosen else np.zeros(0, dtype=int)
-    H = design.H[np.ix_(slots, slots)]
-    g = design.g[slots]
-    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    apply = _solver(H / np.outer(d, d))
-    x = apply(g / d) / d
+    apply, d = _factored(design.H[np.ix_(slots, slots)])
+    x = apply(design.g[slots] / d) / d
     if not covariance:
         return Fit(x, slots, None, float("nan"), block)
     fit = design.fit
@@ -94,6 +91,13 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
     unit = np.eye(len(slots))[:, block if block is not None else slice(None)]
     columns = apply(unit / d[:, None]) / d[:, None]  # the needed columns of H^-1
     return Fit(x, slots, columns.T @ middle @ columns, float(w2 @ s2) / len(s2), block)
+
+
+def _factored(H: np.ndarray):
+    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal, Hs = H / (d d^T): the columns'
+    units differ by orders of magnitude. H^-1 b = Hs^-1 (b / d) / d."""
+    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
+    return _solver(H / np.outer(d, d)), d
 
 
 def _solver(Hs: np.ndarray):
@@ -169,14 +173,10 @@ def selection_mse(design, chosen) -> np.ndarray:
         G, b = m.G[:, slots][:, :, slots], m.b[:, slots]
         H = np.einsum("j,jkl->kl", w2, G_all - G)
         g = w2 @ (b_all - b)
-        x = _fold_solve(H, g)
+        apply, d = _factored(H)
+        x = apply(g / d) / d
         sse += np.maximum(m.c - 2 * b @ x + np.einsum("k,jkl,l->j", x, G, x), 0.0)
     return sse / max(sum(m.count for m in design.groups), 1)
-
-
-def _fold_solve(H, g):
-    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    return _solver(H / np.outer(d, d))(g / d) / d
 
 
 def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
