@@ -397,3 +397,24 @@ def test_static_friction_is_refused_outside_what_a_joint_shows():
     assert "not told apart" in law.refusal_beside(np.array([0.08]), np.array([0.9]))
     assert law.refusal_beside(np.array([0.8]), np.array([0.8])) == ""
     assert law.refusal_beside(np.array([0.3]), np.array([1.0])) == ""  # 0.3 of the level: shown
+
+
+def test_a_local_effects_column_on_a_joint_needs_that_joint_alone(lwr):
+    """Effect.local lets the search of a velocity scale compute one joint's column
+    (design.columns_of with a joint): for every effect in the library that says so, its column
+    on joint j from joint j's signals alone equals joint j's column from the whole arm's."""
+    from dyngen.catalogue import STANDARD_FROM_DYNAMIC
+    from dyngen.diagnosis.effects import Context, library
+
+    model, robot, arm, p, trajectories = lwr
+    t, at, q, qd, qdd, tau = trajectories["fit"]
+    s = model(STANDARD_FROM_DYNAMIC.name, p)
+    context = Context(model, robot, p, s, 0.01, (q.min(axis=0), q.max(axis=0)), (qd.min(axis=0), qd.max(axis=0)))
+    whole = signals("fit", t, q, qd, qdd, tau)
+    local = [e for e in library(context) if e.local]
+    assert {e.name for e in local} >= {"coulomb", "stribeck", "viscous", "offset"}
+    for effect in local:
+        full = effect.columns(context, whole, tau)
+        for j in range(7):
+            alone = effect.columns(context, whole.of_joint(j), tau[:, j: j + 1])
+            np.testing.assert_array_equal(alone[:, 0, :], full[:, j, :], err_msg=effect.key)

@@ -86,6 +86,12 @@ class Signals:
         shape = x.shape
         return self.lowpass(np.asarray(x, dtype=float).reshape(shape[0], -1)).reshape(shape)
 
+    def of_joint(self, j: int) -> "Signals":
+        """The signals of joint j alone (columns j: j + 1), filtered the same way."""
+        one = slice(j, j + 1)
+        return dataclasses.replace(self, q=self.q[:, one], qd=self.qd[:, one], qdd=self.qdd[:, one],
+                                   tau=None if self.tau is None else self.tau[:, one], extra={})
+
     def inner(self) -> np.ndarray:
         """Boolean (T,): the samples that are data (not the filter's start-up)."""
         keep = np.ones(self.t.size, dtype=bool)

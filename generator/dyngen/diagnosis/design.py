@@ -79,17 +79,30 @@ def effect_columns(effects, context, segment) -> dict:
     return {e.key: columns_of(e, context, segment) for e in effects}
 
 
-def columns_of(effect, context, segment) -> np.ndarray:
+def columns_of(effect, context, segment, joint=None) -> np.ndarray:
     """An effect's columns on one segment, computed once per segment and effect setting (the
     selection and the pruning ask again). Laws that switch with the sign of the velocity
     (Effect.switching: Coulomb, Stribeck, direction) are passed through the recording's filter,
     like the torque they explain: a filtered friction step is then compared with a filtered
-    step, not a sharp one. Smooth functions of the filtered motion are filtered already."""
-    def compute():
-        x = np.asarray(effect.columns(context, segment.signals, segment.tau_model), float)
-        return segment.signals.filtered(x) if effect.switching else x
+    step, not a sharp one. Smooth functions of the filtered motion are filtered already.
 
-    return context.memo(("columns", id(segment), effect.key), compute)
+    joint: of a local effect (Effect.local), only that joint's columns are computed, the
+    others left zero (the search of a velocity scale asks for one joint's column dozens of times)."""
+    part = joint is not None and effect.local
+
+    def compute():
+        signals, tau_model = segment.signals, segment.tau_model
+        if part:
+            signals, tau_model = signals.of_joint(joint), tau_model[:, joint: joint + 1]
+        x = np.asarray(effect.columns(context, signals, tau_model), float)
+        x = signals.filtered(x) if effect.switching else x
+        if not part:
+            return x
+        out = np.zeros((x.shape[0], segment.residual.shape[1], x.shape[2]))
+        out[:, joint, :] = x[:, 0, :]
+        return out
+
+    return context.memo(("columns", id(segment), effect.key, joint if part else None), compute)
 
 
 def joint_matrix(candidates, columns: dict, joint: int) -> tuple[np.ndarray, np.ndarray]:

@@ -72,7 +72,11 @@ class _State:
         old = self.chosen[index]
         effect = old.effect.at(setting)
         chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
-        columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg)}
+        # a per-joint candidate's columns on its own joint only, unless another joint's
+        # candidate has the same setting (and key)
+        shared = any(c.effect.key == effect.key and c.joint != old.joint for c in chosen)
+        joint = None if shared else old.joint
+        columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg, joint)}
                    for cols, seg in zip(self.columns, self.segments)]
         return chosen, columns, self.updated(chosen, columns, index)
 
@@ -91,17 +95,21 @@ class _State:
                 m.G[j][:, new] = 0.0
                 m.b[j][new] = 0.0
         for seg, cols in zip(self.segments, columns):
+            # every role's sums at once: its mask (as 0/1 rows) times per-sample products
+            masks = np.array([seg.fit, seg.select, seg.test, *_groups(seg, design)], dtype=float)
             for j in joints:
                 acting = [c for c in chosen if c.joint is None or c.joint == j]
                 A, slots = dz.joint_matrix(acting, cols, j)
                 B = cols[cand.effect.key][:, j, :]
-                for m, mask in zip(moments, (seg.fit, seg.select, seg.test, *_groups(seg, design))):
-                    if mask.any():
-                        cross = A[mask].T @ B[mask]
-                        m.G[j][np.ix_(slots, new)] += cross
-                        m.G[j][np.ix_(new, slots)] += cross.T
-                        m.G[j][np.ix_(new, new)] -= B[mask].T @ B[mask]  # counted twice above
-                        m.b[j][new] += B[mask].T @ seg.residual[mask, j]
+                k = B.shape[1]
+                cross = (masks @ (A[:, :, None] * B[:, None, :]).reshape(len(B), -1)).reshape(len(masks), -1, k)
+                own = (masks @ (B[:, :, None] * B[:, None, :]).reshape(len(B), -1)).reshape(len(masks), k, k)
+                rhs = masks @ (B * seg.residual[:, j, None])
+                for m, c, o, b in zip(moments, cross, own, rhs):
+                    m.G[j][np.ix_(slots, new)] += c
+                    m.G[j][np.ix_(new, slots)] += c.T
+                    m.G[j][np.ix_(new, new)] -= o  # counted twice above
+                    m.b[j][new] += b
         return type(self.template)(chosen, *moments[:3], self.weights, moments[3:])
 
     def accept(self, trial):

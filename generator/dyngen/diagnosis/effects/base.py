@@ -53,6 +53,7 @@ class Effect:
     extends = ""  # name of the effect this one only adds to, on the same joint (selected first, dropped with it)
     simple_term = ""  # the simple model's term (baseline.NAMES) this effect is, if it is one (b, Fv)
     switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
+    local = False  # scope "joint": its column on joint j depends on joint j's own motion alone
     simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")
 
     @classmethod

@@ -34,6 +34,8 @@ RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many p
 class _Dissipative(Effect):
     """Friction opposes motion and a rotor inertia is positive: only positive values qualify."""
 
+    local = True
+
     def plausible(self, values):
         return bool(np.all(values > 0))
 
@@ -74,7 +76,7 @@ class Coulomb(_Dissipative):
 
 class Direction(Effect):
     name, parameters, units = "direction", ("dFc",), ("Nm",)
-    secondary = switching = True
+    secondary = switching = local = True
 
     def columns(self, context, signals, tau_model):
         return np.abs(context.sign(signals.qd))[:, :, None]

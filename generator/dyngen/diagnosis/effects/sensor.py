@@ -29,6 +29,7 @@ MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor
 class Offset(Effect):
     name, parameters, units = "offset", ("b",), ("Nm",)
     simple_term = "b"
+    local = True
 
     def columns(self, context, signals, tau_model):
         return np.ones(signals.q.shape + (1,))
