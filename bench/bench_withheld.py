@@ -5,8 +5,8 @@
 
 For every case of bench/simulation/withheld_cases.py (CASES: the LWR in MuJoCo, torques from
 mj_inverse with effects the nominal model lacks; TRACKED_CASES: a forward simulation of the arm
-tracking its reference, with friction that sticks at reversals; OFF_GRID_CASES: settings
-between the diagnosis's variants), positions as a 20-bit encoder records them (1e-5 rad noise,
+tracking its reference, with friction that sticks at reversals; COMPOSED_CASES: a sensor's lag
+or gain beside friction or a tilt; OFF_GRID_CASES: settings between the diagnosis's variants), positions as a 20-bit encoder records them (1e-5 rad noise,
 quantised), no qd or qdd columns, torque noise 0.05 Nm. Each case runs through
 `dyngen diagnose`'s function with default options, in both directions: fit on the Fourier
 excitation (selection on blocks of it) and test on Table V, and the reverse. The verdict
@@ -35,7 +35,7 @@ blas.use_one_thread()
 import numpy as np  # noqa: E402
 from simulation.mujoco_measurements import Encoder  # noqa: E402
 from simulation.withheld_run import DIRECTIONS, run  # noqa: E402
-from simulation.withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, write_cases  # noqa: E402
+from simulation.withheld_cases import CASES, COMPOSED_CASES, OFF_GRID_CASES, TRACKED_CASES, write_cases  # noqa: E402
 
 from dyngen.atomic import write_file  # noqa: E402
 from dyngen.description import load_robot  # noqa: E402
@@ -103,7 +103,8 @@ def main(argv=None) -> int:
         for rate, encoder in variants:
             label = f"{rate:g} Hz" + ("" if encoder else " exact")
             main_rows, beyond_rows = [], []
-            for name, cases, rows in (("cases", CASES + TRACKED_CASES, main_rows), ("off_grid", OFF_GRID_CASES, beyond_rows)):
+            main = CASES + TRACKED_CASES + COMPOSED_CASES
+            for name, cases, rows in (("cases", main, main_rows), ("off_grid", OFF_GRID_CASES, beyond_rows)):
                 folder = Path(tmp) / f"{name}-{label.replace(' ', '_')}"
                 doc = write_cases(folder, rate_hz=rate, seed=args.seed, cases=cases, encoder=encoder)
                 rows += run_folder(robot, model, folder, doc, label)
@@ -112,7 +113,7 @@ def main(argv=None) -> int:
                    if encoder else
                    "exact positions, velocities and accelerations in the files (the noise-free variant)")
             sections += [f"## {label}: {how}", "",
-                         f"**{summary(main_rows)}** ({len(CASES) + len(TRACKED_CASES)} cases x 2 directions; the "
+                         f"**{summary(main_rows)}** ({len(main)} cases x 2 directions; the "
                          f"coefficients case is out of scope). Diagnosis {min(seconds):.2f}-{max(seconds):.2f} s per run. "
                          f"Cutoffs chosen: {sorted({round(c, 1) for r in main_rows for c in r['cutoff'] if c})} Hz.", "",
                          *table(main_rows), "", "Settings between the diagnosis's variants and a leading torque "

@@ -105,6 +105,13 @@ TRACKED_CASES = [
     Case("sticky_offset", Effects(coulomb={6: 0.4}, offset={1: 0.3}), tracked=True),
 ]
 
+# A sensor effect beside an effect on the arm: the sensor lags or scales friction and gravity
+# as it does the rest of the torque (written after the cases above, whose noise stays as it was).
+COMPOSED_CASES = [
+    Case("shift_coulomb", Effects(coulomb={3: 1.2}, time_shift=0.010)),
+    Case("gain_tilt", Effects(gain={2: 0.06}, tilt_deg=3.0, tilt_axis=TILT_AXIS)),
+]
+
 # Settings between the diagnosis's variants (Stribeck vs 0.03/0.1/0.3 rad/s, time shifts
 # 1/4/16/64 ms), and a torque leading the positions: does its refinement find them?
 OFF_GRID_CASES = [

@@ -19,14 +19,14 @@ from dyngen.diagnosis import diagnose
 from dyngen.diagnosis.report import to_json
 
 from .perfect import perfect_rms
-from .withheld_cases import CASES, OFF_GRID_CASES, TRACKED_CASES, nominal_model, simulated_parameters
+from .withheld_cases import CASES, COMPOSED_CASES, OFF_GRID_CASES, TRACKED_CASES, nominal_model, simulated_parameters
 from .withheld_verdict import problems, truth_text, verdict_text
 
 DIRECTIONS = {"forward": ("fit", "holdout"), "backward": ("holdout", "fit")}
 
 
 def case_by_name(name):
-    return next(c for c in [*CASES, *OFF_GRID_CASES, *TRACKED_CASES] if c.name == name)
+    return next(c for c in [*CASES, *OFF_GRID_CASES, *TRACKED_CASES, *COMPOSED_CASES] if c.name == name)
 
 
 def run(robot, model, folder, doc, name: str, direction: str = "forward", options=None) -> dict:

@@ -13,6 +13,8 @@ over dozens of candidates cheap (diagnosing 30 s at 1 kHz takes about a second).
 
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -87,8 +89,15 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
     step, not a sharp one. Smooth functions of the filtered motion are filtered already.
 
     joint: of a local effect (Effect.local), only that joint's columns are computed, the
-    others left zero (the search of a velocity scale asks for one joint's column dozens of times)."""
+    others left zero (the search of a velocity scale asks for one joint's column dozens of times).
+
+    The torque sensor as the chosen effects have it (measured): with a time shift
+    (Context.delay), every other effect's columns are taken that much earlier, as a late sensor
+    measures friction or a payload as late as the arm's own torque; with a sensor gain
+    (Context.scale), the arm's effects (not the sensor's) are scaled by it on its joint."""
     part = joint is not None and effect.local
+    delay = 0.0 if effect.delays else context.delay
+    scale = None if effect.sensor else context.scale
 
     def compute():
         signals, tau_model = segment.signals, segment.tau_model
@@ -96,13 +105,37 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
             signals, tau_model = signals.of_joint(joint), tau_model[:, joint: joint + 1]
         x = np.asarray(effect.columns(context, signals, tau_model), float)
         x = signals.filtered(x) if effect.switching else x
-        if not part:
-            return x
-        out = np.zeros((x.shape[0], segment.residual.shape[1], x.shape[2]))
-        out[:, joint, :] = x[:, 0, :]
-        return out
+        x = delayed(x, signals.t, delay) if delay else x
+        if part:
+            out = np.zeros((x.shape[0], segment.residual.shape[1], x.shape[2]))
+            out[:, joint, :] = x[:, 0, :]
+            x = out
+        return x * np.asarray(scale)[None, :, None] if scale is not None else x
 
-    return context.memo(("columns", id(segment), effect.key, joint if part else None), compute)
+    return context.memo(("columns", id(segment), effect.key, joint if part else None, delay, scale), compute)
+
+
+def measured(context, chosen):
+    """The context with the torque sensor the chosen candidates describe: the lag of a time
+    shift (Effect.delays, Context.delay) and each joint's 1 + sensor gain (Effect.scales,
+    Context.scale); none without them. The columns of a set of chosen candidates are computed in it."""
+    delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
+    gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
+    scale = None
+    if gains:
+        scale = tuple(1.0 + gains.get(j, 0.0) for j in range(len(context.robot.joints)))
+    if delay == context.delay and scale == context.scale:
+        return context
+    return dataclasses.replace(context, delay=delay, scale=scale)
+
+
+def delayed(x: np.ndarray, t: np.ndarray, delay: float) -> np.ndarray:
+    """x (T, ...) at times t - delay, linearly interpolated, held at its first value before
+    the first sample (as TimeShift's columns are)."""
+    at = np.clip(t - delay, t[0], t[-1])
+    k = np.clip(np.searchsorted(t, at, side="right"), 1, t.size - 1)
+    w = ((at - t[k - 1]) / (t[k] - t[k - 1])).reshape((-1,) + (1,) * (x.ndim - 1))
+    return (1.0 - w) * x[k - 1] + w * x[k]
 
 
 def joint_matrix(candidates, columns: dict, joint: int) -> tuple[np.ndarray, np.ndarray]:

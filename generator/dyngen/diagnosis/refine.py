@@ -37,8 +37,9 @@ def refine(context, segments, design, chosen):
     if not any(c.effect.refinable for c in chosen):
         return design, chosen
     state = _State(context, segments, design, _renumbered(chosen))
-    for index, cand in enumerate(state.chosen):
-        if cand.effect.refinable:
+    # The sensor's lag and gains first: other effects' columns, and so their settings, depend on them.
+    for index in sorted(range(len(state.chosen)), key=lambda i: not _moves_others(state.chosen[i].effect)):
+        if state.chosen[index].effect.refinable:
             _refine_one(state, index)
     return state.design, state.chosen
 
@@ -54,12 +55,15 @@ class _State:
     """The chosen candidates, their columns per segment and their restricted design."""
 
     def __init__(self, context, segments, design, chosen):
-        self.context, self.segments, self.weights = context, segments, design.weights
+        self.context, self.segments, self.weights = dz.measured(context, chosen), segments, design.weights
         self.template = design
-        effects = list({c.effect.key: c.effect for c in chosen}.values())
-        self.columns = [dz.effect_columns(effects, context, seg) for seg in segments]
         self.chosen = chosen
+        self.columns = self.all_columns(chosen, self.context)
         self.design = self.restricted(chosen, self.columns)
+
+    def all_columns(self, chosen, context) -> list:
+        effects = list({c.effect.key: c.effect for c in chosen}.values())
+        return [dz.effect_columns(effects, context, seg) for seg in self.segments]
 
     def values(self, index, design=None, chosen=None) -> np.ndarray:
         design, chosen = design or self.design, chosen or self.chosen
@@ -68,17 +72,21 @@ class _State:
         return fit.x[offset: offset + chosen[index].size]
 
     def trial(self, index, setting):
-        """(chosen, columns, design) with candidate `index` at another setting."""
+        """(chosen, columns, design, context) with candidate `index` at another setting."""
         old = self.chosen[index]
         effect = old.effect.at(setting)
         chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
+        if _moves_others(effect):  # every other effect's columns move with a lag or a gain
+            context = dz.measured(self.context, chosen)
+            columns = self.all_columns(chosen, context)
+            return chosen, columns, self.restricted(chosen, columns), context
         # a per-joint candidate's columns on its own joint only, unless another joint's
         # candidate has the same setting (and key)
         shared = any(c.effect.key == effect.key and c.joint != old.joint for c in chosen)
         joint = None if shared else old.joint
         columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg, joint)}
                    for cols, seg in zip(self.columns, self.segments)]
-        return chosen, columns, self.updated(chosen, columns, index)
+        return chosen, columns, self.updated(chosen, columns, index), self.context
 
     def updated(self, chosen, columns, index):
         """self.design with the rows and columns of candidate `index` recomputed (the others'
@@ -113,7 +121,7 @@ class _State:
         return type(self.template)(chosen, *moments[:3], self.weights, moments[3:])
 
     def accept(self, trial):
-        self.chosen, self.columns, self.design = trial
+        self.chosen, self.columns, self.design, self.context = trial
 
     def restricted(self, chosen, columns):
         """Moments of the chosen candidates only, weighted as the selection's design."""
@@ -159,7 +167,7 @@ def _refine_one(state, index) -> None:
         return
 
     def cost(setting):
-        chosen, _, design = state.trial(index, setting)
+        chosen, _, design, _ = state.trial(index, setting)
         return _weighted_sse(design, solve(design, chosen))
 
     # Searched in the logarithm of the setting (a velocity scale matters by its ratio).
@@ -167,6 +175,11 @@ def _refine_one(state, index) -> None:
     best = minimize_scalar(lambda u: cost(float(np.exp(u))), bounds=(lo, hi), method="bounded",
                            options={"xatol": SEARCH_TOLERANCE})
     state.accept(state.trial(index, float(np.exp(best.x))))
+
+
+def _moves_others(effect) -> bool:
+    """Whether an effect's setting changes the other effects' columns (design.measured)."""
+    return effect.delays or effect.scales
 
 
 def _renumbered(chosen) -> list:

@@ -111,7 +111,7 @@ def _design(context, effects, segments, n) -> Design:
 def predict(context, chosen, x, segment) -> np.ndarray:
     """The chosen candidates' torques (T, N) on one segment, for fitted values x (in chosen order)."""
     effects = list({c.effect.key: c.effect for c in chosen}.values())
-    columns = dz.effect_columns(effects, context, segment)
+    columns = dz.effect_columns(effects, dz.measured(context, chosen), segment)
     out = np.zeros_like(segment.residual)
     offset = 0
     for c in chosen:
@@ -242,15 +242,28 @@ def _settled(context, segments, design, chosen, correlation, options):
     # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
     # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
     design, chosen = refine(context, segments, design, chosen)
+    sensor = _sensor(context, chosen)
     chosen, _, dropped = prune(design, chosen, correlation, options.alpha, options.min_gain)
     narrow = _narrow_stribeck(chosen)
     chosen = [c for c in chosen if c not in narrow]
     dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
     if dropped:
+        if _sensor(context, chosen) != sensor:  # a time shift or gain went: the others' columns change back
+            design, chosen = restricted(context, segments, design, chosen)
         design, chosen = refine(context, segments, design, chosen)
+    sensor = _sensor(context, chosen)
     chosen, final, refused = _plausible(design, chosen)
+    if _sensor(context, chosen) != sensor:
+        design, chosen = restricted(context, segments, design, chosen)
+        final = solve(design, chosen)
     design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
     return design, chosen, final, dropped, refused
+
+
+def _sensor(context, chosen) -> tuple:
+    """The torque sensor's lag and gains the chosen candidates describe (design.measured)."""
+    measured = dz.measured(context, chosen)
+    return measured.delay, measured.scale
 
 
 def _decide_on_folds(context, segments, design, chosen, final, options) -> list[str]:

@@ -19,6 +19,11 @@ class Context:
     sign_velocity: float  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity) (diagnosis Options)
     q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
     qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
+    # The torque sensor as the chosen effects have it (design.measured): every other effect's
+    # torque is measured `delay` s late (a time shift), and the arm's (effects not of the
+    # sensor) times `scale[j]` on joint j (1 + a sensor gain; None: 1 on every joint).
+    delay: float = 0.0
+    scale: tuple | None = None
     cache: dict = field(default_factory=dict)  # columns and shared intermediates, per recording (memo)
 
     def memo(self, key, compute):
@@ -54,6 +59,9 @@ class Effect:
     simple_term = ""  # the simple model's term (baseline.NAMES) this effect is, if it is one (b, Fv)
     switching = False  # switches with the sign of the velocity: its columns are filtered like the torque
     local = False  # scope "joint": its column on joint j depends on joint j's own motion alone
+    sensor = False  # acts on how torques are measured (offset, gain, time shift), not on the arm
+    delays = False  # its setting is a lag of the measured torque, which every other effect's torque shares
+    scales = False  # its setting is its joint's sensor gain, which scales the arm's other torques on it
     simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")
 
     @classmethod

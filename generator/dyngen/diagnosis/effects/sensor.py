@@ -29,14 +29,33 @@ MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor
 class Offset(Effect):
     name, parameters, units = "offset", ("b",), ("Nm",)
     simple_term = "b"
-    local = True
+    local = sensor = True
 
     def columns(self, context, signals, tau_model):
         return np.ones(signals.q.shape + (1,))
 
 
 class Gain(Effect):
+    """measured = (1 + k-1) * torque: the model's torque (its column) and every other effect's
+    torque on the arm alike, friction and payload included. Its setting g0 is the gain those are
+    scaled by (Context.scale), refined to the fitted value once selected (0 while selecting)."""
+
     name, parameters, units = "gain", ("k-1",), ("1",)
+    refinable = sensor = scales = True
+
+    def __init__(self, gain: float = 0.0):
+        self.gain = float(gain)
+        self.label = f"g0={self.gain:.6g}" if self.gain else ""
+
+    @property
+    def setting(self):
+        return self.gain
+
+    def implied_setting(self, values):
+        return float(values[0])
+
+    def at(self, setting):
+        return Gain(setting)
 
     def plausible(self, values):
         return bool(np.all(np.abs(values) < 0.5))  # a sensor that reads 0.5 to 1.5 times the torque
@@ -50,7 +69,7 @@ class Gain(Effect):
 
 class TimeShift(Effect):
     name, scope, parameters, units = "time_shift", "arm", ("dt",), ("s",)
-    refinable = True
+    refinable = sensor = delays = True
 
     def __init__(self, shift: float):
         self.shift = float(shift)  # dt0 [s], not 0
