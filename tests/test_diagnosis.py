@@ -418,3 +418,50 @@ def test_a_local_effects_column_on_a_joint_needs_that_joint_alone(lwr):
         for j in range(7):
             alone = effect.columns(context, whole.of_joint(j), tau[:, j: j + 1])
             np.testing.assert_array_equal(alone[:, 0, :], full[:, j, :], err_msg=effect.key)
+
+
+def test_the_nearest_body_inertia_is_a_body_and_nearest():
+    """Payload.simplified keeps a payload whose fitted inertia is no body's with the nearest
+    body's inertia (same principal axes): checked against a brute-force search over principal
+    moments that satisfy the triangle inequalities."""
+    from dyngen.diagnosis.effects.body import nearest_body_inertia
+
+    rng = np.random.default_rng(5)
+    V = np.linalg.qr(rng.standard_normal((3, 3)))[0]
+    for moments in ([0.004, 0.001, -0.002], [0.001, 0.002, 0.009], [0.003, 0.002, 0.004]):
+        I = V @ np.diag(moments) @ V.T
+        J = nearest_body_inertia(I)
+        e = np.sort(np.linalg.eigvalsh(J))
+        assert e[0] >= -1e-15 and e[0] + e[1] >= e[2] - 1e-15
+        grid = np.linspace(0.0, 0.01, 101)
+        a, b, c = np.meshgrid(grid, grid, grid, indexing="ij")
+        body = (a + b >= c) & (b + c >= a) & (a + c >= b)
+        d = (a - moments[0]) ** 2 + (b - moments[1]) ** 2 + (c - moments[2]) ** 2
+        assert np.linalg.norm(J - I) <= np.sqrt(d[body].min()) + 1e-12
+        if sorted(moments) == sorted(e.tolist()):
+            np.testing.assert_allclose(J, I, atol=1e-15)  # a body's inertia stays as it is
+
+
+def test_a_fixed_shape_payload_exports_the_body_its_columns_describe(lwr):
+    """FixedShapePayload (a payload whose fitted inertia was no body's): its columns times its
+    values equal Newton-Euler with the standard parameters it adds to the last link (what the
+    updated model and the URDF get), and those are a body's."""
+    from dyngen.catalogue import STANDARD_FROM_DYNAMIC
+    from dyngen.diagnosis.effects import Context
+    from dyngen.diagnosis.effects.body import FixedShapePayload, consistent_inertia
+
+    model, robot, arm, p, trajectories = lwr
+    t, at, q, qd, qdd, tau = trajectories["fit"]
+    s = model(STANDARD_FROM_DYNAMIC.name, p)
+    context = Context(model, robot, p, s, 0.01)
+    centre, per_kg = np.array([0.02, -0.01, 0.12]), np.diag([0.002, 0.003, 0.004])
+    payload = FixedShapePayload(centre, per_kg, 20.0)
+    values = np.array([1.3, *(1.3 * centre)])
+    entry = dict(zip(payload.parameters, values))
+    added = FixedShapePayload.last_link(entry, payload.fixed())
+    assert consistent_inertia(added)
+    loaded = s.copy()
+    loaded[-10:] += added
+    predicted = payload.columns(context, signals("fit", t, q, qd, qdd, tau), tau) @ values
+    added_torque = model.batch("rnea", q, qd, qdd, loaded) - model.batch("rnea", q, qd, qdd, s)
+    np.testing.assert_allclose(predicted, added_torque, atol=1e-10)

@@ -36,7 +36,7 @@ LWR = ROOT / "examples" / "lwr.yaml"
 IN_SCOPE = [c for c in CASES if c.name != "coefficients"]  # coefficient errors: not in the default library
 # Fitted on Table V, a time shift once drew a small viscous term on joint 2 beside it: a shift
 # refitted with it that spoiled joints 1 and 3 (selection.selection_gain charges for that).
-BACKWARD = ["none", "sticky", "stribeck_sticky", "time_shift", "shift_coulomb", "gain_tilt"]
+BACKWARD = ["none", "sticky", "stribeck_sticky", "time_shift", "shift_coulomb", "gain_tilt", "payload_tilt"]
 
 
 @pytest.fixture(scope="module")

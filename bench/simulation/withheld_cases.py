@@ -110,6 +110,8 @@ TRACKED_CASES = [
 COMPOSED_CASES = [
     Case("shift_coulomb", Effects(coulomb={3: 1.2}, time_shift=0.010)),
     Case("gain_tilt", Effects(gain={2: 0.06}, tilt_deg=3.0, tilt_axis=TILT_AXIS)),
+    # and a tilt turns a payload's gravity as it does the arm's
+    Case("payload_tilt", Effects(payload=PAYLOAD, tilt_deg=3.0, tilt_axis=TILT_AXIS)),
 ]
 
 # Settings between the diagnosis's variants (Stribeck vs 0.03/0.1/0.3 rad/s, time shifts

@@ -29,12 +29,14 @@ def case_by_name(name):
     return next(c for c in [*CASES, *OFF_GRID_CASES, *TRACKED_CASES, *COMPOSED_CASES] if c.name == name)
 
 
-def run(robot, model, folder, doc, name: str, direction: str = "forward", options=None) -> dict:
+def run(robot, model, folder, doc, name: str, direction: str = "forward", options=None, case=None) -> dict:
+    """Diagnose case `name` of a written folder in one direction; `case`: its Case, if not one of
+    the module's lists (bench_withheld_random.py)."""
     entry = next(c for c in doc["cases"] if c["name"] == name)
     fit_key, test_key = DIRECTIONS[direction]
     fit, test = (condition(read_recording(folder / entry[k], robot.dof)) for k in (fit_key, test_key))
     p_model = nominal_model(robot)
-    case = case_by_name(name)
+    case = case or case_by_name(name)
     p_true = simulated_parameters(case, p_model, doc["seed"])
     start = time.perf_counter()
     kwargs = {"options": options} if options is not None else {}

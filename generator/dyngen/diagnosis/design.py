@@ -91,10 +91,11 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
     joint: of a local effect (Effect.local), only that joint's columns are computed, the
     others left zero (the search of a velocity scale asks for one joint's column dozens of times).
 
-    The torque sensor as the chosen effects have it (measured): with a time shift
+    The arm and its torque sensor as the chosen effects have them (as_chosen): with a time shift
     (Context.delay), every other effect's columns are taken that much earlier, as a late sensor
     measures friction or a payload as late as the arm's own torque; with a sensor gain
-    (Context.scale), the arm's effects (not the sensor's) are scaled by it on its joint."""
+    (Context.scale), the arm's effects (not the sensor's) are scaled by it on its joint; a
+    tilt turns a payload's gravity with the arm's (Context.load, Effect.reads)."""
     part = joint is not None and effect.local
     delay = 0.0 if effect.delays else context.delay
     scale = None if effect.sensor else context.scale
@@ -112,21 +113,24 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
             x = out
         return x * np.asarray(scale)[None, :, None] if scale is not None else x
 
-    return context.memo(("columns", id(segment), effect.key, joint if part else None, delay, scale), compute)
+    key = ("columns", id(segment), effect.key, joint if part else None, delay, scale, effect.reads(context))
+    return context.memo(key, compute)
 
 
-def measured(context, chosen):
-    """The context with the torque sensor the chosen candidates describe: the lag of a time
-    shift (Effect.delays, Context.delay) and each joint's 1 + sensor gain (Effect.scales,
-    Context.scale); none without them. The columns of a set of chosen candidates are computed in it."""
+def as_chosen(context, chosen):
+    """The context with the arm and torque sensor the chosen candidates describe: the lag of
+    a time shift (Effect.delays), each joint's 1 + sensor gain (Effect.scales) and a payload
+    (Effect.load), each at its setting; none without them. The columns of a set of chosen candidates are computed in it."""
     delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
     scale = None
     if gains:
         scale = tuple(1.0 + gains.get(j, 0.0) for j in range(len(context.robot.joints)))
-    if delay == context.delay and scale == context.scale:
+    load = next((c.effect.load for c in chosen if c.effect.load is not None), None)
+    world = {"delay": delay, "scale": scale, "load": load}
+    if all(getattr(context, k) == v for k, v in world.items()):
         return context
-    return dataclasses.replace(context, delay=delay, scale=scale)
+    return dataclasses.replace(context, **world)
 
 
 def delayed(x: np.ndarray, t: np.ndarray, delay: float) -> np.ndarray:

@@ -41,7 +41,7 @@ FOLDS_PER_VALUE = 0.02  # least gain per extra value on errors summed over the t
 
 def _parts(context, chosen, x, seg, j):
     """(arm-wide effects' torque on joint j, columns of the per-joint effects on joint j)."""
-    context = dz.measured(context, chosen)
+    context = dz.as_chosen(context, chosen)
     arm = np.zeros(seg.residual.shape[0])
     columns = []
     for c, v in zip(chosen, dz.split_values(chosen, x)):

@@ -46,7 +46,7 @@ def with_payload(diagnosis, p: np.ndarray) -> np.ndarray:
     are all determined); otherwise p unchanged."""
     s = None
     for e in diagnosis.selected:
-        added = effect_class(e["effect"]).last_link(e["values"])
+        added = effect_class(e["effect"]).last_link(e["values"], e.get("variant"))
         if added is not None:
             s = standard_from_dynamic(p) if s is None else s
             s[-PER_LINK:] += added

@@ -37,8 +37,8 @@ def refine(context, segments, design, chosen):
     if not any(c.effect.refinable for c in chosen):
         return design, chosen
     state = _State(context, segments, design, _renumbered(chosen))
-    # The sensor's lag and gains first: other effects' columns, and so their settings, depend on them.
-    for index in sorted(range(len(state.chosen)), key=lambda i: not _moves_others(state.chosen[i].effect)):
+    # Settings that enter other effects' columns first (a lag, gains, a payload, a tilt).
+    for index in sorted(range(len(state.chosen)), key=lambda i: not state.chosen[i].effect.shapes_others):
         if state.chosen[index].effect.refinable:
             _refine_one(state, index)
     return state.design, state.chosen
@@ -55,7 +55,7 @@ class _State:
     """The chosen candidates, their columns per segment and their restricted design."""
 
     def __init__(self, context, segments, design, chosen):
-        self.context, self.segments, self.weights = dz.measured(context, chosen), segments, design.weights
+        self.context, self.segments, self.weights = dz.as_chosen(context, chosen), segments, design.weights
         self.template = design
         self.chosen = chosen
         self.columns = self.all_columns(chosen, self.context)
@@ -76,8 +76,8 @@ class _State:
         old = self.chosen[index]
         effect = old.effect.at(setting)
         chosen = self.chosen[:index] + [dz.Candidate(effect, old.joint, old.start, old.size)] + self.chosen[index + 1:]
-        if _moves_others(effect):  # every other effect's columns move with a lag or a gain
-            context = dz.measured(self.context, chosen)
+        if effect.shapes_others:  # other effects' columns change with it (design.as_chosen)
+            context = dz.as_chosen(self.context, chosen)
             columns = self.all_columns(chosen, context)
             return chosen, columns, self.restricted(chosen, columns), context
         # a per-joint candidate's columns on its own joint only, unless another joint's
@@ -149,15 +149,23 @@ class _State:
 def _refine_one(state, index) -> None:
     effect = state.chosen[index].effect
     if effect.implied_setting(state.values(index)) is not None:
+        start, last = (state.chosen, state.columns, state.design, state.context), np.inf
         for _ in range(MAX_ITERATIONS):
             current = state.chosen[index].effect
-            setting = current.implied_setting(state.values(index))
+            values = state.values(index)
+            setting = current.implied_setting(values)
             if setting is None:
                 return
-            state.accept(state.trial(index, setting))
-            step = np.linalg.norm(np.subtract(setting, current.setting))
-            if step <= REFINE_TOLERANCE * max(np.linalg.norm(setting), 1e-12):
+            step = float(np.linalg.norm(np.subtract(setting, current.setting)))
+            if not current.plausible(values) or step > last:
+                # values no effect can have, or steps that grow: a setting the data do not
+                # determine (a sensor gain on a joint with little torque ran off to 14)
+                state.accept(start)
                 return
+            state.accept(state.trial(index, setting))
+            if step <= max(REFINE_TOLERANCE * np.linalg.norm(setting), current.tolerance):
+                return
+            last = step
         return
     joint = state.chosen[index].joint
     beside = tuple(c.effect for i, c in enumerate(state.chosen)
@@ -175,11 +183,6 @@ def _refine_one(state, index) -> None:
     best = minimize_scalar(lambda u: cost(float(np.exp(u))), bounds=(lo, hi), method="bounded",
                            options={"xatol": SEARCH_TOLERANCE})
     state.accept(state.trial(index, float(np.exp(best.x))))
-
-
-def _moves_others(effect) -> bool:
-    """Whether an effect's setting changes the other effects' columns (design.measured)."""
-    return effect.delays or effect.scales
 
 
 def _renumbered(chosen) -> list:

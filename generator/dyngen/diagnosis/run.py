@@ -111,7 +111,7 @@ def _design(context, effects, segments, n) -> Design:
 def predict(context, chosen, x, segment) -> np.ndarray:
     """The chosen candidates' torques (T, N) on one segment, for fitted values x (in chosen order)."""
     effects = list({c.effect.key: c.effect for c in chosen}.values())
-    columns = dz.effect_columns(effects, dz.measured(context, chosen), segment)
+    columns = dz.effect_columns(effects, dz.as_chosen(context, chosen), segment)
     out = np.zeros_like(segment.residual)
     offset = 0
     for c in chosen:
@@ -261,9 +261,10 @@ def _settled(context, segments, design, chosen, correlation, options):
 
 
 def _sensor(context, chosen) -> tuple:
-    """The torque sensor's lag and gains the chosen candidates describe (design.measured)."""
-    measured = dz.measured(context, chosen)
-    return measured.delay, measured.scale
+    """What the chosen candidates set of the context (design.as_chosen): the sensor's lag and
+    gains, a payload."""
+    world = dz.as_chosen(context, chosen)
+    return world.delay, world.scale, world.load
 
 
 def _decide_on_folds(context, segments, design, chosen, final, options) -> list[str]:

@@ -38,7 +38,7 @@ def check_names(names) -> None:
 
 
 def effect_class(name: str) -> type:
-    """The class of the effect a report entry names (PointPayload reports as "payload")."""
+    """The class of the effect a report entry names (FixedShapePayload reports as "payload")."""
     return next(cls for cls in EFFECTS if cls.name == name)
 
 

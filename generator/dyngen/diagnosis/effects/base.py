@@ -19,11 +19,14 @@ class Context:
     sign_velocity: float  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity) (diagnosis Options)
     q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
     qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
-    # The torque sensor as the chosen effects have it (design.measured): every other effect's
-    # torque is measured `delay` s late (a time shift), and the arm's (effects not of the
-    # sensor) times `scale[j]` on joint j (1 + a sensor gain; None: 1 on every joint).
+    # The arm and its torque sensor as the chosen effects have them (design.as_chosen): every
+    # other effect's torque is measured `delay` s late (a time shift), and the arm's (effects
+    # not of the sensor) times `scale[j]` on joint j (1 + a sensor gain; None: 1 on every
+    # joint); `load`: (m, mx, my, mz) of a payload on the last link, whose gravity a tilt turns
+    # with the arm's.
     delay: float = 0.0
     scale: tuple | None = None
+    load: tuple | None = None
     cache: dict = field(default_factory=dict)  # columns and shared intermediates, per recording (memo)
 
     def memo(self, key, compute):
@@ -52,6 +55,7 @@ class Effect:
     units: tuple = ()
     label = ""  # a variant's setting, e.g. "vs = 0.1 rad/s"
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
+    tolerance = 0.0  # a setting refined by fixed-point iteration: steps this small (absolute) end it
     suspect = ""  # a symptom rather than a cause: why, reported with a warning
     secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
     ranged = False  # its columns depend on the positions the fit data cover (Context.q_range)
@@ -62,6 +66,7 @@ class Effect:
     sensor = False  # acts on how torques are measured (offset, gain, time shift), not on the arm
     delays = False  # its setting is a lag of the measured torque, which every other effect's torque shares
     scales = False  # its setting is its joint's sensor gain, which scales the arm's other torques on it
+    shapes_others = False  # its setting enters other effects' columns (Context: delay, scale, load)
     simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")
 
     @classmethod
@@ -73,6 +78,16 @@ class Effect:
         """(T, N, k): column c of joint j's residual. Scope "joint": entry [:, j, :] is the
         candidate on joint j and acts on joint j only."""
         raise NotImplementedError
+
+    def reads(self, context: Context) -> tuple:
+        """The parts of the context its columns depend on besides the recording (for the memo):
+        what other chosen effects set (Context.load)."""
+        return ()
+
+    @property
+    def load(self):
+        """A payload at its setting: its (m, mx, my, mz) (Context.load); others None."""
+        return None
 
     def plausible(self, values: np.ndarray) -> bool:
         """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
@@ -133,8 +148,9 @@ class Effect:
         return {}
 
     @classmethod
-    def last_link(cls, values: dict) -> np.ndarray | None:
-        """Standard parameters this effect adds to the last link (a payload); else None."""
+    def last_link(cls, values: dict, variant: dict | None = None) -> np.ndarray | None:
+        """Standard parameters this effect adds to the last link (a payload; its report entry's
+        values and variant); else None."""
         return None
 
     @property

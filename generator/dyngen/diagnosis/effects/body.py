@@ -20,13 +20,31 @@ class Payload(Effect):
     name, scope = "payload", "arm"
     parameters = STANDARD_NAMES_PER_LINK
     units = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
+    # Its setting (m, mx, my, mz, refined to the fitted values) is the body whose gravity a tilt
+    # turns with the arm's (Context.load): the product of the two enters the tilt's columns.
+    refinable = shapes_others = True
 
-    def __init__(self, max_mass: float):
+    def __init__(self, max_mass: float, weight=None):
         self.max_mass = float(max_mass)  # kg: the arm's own mass; a heavier "payload" is refused
+        self.weight = None if weight is None else tuple(float(x) for x in weight)  # (m, mx, my, mz) setting
 
     @classmethod
     def of(cls, context):
         return cls(float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0])))
+
+    @property
+    def setting(self):
+        return np.zeros(4) if self.weight is None else np.array(self.weight)
+
+    def implied_setting(self, values):
+        return np.array(values[:4], dtype=float)
+
+    def at(self, setting):
+        return Payload(self.max_mass, setting)
+
+    @property
+    def load(self):
+        return self.weight
 
     def plausible(self, values):
         """A body has a positive mass, not more than the arm's, and its centre of mass
@@ -35,23 +53,32 @@ class Payload(Effect):
         return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
 
     def simplified(self, values):
-        """A fitted inertia that is no body's (a negative principal moment about its centre of
-        mass): a point mass at the fitted centre instead. The data determine m and m c, not that
-        inertia, and an impossible inertia mispredicts other motions."""
+        """A fitted inertia that is no body's (about its centre of mass: a negative principal
+        moment, or one larger than the other two together): the nearest body's inertia instead,
+        per kg of the fitted mass, at the fitted centre (FixedShapePayload). The data determine
+        m and m c far better than that inertia; an impossible one mispredicts other motions,
+        and none at all (a point mass) leaves the body's own on the wrist joints."""
         if consistent_inertia(values):
             return None
-        refusal = {"candidate": "the payload's inertia about its centre of mass (a negative principal moment; "
-                                "the payload is kept as a point mass at its fitted centre)",
+        refusal = {"candidate": "the payload's inertia about its centre of mass (not a body's; the payload keeps its "
+                                "fitted centre and the nearest body's inertia, per kg of its mass)",
                    "values": values[4:].tolist()}
-        return PointPayload(values[1:4] / values[0], self.max_mass), refusal
+        m, c = values[0], values[1:4] / values[0]
+        nearest = nearest_body_inertia(_matrix(values[4:10]) - m * _point(c))
+        return FixedShapePayload(c, nearest / m, self.max_mass, values[:4]), refusal
 
     def columns(self, context, signals, tau_model):
+        return self.body_columns(context, signals, np.eye(PER_LINK))
+
+    @staticmethod
+    def body_columns(context, signals, units) -> np.ndarray:
+        """(T, N, k): Newton-Euler torques of the last link's standard parameters units[k]."""
         n = signals.q.shape[1]
-        out = np.empty(signals.q.shape + (PER_LINK,))
-        for k in range(PER_LINK):
-            unit = np.zeros(PER_LINK * n)
-            unit[PER_LINK * (n - 1) + k] = 1.0
-            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, unit)
+        out = np.empty(signals.q.shape + (len(units),))
+        for k, unit in enumerate(units):
+            s = np.zeros(PER_LINK * n)
+            s[PER_LINK * (n - 1):] = unit
+            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, s)
         return out
 
     def derived(self, robot, values, std, torque_rms):
@@ -62,63 +89,97 @@ class Payload(Effect):
                 "com_m": [values[k] / m if values.get(k) is not None else None for k in ("mx", "my", "mz")]}
 
     @classmethod
-    def last_link(cls, values):
-        return None if None in values.values() else standard_of_payload(values)
+    def last_link(cls, values, variant=None):
+        return None if None in values.values() else standard_of_payload(values, variant)
 
 
-class PointPayload(Payload):
-    """A payload as a point mass at c0 (the centre of mass of a fitted Payload whose inertia
-    about its centre came out physically impossible: the data do not determine it). Values m
-    and m c; the inertia about the frame origin is m (|c0|^2 1 - c0 c0^T), always consistent."""
+class FixedShapePayload(Payload):
+    """A payload of a fixed shape: centre c0 and inertia J0 about it per kg (those of a fitted
+    Payload whose own inertia came out no body's: Payload.simplified), its mass fitted. Values m
+    and m c; the inertia about the frame origin is m (J0 + |c0|^2 1 - c0 c0^T), a body's for any
+    positive m."""
 
     parameters = ("m", "mx", "my", "mz")
     units = ("kg", "kg m", "kg m", "kg m")
 
-    def __init__(self, centre, max_mass: float):
-        super().__init__(max_mass)
+    def __init__(self, centre, per_kg, max_mass: float, weight=None):
+        super().__init__(max_mass, weight)
         self.centre = np.asarray(centre, dtype=float)
-        self.label = "point mass at c0=(" + ",".join(f"{x:.4g}" for x in self.centre) + ")"
+        self.per_kg = np.asarray(per_kg, dtype=float)  # (3, 3) J0
+        self.label = "fixed shape at c0=(" + ",".join(f"{x:.4g}" for x in self.centre) + ")"
 
     def fixed(self):
-        return {"point_mass_at": [float(x) for x in self.centre]}
+        J = self.per_kg
+        return {"centre_m": [float(x) for x in self.centre],
+                "inertia_per_kg": [float(J[i, k]) for i, k in _UPPER]}  # XX, XY, XZ, YY, YZ, ZZ about the centre
+
+    def at(self, setting):
+        return FixedShapePayload(self.centre, self.per_kg, self.max_mass, setting)
 
     def simplified(self, values):
-        return None  # a point mass is always a body
+        return None  # always a body
 
     def columns(self, context, signals, tau_model):
-        n = signals.q.shape[1]
-        c = self.centre
-        I = c @ c * np.eye(3) - np.outer(c, c)  # unit mass
-        units = [np.array([1.0, 0, 0, 0, I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]]),
-                 *np.eye(PER_LINK)[1:4]]
-        out = np.empty(signals.q.shape + (4,))
-        for k, unit in enumerate(units):
-            s = np.zeros(PER_LINK * n)
-            s[PER_LINK * (n - 1):] = unit
-            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, s)
-        return out
+        I = self.per_kg + _point(self.centre)  # per kg, about the frame origin
+        units = [np.array([1.0, 0, 0, 0, *(I[i, k] for i, k in _UPPER)]), *np.eye(PER_LINK)[1:4]]
+        return self.body_columns(context, signals, np.array(units))
+
+    @classmethod
+    def last_link(cls, values, variant=None):
+        if None in values.values():
+            return None
+        m = values["m"]
+        c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
+        J = _matrix((variant or {}).get("inertia_per_kg", [0.0] * 6))
+        I = m * (J + _point(c))
+        return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
+
+
+_UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))  # XX, XY, XZ, YY, YZ, ZZ
+
+
+def _matrix(six) -> np.ndarray:
+    XX, XY, XZ, YY, YZ, ZZ = six
+    return np.array([[XX, XY, XZ], [XY, YY, YZ], [XZ, YZ, ZZ]], dtype=float)
+
+
+def _point(c) -> np.ndarray:
+    """Inertia of a unit point mass at c about the origin."""
+    c = np.asarray(c, dtype=float)
+    return c @ c * np.eye(3) - np.outer(c, c)
+
+
+def nearest_body_inertia(I) -> np.ndarray:
+    """The inertia nearest to the symmetric I (in principal moments, same axes) that a body can
+    have: principal moments non-negative, none larger than the other two together. The set is a
+    cone with six faces; the nearest point lies on some of them, so it is the nearest of the
+    projections onto each set of faces that satisfies all six."""
+    e, V = np.linalg.eigh(I)
+    faces = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], dtype=float)
+    best, distance = np.zeros(3), np.inf
+    for subset in range(64):
+        A = faces[[k for k in range(6) if subset >> k & 1]]
+        x = e - A.T @ np.linalg.lstsq(A @ A.T, A @ e, rcond=None)[0] if len(A) else e  # onto A x = 0
+        if np.all(faces @ x >= -1e-15 * max(np.abs(e).max(), 1e-300)) and np.linalg.norm(x - e) < distance:
+            best, distance = x, np.linalg.norm(x - e)
+    return V @ np.diag(np.maximum(best, 0.0)) @ V.T
 
 
 def consistent_inertia(values, tolerance: float = 0.0) -> bool:
     """Whether a fitted payload's 10 standard values (m, m c, inertia about the frame origin)
     describe a body: inertia about its centre of mass with non-negative principal moments that
     satisfy the triangle inequalities."""
-    m, mc = values[0], np.asarray(values[1:4])
-    XX, XY, XZ, YY, YZ, ZZ = values[4:10]
-    c = mc / m
-    Ic = np.array([[XX, XY, XZ], [XY, YY, YZ], [XZ, YZ, ZZ]]) - m * (c @ c * np.eye(3) - np.outer(c, c))
-    e = np.linalg.eigvalsh(Ic)
+    m, c = values[0], np.asarray(values[1:4]) / values[0]
+    e = np.linalg.eigvalsh(_matrix(values[4:10]) - m * _point(c))
     return bool(e[0] >= -tolerance and e[0] + e[1] >= e[2] - tolerance)
 
 
-def standard_of_payload(values: dict) -> np.ndarray:
-    """The 10 standard parameters of a selected payload (10 values, or a point mass's 4)."""
-    v = [values[k] for k in ("m", "mx", "my", "mz")]
+def standard_of_payload(values: dict, variant=None) -> np.ndarray:
+    """The 10 standard parameters of a selected payload (its 10 values, or a fixed shape's 4
+    with the variant's inertia per kg)."""
     if "XX" in values:
         return np.array(list(values.values()), dtype=float)
-    m, c = v[0], np.array(v[1:4]) / v[0]
-    I = m * (c @ c * np.eye(3) - np.outer(c, c))
-    return np.array([m, *v[1:4], I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]])
+    return FixedShapePayload.last_link(values, variant)
 
 
 class Coefficients(Effect):

@@ -41,7 +41,8 @@ class Gain(Effect):
     scaled by (Context.scale), refined to the fitted value once selected (0 while selecting)."""
 
     name, parameters, units = "gain", ("k-1",), ("1",)
-    refinable = sensor = scales = True
+    refinable = sensor = scales = shapes_others = True
+    tolerance = 1e-4  # of the torque: far below any gain a diagnosis reports
 
     def __init__(self, gain: float = 0.0):
         self.gain = float(gain)
@@ -69,7 +70,7 @@ class Gain(Effect):
 
 class TimeShift(Effect):
     name, scope, parameters, units = "time_shift", "arm", ("dt",), ("s",)
-    refinable = sensor = delays = True
+    refinable = sensor = delays = shapes_others = True
 
     def __init__(self, shift: float):
         self.shift = float(shift)  # dt0 [s], not 0

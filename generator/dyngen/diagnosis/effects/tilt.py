@@ -45,14 +45,15 @@ class Tilt(Effect):
     units = ("m/s^2", "m/s^2")
     refinable = True
 
-    def __init__(self, g: float, estimate=(0.0, 0.0)):
+    def __init__(self, g: float, directions, estimate=(0.0, 0.0)):
         self.g = float(g)  # |gravity| of the robot's model
+        self.directions = directions  # (u1, u2): tilt_directions of the robot
         self.estimate = tuple(float(x) for x in estimate)  # dg1, dg2 of the second-order term
         self.label = "" if not any(self.estimate) else f"dg0=({self.estimate[0]:.6g},{self.estimate[1]:.6g})"
 
     @classmethod
     def of(cls, context):
-        return cls(gravity_norm(context.robot))
+        return cls(gravity_norm(context.robot), tilt_directions(context.robot))
 
     @property
     def setting(self):
@@ -62,11 +63,14 @@ class Tilt(Effect):
         return np.array(values[:2], dtype=float) if np.any(values[:2]) else None
 
     def at(self, setting):
-        return Tilt(self.g, setting)
+        return Tilt(self.g, self.directions, setting)
+
+    def reads(self, context):
+        return (context.load,)
 
     def columns(self, context, signals, tau_model):
         G = _gravity(context, signals)  # (T, N, 3)
-        u1, u2 = tilt_directions(context.robot)
+        u1, u2 = self.directions
         along = G @ np.cross(u1, u2)
         return np.stack([G @ u1 - along * self.estimate[0] / (2 * self.g),
                          G @ u2 - along * self.estimate[1] / (2 * self.g)], axis=-1)
@@ -98,6 +102,9 @@ class GravityScale(Effect):
     def of(cls, context):
         return cls(gravity_norm(context.robot))
 
+    def reads(self, context):
+        return (context.load,)
+
     def columns(self, context, signals, tau_model):
         G = _gravity(context, signals)
         u1, u2 = tilt_directions(context.robot)
@@ -111,8 +118,24 @@ class GravityScale(Effect):
 
 
 def _gravity(context, signals) -> np.ndarray:
-    """G(q) of a recording, computed once for the tilt and the gravity scale."""
-    return context.memo(("gravity_matrix", id(signals)), lambda: gravity_matrix(context.robot, context.p, signals.q))
+    """G(q) of a recording, computed once for the tilt and the gravity scale, with a chosen
+    payload (Context.load) on the last link: a tilt turns its gravity too."""
+    G = context.memo(("gravity_matrix", id(signals)),
+                     lambda: gravity_matrix(context.robot, context.p, signals.q, _poses(context, signals)))
+    if context.load is None:
+        return G
+    return G + body_gravity(context, signals) @ np.asarray(context.load)
+
+
+def body_gravity(context, signals) -> np.ndarray:
+    """B (T, N, 3, 4) of a recording: a body on the last link with standard values (m, mx,
+    my, mz) in its frame adds sum_k B[..., k] value_k to G(q) (docs: gravity_matrix)."""
+    return context.memo(("body_gravity", id(signals)),
+                        lambda: body_gravity_matrix(context.robot, signals.q, _poses(context, signals)))
+
+
+def _poses(context, signals):
+    return context.memo(("poses", id(signals)), lambda: forward_kinematics(context.robot.joint_models, signals.q))
 
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
@@ -145,11 +168,12 @@ def tilt_axes(robot) -> tuple[str, str]:
     return names[0], names[1]
 
 
-def gravity_matrix(robot, p, q) -> np.ndarray:
-    """G (T, N, 3) with g(q) = G(q) gvec for link parameters p (dynamic, 10N)."""
+def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
+    """G (T, N, 3) with g(q) = G(q) gvec for link parameters p (dynamic, 10N); poses: the
+    forward kinematics of q, if computed already."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     links = np.asarray(p, dtype=float).reshape(-1, 10)
-    poses = forward_kinematics(robot.joint_models, q)
+    poses = poses or forward_kinematics(robot.joint_models, q)
     n = len(poses)
     G = np.zeros((q.shape[0], n, 3))
     centres = [pose.origin + np.einsum("tij,j->ti", pose.R, links[k, 1:4]) for k, pose in enumerate(poses)]
@@ -159,3 +183,23 @@ def gravity_matrix(robot, p, q) -> np.ndarray:
             m = links[k, 0]
             G[:, i, :] -= m * (np.cross(z, centres[k] - o) if model.revolute else z)
     return G
+
+
+def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
+    """B (T, N, 3, 4): the G(q) of a body on the last link per unit of its standard values
+    (m, mx, my, mz; first moments in the last link's frame). Its mass times its centre is
+    m o_N + R_N (mx, my, mz), so for a revolute joint i (axis z through o):
+    B_i = -[z x (o_N - o), z x R_N e_x, z x R_N e_y, z x R_N e_z]; prismatic: [-z, 0, 0, 0]."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    poses = poses or forward_kinematics(robot.joint_models, q)
+    last = poses[-1]
+    B = np.zeros((q.shape[0], len(poses), 3, 4))
+    for i, model in enumerate(robot.joint_models):
+        z, o = poses[i].axis, poses[i].point
+        if model.revolute:
+            B[:, i, :, 0] = -np.cross(z, last.origin - o)
+            for k in range(3):
+                B[:, i, :, 1 + k] = -np.cross(z, last.R[:, :, k])
+        else:
+            B[:, i, :, 0] = -z
+    return B
