@@ -372,7 +372,8 @@ def _plausible(design, chosen):
 
 def _consistent_payload(context, segments, design, chosen, final, refused):
     """An effect whose fitted values are possible only in part (Effect.simplified: a payload
-    whose inertia is no body's) is replaced by its simpler form, and everything refitted."""
+    whose inertia is no body's) is replaced by the simpler form that does best on the
+    selection data (weighted as the fit), and everything refitted."""
     offset = 0
     for i, c in enumerate(chosen):
         values = final.x[offset: offset + c.size]
@@ -380,10 +381,15 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
         simpler = c.effect.simplified(values)
         if simpler is None:
             continue
-        effect, refusal = simpler
+        refusal, forms = simpler
+        options = []
+        for effect in forms:
+            replaced = chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:]
+            form_design, form_chosen = restricted(context, segments, design, replaced)
+            score = float(design.weights ** 2 @ selection_mse(form_design, form_chosen))
+            options.append((score, form_design, form_chosen))
+        _, design, chosen = min(options, key=lambda o: o[0])
         refused.append(refusal)
-        replaced = chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:]
-        design, chosen = restricted(context, segments, design, replaced)
         return design, chosen, solve(design, chosen)
     return design, chosen, final
 

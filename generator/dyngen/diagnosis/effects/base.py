@@ -99,8 +99,9 @@ class Effect:
         return ""
 
     def simplified(self, values: np.ndarray):
-        """Fitted values possible only in part: (a simpler effect that keeps the first of
-        these values, the refusal to report: {"candidate", "values"}); else None."""
+        """Fitted values possible only in part: (the refusal to report: {"candidate", "values"},
+        simpler effects that keep the first of these values, of which the selection data take
+        one); else None."""
         return None
 
     def reshapes(self, other: "Effect") -> bool:
