@@ -149,23 +149,22 @@ class _State:
 def _refine_one(state, index) -> None:
     effect = state.chosen[index].effect
     if effect.implied_setting(state.values(index)) is not None:
-        start, last = (state.chosen, state.columns, state.design, state.context), np.inf
+        start = (state.chosen, state.columns, state.design, state.context)
         for _ in range(MAX_ITERATIONS):
             current = state.chosen[index].effect
             values = state.values(index)
             setting = current.implied_setting(values)
             if setting is None:
                 return
-            step = float(np.linalg.norm(np.subtract(setting, current.setting)))
-            if not current.plausible(values) or step > last:
-                # values no effect can have, or steps that grow: a setting the data do not
-                # determine (a sensor gain on a joint with little torque ran off to 14)
-                state.accept(start)
-                return
+            if not current.plausible(values):
+                break
             state.accept(state.trial(index, setting))
+            step = float(np.linalg.norm(np.subtract(setting, current.setting)))
             if step <= max(REFINE_TOLERANCE * np.linalg.norm(setting), current.tolerance):
                 return
-            last = step
+        # values no effect can have, or no fixed point: a setting the data do not determine (a
+        # sensor gain on a joint with little torque ran off to 14); it stays as selected
+        state.accept(start)
         return
     joint = state.chosen[index].joint
     beside = tuple(c.effect for i, c in enumerate(state.chosen)
