@@ -117,20 +117,26 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
     return context.memo(key, compute)
 
 
-def as_chosen(context, chosen):
-    """The context with the arm and torque sensor the chosen candidates describe: the lag of
-    a time shift (Effect.delays), each joint's 1 + sensor gain (Effect.scales) and a payload
-    (Effect.load), each at its setting; none without them. The columns of a set of chosen candidates are computed in it."""
+def world(context, chosen) -> dict:
+    """The Context fields the chosen candidates set, each at its setting: the lag of a time
+    shift (delay; Effect.delays), each joint's 1 + sensor gain (scale; Effect.scales) and a
+    payload (load; Effect.load); none without them."""
     delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
     scale = None
     if gains:
         scale = tuple(1.0 + gains.get(j, 0.0) for j in range(len(context.robot.joints)))
     load = next((c.effect.load for c in chosen if c.effect.load is not None), None)
-    world = {"delay": delay, "scale": scale, "load": load}
-    if all(getattr(context, k) == v for k, v in world.items()):
+    return {"delay": delay, "scale": scale, "load": load}
+
+
+def as_chosen(context, chosen):
+    """The context with the arm and torque sensor the chosen candidates describe (world): the
+    columns of a set of chosen candidates are computed in it."""
+    fields = world(context, chosen)
+    if all(getattr(context, k) == v for k, v in fields.items()):
         return context
-    return dataclasses.replace(context, **world)
+    return dataclasses.replace(context, **fields)
 
 
 def delayed(x: np.ndarray, t: np.ndarray, delay: float) -> np.ndarray:

@@ -242,29 +242,28 @@ def _settled(context, segments, design, chosen, correlation, options):
     # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
     # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
     design, chosen = refine(context, segments, design, chosen)
-    sensor = _sensor(context, chosen)
+    before = chosen
     chosen, _, dropped = prune(design, chosen, correlation, options.alpha, options.min_gain)
     narrow = _narrow_stribeck(chosen)
     chosen = [c for c in chosen if c not in narrow]
     dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
     if dropped:
-        if _sensor(context, chosen) != sensor:  # a time shift or gain went: the others' columns change back
+        if _moved(context, chosen, before):
             design, chosen = restricted(context, segments, design, chosen)
         design, chosen = refine(context, segments, design, chosen)
-    sensor = _sensor(context, chosen)
+    before = chosen
     chosen, final, refused = _plausible(design, chosen)
-    if _sensor(context, chosen) != sensor:
+    if _moved(context, chosen, before):
         design, chosen = restricted(context, segments, design, chosen)
         final = solve(design, chosen)
     design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
     return design, chosen, final, dropped, refused
 
 
-def _sensor(context, chosen) -> tuple:
-    """What the chosen candidates set of the context (design.as_chosen): the sensor's lag and
-    gains, a payload."""
-    world = dz.as_chosen(context, chosen)
-    return world.delay, world.scale, world.load
+def _moved(context, chosen, before) -> bool:
+    """Whether dropping some of `before` changed what the others' columns are computed with
+    (design.world: a time shift, a gain or a payload went): then the design is rebuilt."""
+    return dz.world(context, chosen) != dz.world(context, before)
 
 
 def _decide_on_folds(context, segments, design, chosen, final, options) -> list[str]:
