@@ -21,6 +21,15 @@ effect must gain to be selected at all), so that three numbers fitting noise do 
 one-value finding, and six ripple harmonics do not displace the simple model on a whim. The decision is made with the values fitted on the fit samples only;
 `apply` then sets each joint's correction with the final values.
 
+That margin decides what is *claimed*. What *predicts* the joint's torque is the simple model
+unless the model chosen beats it by `min_gain` of the mean square on the selection data (else
+TIED): the effects stay findings, but where the data cannot tell the two apart the baseline
+every diagnosis is measured against is the one used. (A joint that no effect acts on keeps the
+nominal model, which claims nothing, unless the simple model wins by its margin.) The burden of proof is the diagnosis's:
+on the real LWR's joint 5 (fit on measurement 1) Coulomb + offset and the simple model differ
+by 0-1.5 % on the fit trajectory, depending on the selection blocks, and only extrapolate
+differently to a faster one.
+
 With selection on blocks of the fit data, the errors are summed over the three cuts
 (run._decide_on_folds), so every fit sample is judged once and the sums are far less noisy
 than one selection set's: there an extra value must gain FOLDS_PER_VALUE (2 %) instead. Values
@@ -36,6 +45,7 @@ from . import baseline
 from . import design as dz
 
 EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple", "consistent parameters"
+TIED = "simple (effects not shown better)"  # the simple model predicts; the effects stay findings
 FOLDS_PER_VALUE = 0.02  # least gain per extra value on errors summed over the three cuts (see above)
 
 
@@ -80,7 +90,7 @@ def _completed_predict(context, chosen, x, values, seg, j):
 
 def decide(context, segments, chosen, x, simple, min_gain: float, consistent=None, consistent_values: int = 0) \
         -> list[str]:
-    """Per joint EFFECTS, SIMPLE, COMPLETED or (given consistent: per segment its corrections
+    """Per joint EFFECTS, SIMPLE, TIED, COMPLETED or (given consistent: per segment its corrections
     (T, N), with consistent_values values counted per joint) CONSISTENT; seg.correction holds
     the effects' torques."""
     return choose(errors(context, segments, chosen, x, simple, consistent), chosen, min_gain, consistent_values)
@@ -129,6 +139,10 @@ def choose(sse_per_joint: list[dict], chosen, min_gain: float, consistent_values
         if CONSISTENT in sse and _better(sse[CONSISTENT], consistent_values, sse[best], size[best], min_gain) \
                 and sse[CONSISTENT] < (1 - min_gain) * sse[best]:
             best = CONSISTENT
+        # (a joint no effect acts on keeps the nominal model unless the simple model wins outright)
+        acting = COMPLETED in sse
+        if acting and best in (EFFECTS, COMPLETED) and not sse[best] < (1 - min_gain) * sse[SIMPLE]:
+            best = TIED
         modes.append(best)
     return modes
 
@@ -151,7 +165,7 @@ def apply(context, segments, chosen, x, simple, modes, consistent=None) -> dict:
         if mode == CONSISTENT:
             for seg, c in zip(segments, consistent):
                 seg.correction[:, j] = c[:, j]
-        elif mode == SIMPLE:
+        elif mode in (SIMPLE, TIED):
             for seg in segments:
                 seg.correction[:, j] = baseline.predict(simple, seg)[:, j]
         elif mode == COMPLETED:

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..parameters import PER_LINK, dynamic_from_standard, standard_from_dynamic
 from .effects import effect_class
+from .joints import COMPLETED, SIMPLE, TIED
 
 FRICTION_FIELDS = ("Fc", "Fv", "Fs", "vs", "eps")  # templates/friction.c.j2
 
@@ -67,10 +68,16 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
         "friction": {"layout": "per joint: " + ", ".join(FRICTION_FIELDS) + " (generated <robot>_friction)",
                      "f": [[float(x) for x in row] for row in f]},
     }
-    if diagnosis.simple_wins:
+    modes = list(enumerate(diagnosis.joint_models, start=1))
+    replaces = {j: dict(zip(NAMES, map(float, diagnosis.simple_values[j - 1])))
+                for j, m in modes if m in (SIMPLE, TIED)}
+    added = {j: dict(zip(NAMES, map(float, diagnosis.completed[j][-len(NAMES):])))
+             for j, m in modes if m == COMPLETED and j in diagnosis.completed}
+    if replaces or added:
         doc["simple_model"] = {
-            "law": f"b + Fc tanh(qd / {VELOCITY:g}) + Fv qd, on the joints where it did better than the effects",
-            "joints": {j: dict(zip(NAMES, map(float, diagnosis.simple_values[j - 1]))) for j in diagnosis.simple_wins}}
+            "law": f"b + Fc tanh(qd / {VELOCITY:g}) + Fv qd (diagnosis.json joint_models says why, per joint)",
+            **({"replaces_effects": replaces} if replaces else {}),  # the joint's torque is this law alone
+            **({"added_to_effects": added} if added else {})}  # this law on top of the effects on the joint
     head = (f"# Unmodelled effects of {diagnosis.robot} selected by `dyngen diagnose` (on selection data).\n"
             "# tau = rnea(q, qd, qdd, s) + friction(qd, f) + the other effects listed here.\n")
     return head + yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=120)

@@ -7,6 +7,8 @@ import json
 
 import numpy as np
 
+from .joints import TIED
+
 SCHEMA_VERSION = 2
 
 
@@ -102,7 +104,7 @@ def markdown(d, sources: dict) -> str:
                "**No test data**: these are the selection data, which chose the effects. Not a held-out figure."),
               "", f"| | {head} |", rule,
               _row("RMS, nominal model", d.rms_before),
-              _row("RMS, final model (effects; simple model where it won)", d.rms_after),
+              _row("RMS, final model (effects; simple model where it won or tied)", d.rms_after),
               _row("RMS, selected effects alone", d.rms_effects),
               _row(f"RMS, {simple}", d.rms_simple),
               _row("peak, nominal model", d.peak_before),
@@ -149,6 +151,12 @@ def markdown(d, sources: dict) -> str:
     if d.superseded:
         lines += ["Not kept (the simple model did better on these joints' selection data): "
                   + ", ".join(f"{e['effect']} on joint {e['joints'][0]}" for e in d.superseded) + ".", ""]
+    tied = [j + 1 for j, m in enumerate(d.joint_models) if m == TIED]
+    if tied:
+        lines += [f"On joint(s) {', '.join(map(str, tied))} the simple model predicts the torque: on the selection "
+                  "data the effects acting there did not beat it by the margin a value must gain. Findings there "
+                  "stay findings; the data cannot tell the two apart, and beyond the fit data they may "
+                  "extrapolate differently.", ""]
     if d.refused:
         lines += ["Refused as physically impossible once fitted: " + ", ".join(r["candidate"] for r in d.refused)
                   + ".", ""]
