@@ -2,6 +2,7 @@
 
     python bench/bench_withheld_random.py                       # 12 cases at 1 kHz, seed 101
     python bench/bench_withheld_random.py --rate 200 --cases 20 --seed 7
+    python bench/bench_withheld_random.py --robot examples/panda.yaml   # another arm
 
 bench/bench_withheld.py runs a fixed list of cases, which the diagnosis was developed on. Here
 each case draws one or two effects (Coulomb, viscous, Stribeck beside Coulomb, rotor inertia,
@@ -11,11 +12,15 @@ that sticks). Otherwise as bench_withheld.py: the LWR in MuJoCo (bench/simulatio
 from a 20-bit encoder with 1e-5 rad noise, no qd or qdd columns, torque noise 0.05 Nm, default
 options, both directions (fit on the Fourier excitation, test on Table V, and the reverse), the
 same verdict. Table to bench/results/withheld_random.md (--results).
+
+--robot: another arm's YAML (its C generated into a temporary folder): the same draws on its
+joints, with a second Fourier excitation in place of Table V, which is the LWR's.
 """
 
 from __future__ import annotations
 
 import argparse
+import subprocess
 import sys
 import tempfile
 import time
@@ -40,9 +45,9 @@ from dyngen.runtime import load  # noqa: E402
 KINDS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain", "payload", "tilt", "time_shift")
 
 
-def draw(kind: str, rng) -> dict:
+def draw(kind: str, rng, dof: int = 7) -> dict:
     """Effects(...) keyword values of one effect of this kind (joints 1-based, as Effects)."""
-    j = int(rng.integers(1, 8))
+    j = int(rng.integers(1, dof + 1))
     sign = rng.choice([-1.0, 1.0])
     if kind == "coulomb":
         return {"coulomb": {j: round(rng.uniform(0.3, 2.0), 2)}}
@@ -68,14 +73,14 @@ def draw(kind: str, rng) -> dict:
     return {"time_shift": round(rng.uniform(0.003, 0.02), 4)}
 
 
-def random_cases(count: int, seed: int) -> list[Case]:
+def random_cases(count: int, seed: int, dof: int = 7) -> list[Case]:
     rng = np.random.default_rng(seed)
     cases = []
     for i in range(count):
         kinds = rng.choice(KINDS, int(rng.integers(1, 3)), replace=False)
         merged: dict = {}
         for kind in kinds:
-            for key, value in draw(kind, rng).items():
+            for key, value in draw(kind, rng, dof).items():
                 merged[key] = {**merged[key], **value} if isinstance(value, dict) and key in merged else value
         tracked = bool(rng.random() < 0.3) and "time_shift" not in kinds  # the tracker has no sensor lag
         cases.append(Case(f"random{seed}_{i}", Effects(**merged), tracked=tracked))
@@ -87,14 +92,21 @@ def main(argv=None) -> int:
     ap.add_argument("--rate", type=float, default=1000.0, help="sample rate [Hz] (default 1000)")
     ap.add_argument("--cases", type=int, default=12, help="number of random cases (default 12)")
     ap.add_argument("--seed", type=int, default=101, help="draws the cases and the noise (default 101)")
-    ap.add_argument("--results", type=Path, default=ROOT / "bench" / "results" / "withheld_random.md")
+    ap.add_argument("--robot", type=Path, default=ROOT / "examples" / "lwr.yaml",
+                    help="the arm's YAML (default examples/lwr.yaml)")
+    ap.add_argument("--results", type=Path, default=None,
+                    help="default bench/results/withheld_random.md (the LWR) or withheld_random_<robot>.md")
     args = ap.parse_args(argv)
 
-    robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(ROOT / "generated" / "lwr")
-    cases = random_cases(args.cases, args.seed)
+    robot = load_robot(args.robot)
+    results = args.results or ROOT / "bench" / "results" / (
+        "withheld_random.md" if robot.name == "lwr" else f"withheld_random_{robot.name}.md")
+    cases = random_cases(args.cases, args.seed, robot.dof)
     rows, passed, start = [], 0, time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="withheld-random-") as tmp:
-        doc = write_cases(Path(tmp), rate_hz=args.rate, seed=args.seed, cases=cases, encoder=Encoder())
+        model = load(ROOT / "generated" / "lwr") if robot.name == "lwr" else generated(args.robot, Path(tmp) / "c")
+        doc = write_cases(Path(tmp), rate_hz=args.rate, seed=args.seed, cases=cases, encoder=Encoder(),
+                          robot_path=args.robot)
         for case in cases:
             for direction in ("forward", "backward"):
                 r = run(robot, model, Path(tmp), doc, case.name, direction, case=case)
@@ -108,8 +120,9 @@ def main(argv=None) -> int:
     total = 2 * len(cases)
     text = "\n".join([
         "# Diagnosis on random withheld effects (bench/bench_withheld_random.py)", "",
-        f"`python bench/bench_withheld_random.py --rate {args.rate:g} --cases {args.cases} --seed {args.seed}` "
-        f"({time.perf_counter() - start:.0f} s). Effects drawn at random (one or two per case, random joints and "
+        f"`python bench/bench_withheld_random.py --rate {args.rate:g} --cases {args.cases} --seed {args.seed}"
+        + ("" if robot.name == "lwr" else f" --robot {args.robot}") + "` "
+        f"({time.perf_counter() - start:.0f} s). Arm: {robot.name}. Effects drawn at random (one or two per case, random joints and "
         "magnitudes; see the script), encoder positions, default options, both directions; the verdict of "
         "bench_withheld.py. 'after / perfect': the worst joint's test RMS after the diagnosis over what the perfect "
         "model leaves on the same conditioned data; 'simple / perfect': the same for the simple model (offset + "
@@ -117,9 +130,16 @@ def main(argv=None) -> int:
         f"**{passed} of {total} runs pass.**", "",
         "| case | fit -> test | truth | verdict (fitted) | after / perfect | simple / perfect | result |",
         "|---|---|---|---|---:|---:|---|", *rows, ""])
-    write_file(args.results, text)
-    print(f"{passed} of {total} runs pass; table: {args.results}")
+    write_file(results, text)
+    print(f"{passed} of {total} runs pass; table: {results}")
     return 0
+
+
+def generated(yaml_path: Path, out: Path):
+    """The arm's C, generated by dyngen's command line into `out`, compiled and loaded."""
+    subprocess.run([sys.executable, "-m", "dyngen", "generate", str(yaml_path), "-o", str(out), "-q"], check=True,
+                   cwd=ROOT)
+    return load(out / load_robot(yaml_path).name)
 
 
 if __name__ == "__main__":

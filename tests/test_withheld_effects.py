@@ -194,3 +194,27 @@ def test_a_coarse_encoder_at_100_hz_claims_no_static_friction_spike(tmp_path):
     r = run(robot, model, tmp_path, doc, "coulomb", "backward")
     assert r["problems"] == [], "\n".join(r["problems"])
     assert not any(e["effect"] == "stribeck" for e in r["diagnosis"]["selected"])
+
+
+@pytest.fixture(scope="module")
+def panda_folder(tmp_path_factory):
+    from dyngen.generate import generate
+    from dyngen.progress import Progress
+
+    path = ROOT / "examples" / "panda.yaml"
+    out = tmp_path_factory.mktemp("withheld_panda") / "cases"
+    robot = load_robot(path)
+    model = load(generate(robot, None, Progress(quiet=True)).folder)
+    return robot, model, out, write_cases(out, rate_hz=RATE, cases=COMPOSED_CASES, encoder=Encoder(), robot_path=path)
+
+
+@pytest.mark.parametrize("name", [c.name for c in COMPOSED_CASES])
+@pytest.mark.parametrize("direction", ["forward", "backward"])
+def test_two_effects_at_once_on_the_panda(panda_folder, name, direction):
+    """Another arm than the one the diagnosis was developed on: the Panda in MuJoCo, the test
+    trajectory a second Fourier excitation (Table V is the LWR's), the same encoder and verdict.
+    bench/bench_withheld_random.py --robot examples/panda.yaml draws such cases at random."""
+    robot, model, out, doc = panda_folder
+    r = run(robot, model, out, doc, name, direction)
+    assert r["problems"] == [], "\n".join(r["problems"])
+    assert max(np.array(r["before"]) / np.array(r["perfect"])) > 1.5

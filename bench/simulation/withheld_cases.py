@@ -180,11 +180,18 @@ def grid(duration: float, rate_hz: float) -> np.ndarray:
 
 
 def trajectories(robot, rate_hz: float, fit_seconds: float = FIT_SECONDS, seed: int = FIT_SEED):
-    """{"fit": Fourier excitation, "holdout": Table V}, sampled at rate_hz."""
+    """{"fit": Fourier excitation, "holdout": Table V}, sampled at rate_hz. Table V is the LWR's
+    (the paper's validation trajectory); another arm's holdout is a second Fourier excitation
+    within its limits (seed + 1), as long as Table V."""
     excitation = robot_excitation(robot, seed)
+    holdout = (lambda t: cubic_at(TABLE_V_KNOTS, TABLE_V_TIMES, t)) if uses_table_v(robot) \
+        else robot_excitation(robot, seed + 1)
     return {"fit": Trajectory(grid(fit_seconds, rate_hz), excitation),
-            "holdout": Trajectory(grid(TABLE_V_TIMES[-1], rate_hz),
-                                  lambda t: cubic_at(TABLE_V_KNOTS, TABLE_V_TIMES, t))}
+            "holdout": Trajectory(grid(TABLE_V_TIMES[-1], rate_hz), holdout)}
+
+
+def uses_table_v(robot) -> bool:
+    return robot.name == "lwr" and robot.dof == len(TABLE_V_KNOTS[0])
 
 
 # ------------------------------------------------------------------ truth
@@ -284,7 +291,9 @@ def write_cases(folder, rate_hz: float = 1000.0, noise: float = NOISE, seed: int
            "params": "params.yaml", "rate_hz": float(rate_hz), "noise_sigma": noise, "seed": seed,
            "trajectories": {"fit": {"kind": "fourier", "seed": FIT_SEED, "seconds": fit_seconds,
                                     "base_hz": 0.1, "harmonics": 5},
-                            "holdout": {"kind": "table_v", "seconds": float(TABLE_V_TIMES[-1])}},
+                            "holdout": {"kind": "table_v", "seconds": float(TABLE_V_TIMES[-1])} if uses_table_v(robot)
+                            else {"kind": "fourier", "seed": FIT_SEED + 1, "seconds": float(TABLE_V_TIMES[-1]),
+                                  "base_hz": 0.1, "harmonics": 5}},
            "laws": LAWS, "cases": [],
            "positions": "exact, with qd and qdd columns" if encoder is None else
            {"noise": encoder.noise, "bits": encoder.bits, "columns": "t, q, tau (no qd, qdd)"}}
