@@ -10,7 +10,8 @@ fit samples, every other selected effect refitted each time (selection and test 
   - a setting the fitted values imply (Effect.implied_setting: the time shift, whose exact
     column at dt0 gives the fitted value dt = dt0 when the model holds; the tilt, whose
     second-order change along gravity follows from the angles) by fixed-point
-    iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE;
+    iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE (a
+    scalar setting whose iteration fails: the secant method on implied(s) - s);
   - a setting independent of the values (Effect.search_interval: the Stribeck velocity) by a
     bounded scalar search for the smallest weighted fit residual.
 
@@ -162,9 +163,12 @@ def _refine_one(state, index) -> None:
             step = float(np.linalg.norm(np.subtract(setting, current.setting)))
             if step <= max(REFINE_TOLERANCE * np.linalg.norm(setting), current.tolerance):
                 return
-        # values no effect can have, or no fixed point: a setting the data do not determine (a
-        # sensor gain on a joint with little torque ran off to 14); it stays as selected
+        # values no effect can have, or no fixed point found: a setting the data do not determine
+        # (a sensor gain on a joint with little torque ran off to 14); it stays as selected,
+        # unless a secant search finds the fixed point
         state.accept(start)
+        if np.ndim(effect.setting) == 0:
+            _secant(state, index)
         return
     joint = state.chosen[index].joint
     beside = tuple(c.effect for i, c in enumerate(state.chosen)
@@ -182,6 +186,39 @@ def _refine_one(state, index) -> None:
     best = minimize_scalar(lambda u: cost(float(np.exp(u))), bounds=(lo, hi), method="bounded",
                            options={"xatol": SEARCH_TOLERANCE})
     state.accept(state.trial(index, float(np.exp(best.x))))
+
+
+def _secant(state, index) -> None:
+    """The fixed point of a scalar setting s = implied(s) as the root of implied(s) - s, by the
+    secant method: where the plain iteration overshoots further each step. A sensor gain on a
+    wrist joint beside a heavy payload: the payload's torque there, scaled by 1 + g0, moves the
+    fitted gain by more than g0 moved (random withheld case, 4.6 % on the LWR's joint 5 beside
+    2.7 kg). Kept only if it converges with plausible values; else the state stays as it was."""
+    start = (state.chosen, state.columns, state.design, state.context)
+
+    def excess(setting):
+        state.accept(state.trial(index, setting))
+        current = state.chosen[index].effect
+        values = state.values(index)
+        implied = current.implied_setting(values)
+        if implied is None or not current.plausible(values):
+            return None
+        return float(implied) - setting
+
+    s0 = float(state.chosen[index].effect.setting)
+    f0 = excess(s0)
+    s1 = s0 + f0 if f0 is not None else None
+    f1 = excess(s1) if s1 is not None else None
+    for _ in range(MAX_ITERATIONS):
+        if f0 is None or f1 is None or f1 == f0:
+            break
+        s2 = s1 - f1 * (s1 - s0) / (f1 - f0)
+        f2 = excess(s2)
+        if f2 is not None and abs(s2 - s1) <= max(REFINE_TOLERANCE * abs(s2), state.chosen[index].effect.tolerance):
+            state.accept(state.trial(index, s2 + f2))
+            return
+        s0, f0, s1, f1 = s1, f1, s2, f2
+    state.accept(start)
 
 
 def _renumbered(chosen) -> list:
