@@ -210,6 +210,9 @@ def summary_lines(d) -> list[str]:
     worse = worse_than_simple(d)
     if worse:
         out.append(f"  {worse}")
+    models = ", ".join(f"J{j + 1} {m}" for j, m in enumerate(d.joint_models) if m != "effects")
+    if models:
+        out.append(f"  per joint model where not the effects alone: {models}")
     if not d.selected:
         out.append("  no significant unmodelled effect")
     for e in d.selected:
