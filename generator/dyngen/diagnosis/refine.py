@@ -124,6 +124,10 @@ class _State:
     def accept(self, trial):
         self.chosen, self.columns, self.design, self.context = trial
 
+    def snapshot(self):
+        """The state as a trial, to accept again if a search fails."""
+        return self.chosen, self.columns, self.design, self.context
+
     def restricted(self, chosen, columns):
         """Moments of the chosen candidates only, weighted as the selection's design."""
         n = self.weights.size
@@ -150,7 +154,7 @@ class _State:
 def _refine_one(state, index) -> None:
     effect = state.chosen[index].effect
     if effect.implied_setting(state.values(index)) is not None:
-        start = (state.chosen, state.columns, state.design, state.context)
+        start = state.snapshot()
         for _ in range(MAX_ITERATIONS):
             current = state.chosen[index].effect
             values = state.values(index)
@@ -160,8 +164,7 @@ def _refine_one(state, index) -> None:
             if not current.plausible(values):
                 break
             state.accept(state.trial(index, setting))
-            step = float(np.linalg.norm(np.subtract(setting, current.setting)))
-            if step <= max(REFINE_TOLERANCE * np.linalg.norm(setting), current.tolerance):
+            if _settled(setting, current.setting, current):
                 return
         # values no effect can have, or no fixed point found: a setting the data do not determine
         # (a sensor gain on a joint with little torque ran off to 14); it stays as selected,
@@ -194,7 +197,7 @@ def _secant(state, index) -> None:
     wrist joint beside a heavy payload: the payload's torque there, scaled by 1 + g0, moves the
     fitted gain by more than g0 moved (random withheld case, 4.6 % on the LWR's joint 5 beside
     2.7 kg). Kept only if it converges with plausible values; else the state stays as it was."""
-    start = (state.chosen, state.columns, state.design, state.context)
+    start = state.snapshot()
 
     def excess(setting):
         state.accept(state.trial(index, setting))
@@ -214,11 +217,18 @@ def _secant(state, index) -> None:
             break
         s2 = s1 - f1 * (s1 - s0) / (f1 - f0)
         f2 = excess(s2)
-        if f2 is not None and abs(s2 - s1) <= max(REFINE_TOLERANCE * abs(s2), state.chosen[index].effect.tolerance):
+        if f2 is not None and _settled(s2, s1, state.chosen[index].effect):
             state.accept(state.trial(index, s2 + f2))
             return
         s0, f0, s1, f1 = s1, f1, s2, f2
     state.accept(start)
+
+
+def _settled(setting, before, effect) -> bool:
+    """Whether a fixed-point search has converged: the setting moved by less than
+    REFINE_TOLERANCE of itself, or than the effect's own tolerance."""
+    step = float(np.linalg.norm(np.subtract(setting, before)))
+    return step <= max(REFINE_TOLERANCE * float(np.linalg.norm(setting)), effect.tolerance)
 
 
 def _renumbered(chosen) -> list:

@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-from .joints import TIED
+from .joints import EFFECTS, TIED
 
 SCHEMA_VERSION = 2
 
@@ -210,7 +210,7 @@ def summary_lines(d) -> list[str]:
     worse = worse_than_simple(d)
     if worse:
         out.append(f"  {worse}")
-    models = ", ".join(f"J{j + 1} {m}" for j, m in enumerate(d.joint_models) if m != "effects")
+    models = ", ".join(f"J{j + 1} {m}" for j, m in enumerate(d.joint_models) if m != EFFECTS)
     if models:
         out.append(f"  per joint model where not the effects alone: {models}")
     if not d.selected:
