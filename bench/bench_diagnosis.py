@@ -17,6 +17,7 @@ default threads on this loaded 2-core machine, the same diagnosis took 17 s inst
 
 from __future__ import annotations
 
+import argparse
 import sys
 import tempfile
 import time
@@ -77,6 +78,7 @@ def timed(robot, model, p, fit, test):
 
 
 def main():
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     robot = load_robot(ROOT / "examples" / "lwr.yaml")
     model = load(ROOT / "generated" / "lwr")
     p = read_link_parameters(ROOT / "examples" / "lwr_paper_solution.yaml", 7)

@@ -9,6 +9,7 @@ model (offset + Coulomb + viscous per joint, fitted on the same fit data).
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import sys
 import time
@@ -39,6 +40,7 @@ def simple_of(d):
 
 
 def main() -> int:
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(ROOT / "generated" / "lwr")
     p = read_link_parameters(ROOT / "examples" / "lwr_paper_solution.yaml", 7)
 
