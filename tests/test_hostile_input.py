@@ -213,3 +213,48 @@ def test_absurd_option_values_are_refused_with_the_option_named(option, tmp_path
     result, _ = run(["extract", "tiny.yaml", *option], tmp_path, cache)
     assert result.returncode == 2 and f"argument {option[0]}" in result.stderr.strip().splitlines()[-1]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.yaml"]
+
+
+# --- the cache (issue 28): tightening a folder does not bless what is in it -------------------------
+PLANTED_C = '\n#include <stdio.h>\n__attribute__((constructor)) static void planted_28(void) ' \
+            '{ FILE *f = fopen("MARKER_PATH", "w"); if (f) fclose(f); }\n'
+
+
+def _gravity_identify(tmp_path: Path, cache: Path):
+    (tmp_path / "tiny.yaml").write_text(TINY)
+    (tmp_path / "run.csv").write_text(HEADER + ROWS)
+    return run(["identify", "tiny.yaml", "--data", "run.csv", "--kind", "gravity", "-q", "-o", "g.yaml"],
+               tmp_path, cache)[0]
+
+
+@pytest.mark.parametrize("plant, state", [("model source", "open"), ("library and record", "open"),
+                                          ("library and record", "no stamp"), ("model source", "private")])
+def test_a_model_planted_in_the_cache_is_rebuilt_never_compiled_or_loaded(plant, state, tmp_path):
+    """The reproduced attack: the user's cache was once writable by others, who planted a model
+    folder (or a library with a matching hash record) that dyngen then compiled and loaded."""
+    import hashlib
+
+    cache = tmp_path / "cache"
+    assert _gravity_identify(tmp_path, cache).returncode == 0
+    marker = tmp_path / MARKER
+    planted = PLANTED_C.replace("MARKER_PATH", str(marker))
+    (model,) = cache.glob("models/*/tiny")
+    if plant == "model source":
+        source = model / "tiny_dynamics.c"
+        source.write_text(source.read_text() + planted)
+        for library in cache.glob("libraries/*"):
+            library.unlink()
+    else:
+        (library,) = cache.glob("libraries/*.so")
+        (tmp_path / "plant.c").write_text(planted)
+        subprocess.run(["cc", "-shared", "-fPIC", str(tmp_path / "plant.c"), "-o", str(library)], check=True)
+        Path(str(library) + ".sha256").write_text(hashlib.sha256(library.read_bytes()).hexdigest() + "\n")
+    if state == "open":
+        os.chmod(cache, 0o777)
+    elif state == "no stamp":  # a cache an older dyngen made or tightened
+        next(cache.glob(".dyngen-cache*")).unlink()
+    result = _gravity_identify(tmp_path, cache)
+    assert result.returncode == 0, result.stderr
+    assert not marker.exists(), "planted code ran"
+    assert oct(os.stat(cache).st_mode & 0o777) == "0o700"
+    assert planted not in "".join(p.read_text() for p in cache.glob("models/*/tiny/*.c"))

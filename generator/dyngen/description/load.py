@@ -27,7 +27,7 @@ _LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
 _IDENTIFIED_KINDS = ("gravity", "inertia", "full")
 _C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_kinds.h and the like
-MAX_JOINTS = 20
+MAX_JOINTS = 40  # snake arms and long gantries; the work is bounded by time and terms instead (docs/untrusted-input.md)
 # Ranges no real serial arm leaves (SI units); outside them a value is a typo or an attack, and
 # extreme magnitudes (1e308, 1e-320) would overflow or underflow the generated self-test.
 MAX_LENGTH = 100.0  # DH a, d and centres of mass [m]
