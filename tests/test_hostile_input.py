@@ -78,7 +78,7 @@ YAML_CASES = {
     "coefficient value as text": (yaml_case("value: 0.02", 'value: "nan"'), [], "identified.gravity[0].value"),
     "41 joints": (yaml_case("  - {type: revolute, a: 0.25",
                             "  - {type: revolute, a: 0.1, alpha: 0, d: 0, theta: 0}\n" * 39 + "  - {type: revolute, a: 0.25"),
-                  [], "at most 20"),
+                  [], "at most 40"),
     "compare outside the folder": (yaml_case("restarts: 2", "restarts: 2\n  compare: ../../etc/passwd"), [],
                                    "extraction.compare"),
     # names

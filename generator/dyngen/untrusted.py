@@ -15,11 +15,9 @@ import stat
 import zlib
 from pathlib import Path
 
-import yaml
-
 from .errors import InputError, shorten
 
-MAX_YAML_BYTES = 4 << 20  # a 20-joint description with bounds is about 20 kB
+MAX_YAML_BYTES = 1 << 20  # a 40-joint description with bounds and coefficients is about 100 kB
 MAX_CSV_BYTES = 1 << 30  # an hour at 1 kHz for 12 joints is about 0.5 GB of text
 # Recordings of measured floats pack 3 to 10 times; a file that unpacks 50 times its size past
 # 64 MB is a decompression bomb (or a recording of nothing), refused before the memory is spent.
@@ -101,43 +99,9 @@ def read_text(path, limit: int) -> str:
                          f"not UTF-8 text (byte {err.start}); save the file as UTF-8") from None
 
 
-class _Loader(yaml.SafeLoader):
-    """SafeLoader without duplicate keys and without aliases."""
-
-    def compose_node(self, parent, index):
-        if self.check_event(yaml.AliasEvent):
-            event = self.peek_event()
-            raise yaml.constructor.ConstructorError(None, None, "aliases (*name) are not allowed",
-                                                    event.start_mark)
-        return super().compose_node(parent, index)
-
-    def construct_mapping(self, node, deep=False):
-        seen = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            try:
-                duplicate = key in seen
-            except TypeError:  # an unhashable key: the base class reports it
-                break
-            if duplicate:
-                raise yaml.constructor.ConstructorError(None, None, f"duplicate key {shorten(key)!s}",
-                                                        key_node.start_mark)
-            seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-
 def read_yaml(path):
-    """Plain data (dicts, lists, str, int, float, bool, None) from a YAML file."""
-    name = Path(path).name
-    text = read_text(path, MAX_YAML_BYTES)
-    try:
-        return yaml.load(text, Loader=_Loader)  # noqa: S506 -- _Loader is a SafeLoader
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None) or getattr(err, "context_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        if "could not determine a constructor" in problem:
-            problem = "tags such as !!python/... are not allowed (plain data only)"
-        raise InputError(name, where, f"malformed YAML: {shorten(problem)}") from None
-    except RecursionError:
-        raise InputError(name, "", "malformed YAML: nested too deeply") from None
+    """Plain data (dicts, lists, str, int, float, bool, None) from a YAML file, every scalar
+    and node by one policy (dyngen.yaml_policy)."""
+    from . import yaml_policy
+
+    return yaml_policy.load(read_text(path, MAX_YAML_BYTES), Path(path).name)

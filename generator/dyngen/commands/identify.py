@@ -54,7 +54,8 @@ def main(argv, prog="dyngen identify") -> int:
     kind = options.kind
     required = tuple(_inertia_names(robot)) if kind == "inertia" else ()
     # Bad input fails before anything is announced or written.
-    signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required)
+    signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required,
+                       need_motion=kind == "full")
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
     if kind == "full" and not options.ols:
