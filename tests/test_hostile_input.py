@@ -91,6 +91,29 @@ YAML_CASES = {
                    'c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]\nname: tiny\n', [], "aliases"),
     "5000-deep nesting": ("name: " + "[" * 5000 + "]" * 5000 + "\n", [], "tiny.yaml"),
     "not a mapping": ("- just\n- a list\n", [], "expected a mapping"),
+    # issue 28: YAML scalars SafeLoader would turn into other objects, one policy for every number
+    "5000-digit integer": (yaml_case("a: 0.3", "a: " + "9" * 5000), [], "joints[0].a"),
+    "timestamp": (yaml_case("d: 0.2", "d: 2026-01-01"), [], "joints[0].d"),
+    "sexagesimal": (yaml_case("a: 0.3", "a: 1:30"), [], "joints[0].a"),
+    "bad !!float": (yaml_case("a: 0.3", "a: !!float abc"), [], "joints[0].a"),
+    "bad !!int": (yaml_case("value: 0.02", "value: !!int 0.02"), [], "identified.gravity[0].value"),
+    "!!binary": (yaml_case("value: 0.02", "value: !!binary aGVsbG8="), [], "identified.gravity[0].value"),
+    "!!timestamp": (yaml_case("value: 0.02", "value: !!timestamp 2026-01-01"), [], "identified.gravity[0].value"),
+    # Unicode that is not what it looks like: refused with the column
+    "en dash for minus": (yaml_case('alpha: "pi/2"', 'alpha: "\u2013pi/2"'), [], "column 1"),
+    "superscript two": (yaml_case(GOOD_COEFFICIENT, '"c2y*m2\u00b2"'), [], "column 7"),
+    "decimal comma": (yaml_case("a: 0.3", 'a: "0,3"'), [], "column 2"),
+    "escape byte in an expression": (yaml_case(GOOD_COEFFICIENT, '"c2y*m2\\x1b[2J"'), [], "column 7"),
+    "raw escape byte in the file": (yaml_case("name: tiny", "name: tiny\x1b[2J"), [], "tiny.yaml"),
+    # size of work: every list bounded, its field named
+    "90000 coefficient entries": (yaml_case("  gravity:\n", "  gravity:\n" + '    - {coefficient: "m2", value: 1}\n' * 90_000),
+                                  [], "too large"),
+    "25000 coefficient entries": (yaml_case("  gravity:\n", "  gravity:\n" + '    - {coefficient: "m2", value: 1}\n' * 25_000),
+                                  [], "identified.gravity["),
+    "41 coefficient entries for 2 joints": (yaml_case("  gravity:\n", "  gravity:\n" + '    - {coefficient: "m2", value: 1}\n' * 41),
+                                            [], "at most 20"),
+    "a million joints": ("name: tiny\ndh: standard\njoints: [" + "{}," * 300_000 + "]\n", [], "joints"),
+    "a 0.9 MB list": ("name: tiny\ndescription: [" + "0," * 300_000 + "]\n", [], "description"),
 }
 
 BINARY_CASES = {
@@ -116,6 +139,22 @@ CSV_CASES = {
     "two rows, diagnose": ("run.csv", (HEADER + ROWS.splitlines(True)[1] + ROWS.splitlines(True)[2]).encode(),
                            "diagnose", "run.csv"),
     "time going back": ("run.csv", (HEADER + ROWS + "0.5,0,0,0,0\n").encode(), "identify", "column t"),
+    # issue 28
+    "200 kB column name": ("run.csv", (HEADER.strip() + "," + "x" * 200_000 + "\n").encode(), "identify", "line 1"),
+    "200 kB cell": ("run.csv", (HEADER + ROWS + "2.00," + "1" * 200_000 + ",0,0,0\n").encode(), "identify", "line 202"),
+    "time step 1e-300 s": ("run.csv", (HEADER + "".join(f"{k * 1e-300!r},{0.1 * k:.3f},0.1,0.1,0.2\n"
+                                                        for k in range(200))).encode(), "identify", "column t"),
+    "time step 1e-12 s": ("run.csv", (HEADER + "".join(f"{k * 1e-12!r},{0.1 * k:.3f},0.1,0.1,0.2\n"
+                                                       for k in range(200))).encode(), "identify", "column t"),
+    "all-zero recording": ("run.csv", (HEADER + "".join(f"{k * 0.01:.2f},0,0,0,0\n" for k in range(200))).encode(),
+                           "identify", "every torque is zero"),
+    "all-zero recording, diagnose": ("run.csv", (HEADER + "".join(f"{k * 0.01:.2f},0,0,0,0\n" for k in range(200))).encode(),
+                                     "diagnose", "every torque is zero"),
+    "joints standing still": ("run.csv", (HEADER + "".join(f"{k * 0.01:.2f},0.3,0.2,1,2\n" for k in range(200))).encode(),
+                              "identify", "no joint moves"),
+    "Arabic-Indic digit in a column name": ("run.csv", (HEADER.replace("q1", "q\u0661") + ROWS).encode(), "identify",
+                                            "line 1"),
+    "gzip bomb": ("run.csv.gz", gzip.compress(HEADER.encode() + b"0" * (200 << 20), 9), "identify", "decompression bomb"),
 }
 
 

@@ -140,14 +140,19 @@ for _tag in (INT, FLOAT, BOOL):
 
 def load(text: str, name: str):
     """Plain data from YAML text; every problem an InputError naming `name` and the field or line."""
-    loader = Loader(text)
+    loader = None
     try:
+        loader = Loader(text)  # the reader refuses control characters here already
         return loader.get_single_data()
     except PolicyError as err:
         raise InputError(name, err.field, err.message) from None
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None) or getattr(err, "context_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        if isinstance(err, yaml.reader.ReaderError):
+            line = text[:err.position].count("\n") + 1
+            where = f"line {line}, column {err.position - text.rfind(chr(10), 0, err.position)}"
+            err.problem = f"character U+{err.character:04X} is not allowed in YAML"
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         if "could not determine a constructor" in problem:
             problem = "tags such as !!python/... are not allowed (plain data only)"
@@ -155,4 +160,5 @@ def load(text: str, name: str):
     except RecursionError:
         raise InputError(name, "", "malformed YAML: nested too deeply") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()

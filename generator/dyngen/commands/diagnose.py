@@ -9,6 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..errors import InputError
+from ..errors import printable
 from ..options import add_arguments, resolve
 from ..progress import Progress
 from .recordings import add_data_options, check_enough, compiled_model, conditioning_of, conditioning_text, read_all
@@ -100,7 +101,7 @@ def main(argv, prog="dyngen diagnose") -> int:
     model = compiled_model(args, robot, progress)
     with progress.step("residual, effects, selection, test"):
         result = diagnose(robot, model, p, fit, select or None, options, test=test)
-    sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
+    sources = {"params": printable(Path(args.params).name), "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
     with progress.step("report, JSON, figures, updated model"):
         with results_folder(out) as staging:  # the folder is written as one unit

@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 
 from .. import __version__
+from ..errors import printable
 from ..progress import Progress
 
 
@@ -48,7 +49,7 @@ def generate_step(args, robot, out_root="from args"):
 
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
-    progress.say(f"dyngen {__version__}: generating {args.robot}")
+    progress.say(f"dyngen {__version__}: generating {printable(args.robot)}")
     result = generate(robot, args.output if out_root == "from args" else out_root, progress)
     if not args.quiet:
         summary(result, Path(args.output) / robot.name, time.perf_counter() - start)

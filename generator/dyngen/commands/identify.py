@@ -7,6 +7,7 @@ import argparse
 from pathlib import Path
 
 from ..options import add_arguments, resolve
+from ..errors import printable
 from ..progress import Progress
 from .recordings import add_data_options, compiled_model, conditioning_text, read_all
 
@@ -70,7 +71,7 @@ def main(argv, prog="dyngen identify") -> int:
         estimate = identify(model, signals, kind)
     from ..atomic import write_file
 
-    write_file(out, identified_yaml(robot.name, {kind: estimate}, [Path(p).name for p in args.data],
+    write_file(out, identified_yaml(robot.name, {kind: estimate}, [printable(Path(p).name) for p in args.data],
                                     conditioning_text(signals)))
     if not args.quiet:
         print(f"{robot.name}: {len(estimate.names)} {kind} coefficients from {estimate.rows} equations; "

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, shorten
+from ..errors import InputError, printable, shorten
 from ..untrusted import MAX_CSV_BYTES, read_text
 
 # No robot's time [s], position [rad, m], velocity, acceleration or torque [Nm] comes near this;
@@ -50,7 +50,7 @@ def read_recording(path, dof: int, require_torques: bool = True, required: tuple
     """Read and check `path` for a robot of `dof` joints. `required` names further columns
     (e.g. the stacked inertia entries) that must be present."""
     path = Path(path)
-    name = path.name
+    name = printable(path.name)  # the name reaches comments of written files and the terminal
     text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
     if "\r" in text:  # Windows (CR LF) and old Mac (CR alone) line ends are line ends
         text = text.replace("\r\n", "\n").replace("\r", "\n")
