@@ -120,6 +120,14 @@ def main(argv, prog="dyngen excite") -> int:
     from ..excitation.design import check_limits, limits_of, optimise
 
     robot = load_robot(args.robot)
+    progress = Progress(quiet=args.quiet)
+    from ..output_paths import check_file
+
+    out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"
+    for path in (out, out.with_suffix(".png")):  # the output path policy, before any work
+        note = check_file(path, [args.robot, args.model])
+        if note:
+            progress.say(f"dyngen: {note}")
     limits = limits_of(robot)  # missing limits fail before anything runs
     workspace = None
     if args.workspace:
@@ -130,14 +138,6 @@ def main(argv, prog="dyngen excite") -> int:
         if len(workspace) != 6 or any(workspace[2 * k] >= workspace[2 * k + 1] for k in range(3)):
             raise InputError("--workspace", "", f'expected XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX with min < max, got "{args.workspace}"')
         settings = replace(settings, workspace=workspace)
-    progress = Progress(quiet=args.quiet)
-    from ..output_paths import check_file
-
-    out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"
-    for path in (out, out.with_suffix(".png")):  # the output path policy, before any work
-        note = check_file(path, [args.robot, args.model])
-        if note:
-            progress.say(f"dyngen: {note}")
     progress.say(f"dyngen excite: {robot.name}, {settings.harmonics} harmonics, period {settings.period:g} s, "
                  f"seed {settings.seed}")
     model = compiled_model(args, robot, progress)
