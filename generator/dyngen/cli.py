@@ -88,7 +88,7 @@ def _dispatch(argv) -> int:
 
 def _one_line(err, limit: int = 2000) -> str:
     """Errors quote user input; keep them one bounded line."""
-    text = " ".join(str(err).split("\n"))
+    text = printable(" ".join(str(err).split("\n")))  # no control bytes reach the terminal
     return text if len(text) <= limit else text[:limit] + "..."
 
 
