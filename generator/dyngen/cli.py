@@ -25,7 +25,7 @@ if _LOADING:
 blas.use_one_thread()  # before numpy loads: the imports below load it
 
 from .commands import diagnose, excite, extract, generate, identify  # noqa: E402
-from .errors import DriverError, Infeasible, InputError  # noqa: E402
+from .errors import DriverError, Infeasible, InputError, printable  # noqa: E402
 
 if _LOADING:  # from here on, Ctrl-C unwinds (main below): partial outputs are removed on the way
     signal.signal(signal.SIGINT, signal.default_int_handler)
@@ -66,7 +66,7 @@ def main(argv=None) -> int:
         print("dyngen: interrupted", file=sys.stderr)
         return 130
     except OSError as err:  # e.g. an output folder that cannot be written
-        where = f"{err.filename}: " if err.filename else ""
+        where = f"{printable(err.filename)}: " if err.filename else ""
         print(f"dyngen: error: {_one_line(where)}{err.strerror or err}", file=sys.stderr)
         return 2
     except (RecursionError, MemoryError) as err:
@@ -88,7 +88,7 @@ def _dispatch(argv) -> int:
 
 def _one_line(err, limit: int = 2000) -> str:
     """Errors quote user input; keep them one bounded line."""
-    text = " ".join(str(err).split("\n"))
+    text = printable(" ".join(str(err).split("\n")))  # no control bytes reach the terminal
     return text if len(text) <= limit else text[:limit] + "..."
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import gc
-import hashlib
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,6 +15,7 @@ from .emission.render import Emitted, emit
 from .progress import Progress
 from .errors import InputError
 from .reduction.base import BaseSet, reduce_model
+from .reduction.exact import Reconstruction
 
 
 @dataclass
@@ -56,7 +56,10 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
         models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix(),
                   "unit_accelerations": derivation.unit_accelerations()}
     with progress.step("reduce to base coefficients (exact rank)"):
-        bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
+        try:
+            bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
+        except Reconstruction as err:
+            raise InputError(robot.source, "joints", f"the exact regrouping failed ({err})") from None
         if bases["gravity"].rank == 0:  # C has no zero-length arrays for pi_gravity and Y_g
             raise InputError(robot.source, "gravity", "no joint of this arm moves against gravity (the gravity "
                              "vector is identically zero, e.g. a horizontal SCARA); dyngen needs at least one "
@@ -84,11 +87,8 @@ def cached_folder(name: str, files: dict[str, str]) -> Path:
     """The generated files in the per-user cache, keyed by their content. Commands that need a
     compiled model but no output folder (identify, diagnose, extract before it succeeds) use
     it: nothing is left in the temporary directory or in the user's folders, and a second run
-    with the same model reuses the folder and its compiled library."""
+    with the same model reuses the folder and its compiled library (only when it still holds
+    exactly these files: dyngen.cache.model_folder)."""
     from . import cache
 
-    digest = hashlib.sha256("".join(f"{k}\0{files[k]}\0" for k in sorted(files)).encode()).hexdigest()[:16]
-    folder = cache.folder("models") / digest / name  # the folder's name is the robot's, as everywhere
-    if not (folder / "manifest.json").exists():
-        write_folder(folder, files)  # atomic: the folder is there whole or not at all
-    return folder
+    return cache.model_folder(name, files)

@@ -10,39 +10,82 @@ naming the file and where.
 
 from __future__ import annotations
 
-import gzip
-import io
+import os
+import stat
 import zlib
 from pathlib import Path
 
-import yaml
-
 from .errors import InputError, shorten
 
-MAX_YAML_BYTES = 4 << 20  # a 20-joint description with bounds is about 20 kB
-MAX_CSV_BYTES = 2 << 30  # an hour at 1 kHz for 12 joints is about 0.5 GB of text
+MAX_YAML_BYTES = 1 << 20  # a 40-joint description with bounds and coefficients is about 100 kB
+MAX_CSV_BYTES = 1 << 30  # an hour at 1 kHz for 12 joints is about 0.5 GB of text
+# Recordings of measured floats pack 3 to 10 times; a file that unpacks 50 times its size past
+# 64 MB is a decompression bomb (or a recording of nothing), refused before the memory is spent.
+MAX_RATIO, RATIO_FROM = 50, 64 << 20
 
 
 def read_bytes(path, limit: int) -> bytes:
+    """The file's bytes (a .gz file: unpacked), at most `limit` of them. Anything but a regular
+    file (a FIFO would block, /dev/zero never ends, a folder) is refused before a byte is read,
+    the size is checked from the open file before reading, and unpacking stops at `limit`."""
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            data = f.read(limit + 1)
+    name = path.name
+    try:  # O_NONBLOCK: opening a FIFO must not wait for a writer
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except OSError as err:
         raise InputError(str(path), "", f"cannot read the file ({err.strerror or err})") from None
-    if path.suffix == ".gz":
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):
+        os.close(fd)
+        raise InputError(str(path), "", f"not a regular file ({_kind(info.st_mode)}); give a file")
+    with os.fdopen(fd, "rb") as f:
+        if info.st_size > limit:
+            raise InputError(name, "", f"file too large ({info.st_size >> 20} MB; at most {limit >> 20} MB)")
         try:
-            data = _gunzip(data, limit)
-        except (OSError, EOFError, zlib.error) as err:
-            raise InputError(path.name, "", f"not a readable gzip file ({err or 'truncated'})") from None
-    if len(data) > limit:
-        raise InputError(path.name, "", f"file too large (at most {limit >> 20} MB)")
+            data = f.read(limit + 1)
+        except OSError as err:
+            raise InputError(str(path), "", f"cannot read the file ({err.strerror or err})") from None
+    if len(data) > limit:  # grew while being read
+        raise InputError(name, "", f"file too large (at most {limit >> 20} MB)")
+    if path.suffix == ".gz":
+        data = _gunzip(data, limit, name)
     return data
 
 
-def _gunzip(data: bytes, limit: int) -> bytes:
-    with gzip.GzipFile(fileobj=io.BytesIO(data)) as f:
-        return f.read(limit + 1)  # bounded: a small file may unpack to gigabytes
+def _kind(mode: int) -> str:
+    for test, what in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return what
+    return "not a plain file"
+
+
+def _gunzip(data: bytes, limit: int, name: str) -> bytes:
+    """Unpack in chunks, counting the output: a small file may unpack to gigabytes, and the
+    unpacking stops at `limit`, before the memory is spent. Several gzip members follow each
+    other as `cat a.gz b.gz` makes them."""
+    out = bytearray()
+    pending = data
+    while True:
+        inflater = zlib.decompressobj(16 + zlib.MAX_WBITS)
+        try:
+            while not inflater.eof:
+                room = limit + 1 - len(out)
+                chunk = inflater.decompress(pending, min(room, 1 << 20))
+                pending = inflater.unconsumed_tail
+                out += chunk
+                if len(out) > limit:
+                    raise InputError(name, "", f"unpacks to more than {limit >> 20} MB (at most {limit >> 20} MB)")
+                if len(out) > max(RATIO_FROM, MAX_RATIO * len(data)):
+                    raise InputError(name, "", f"unpacks to more than {MAX_RATIO} times its size "
+                                     f"({len(data) >> 10} kB to over {len(out) >> 20} MB): a decompression bomb?")
+                if not chunk and not pending and not inflater.eof:
+                    raise InputError(name, "", "not a readable gzip file (truncated)")
+        except zlib.error as err:
+            raise InputError(name, "", f"not a readable gzip file ({shorten(str(err))})") from None
+        pending = inflater.unused_data
+        if not pending.strip(b"\0"):  # end, or the zero padding some tools write
+            return bytes(out)
 
 
 def read_text(path, limit: int) -> str:
@@ -56,43 +99,9 @@ def read_text(path, limit: int) -> str:
                          f"not UTF-8 text (byte {err.start}); save the file as UTF-8") from None
 
 
-class _Loader(yaml.SafeLoader):
-    """SafeLoader without duplicate keys and without aliases."""
-
-    def compose_node(self, parent, index):
-        if self.check_event(yaml.AliasEvent):
-            event = self.peek_event()
-            raise yaml.constructor.ConstructorError(None, None, "aliases (*name) are not allowed",
-                                                    event.start_mark)
-        return super().compose_node(parent, index)
-
-    def construct_mapping(self, node, deep=False):
-        seen = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            try:
-                duplicate = key in seen
-            except TypeError:  # an unhashable key: the base class reports it
-                break
-            if duplicate:
-                raise yaml.constructor.ConstructorError(None, None, f"duplicate key {shorten(key)!s}",
-                                                        key_node.start_mark)
-            seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-
 def read_yaml(path):
-    """Plain data (dicts, lists, str, int, float, bool, None) from a YAML file."""
-    name = Path(path).name
-    text = read_text(path, MAX_YAML_BYTES)
-    try:
-        return yaml.load(text, Loader=_Loader)  # noqa: S506 -- _Loader is a SafeLoader
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None) or getattr(err, "context_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        if "could not determine a constructor" in problem:
-            problem = "tags such as !!python/... are not allowed (plain data only)"
-        raise InputError(name, where, f"malformed YAML: {shorten(problem)}") from None
-    except RecursionError:
-        raise InputError(name, "", "malformed YAML: nested too deeply") from None
+    """Plain data (dicts, lists, str, int, float, bool, None) from a YAML file, every scalar
+    and node by one policy (dyngen.yaml_policy)."""
+    from . import yaml_policy
+
+    return yaml_policy.load(read_text(path, MAX_YAML_BYTES), Path(path).name)

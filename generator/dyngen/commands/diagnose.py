@@ -9,6 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..errors import InputError
+from ..errors import printable
 from ..options import add_arguments, resolve
 from ..progress import Progress
 from .recordings import add_data_options, check_enough, compiled_model, conditioning_of, conditioning_text, read_all
@@ -42,6 +43,9 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="cut every --data recording in time into fit, select and test pieces of these "
                              "fractions (e.g. 0.6,0.2,0.2), each conditioned on its own")
     parser.add_argument("--out", default=None, metavar="DIR", help="output folder (default out/<robot>/diagnosis)")
+    parser.add_argument("--force", action="store_true",
+                        help="replace an output folder that holds files dyngen did not write (docs/untrusted-input.md)")
+
     add_arguments(parser.add_argument_group("diagnosis"), Options)
     return parser
 
@@ -69,6 +73,12 @@ def main(argv, prog="dyngen diagnose") -> int:
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
     tests = (args.test or []) + (args.holdout or [])
+    out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
+    from ..output_paths import check_folder, results_folder, shown
+
+    note = check_folder(out, [args.robot, args.params, *args.data, *(args.select or []), *tests, args.model], args.force)
+    if note:
+        progress.say(f"dyngen: {note}")
     # bad input fails before anything is announced or written
     if args.split:
         if args.select or tests:
@@ -91,11 +101,12 @@ def main(argv, prog="dyngen diagnose") -> int:
     model = compiled_model(args, robot, progress)
     with progress.step("residual, effects, selection, test"):
         result = diagnose(robot, model, p, fit, select or None, options, test=test)
-    out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
-    sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
+    sources = {"params": printable(Path(args.params).name), "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
     with progress.step("report, JSON, figures, updated model"):
-        paths = write_outputs(result, robot, p, out, sources, options.sign_velocity)
+        with results_folder(out) as staging:  # the folder is written as one unit
+            paths = write_outputs(result, robot, p, staging, sources, options.sign_velocity)
+        paths = {k: shown(v, staging, out) if isinstance(v, Path) else v for k, v in paths.items()}
     if not args.quiet:
         print(f"{robot.name}: diagnosis in {time.perf_counter() - start:.1f} s ({result.split})")
         print("\n".join(summary_lines(result)))

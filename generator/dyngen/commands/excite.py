@@ -101,6 +101,8 @@ def parser(prog="dyngen excite") -> argparse.ArgumentParser:
                         help="keep the flange (last DH frame's origin) inside this box [m]")
     result.add_argument("--model", metavar="DIR", help="an already generated folder of this robot")
     result.add_argument("-q", "--quiet", action="store_true")
+    result.add_argument("--force", action="store_true",
+                        help="replace an output folder that holds files dyngen did not write (docs/untrusted-input.md)")
     return result
 
 
@@ -118,6 +120,14 @@ def main(argv, prog="dyngen excite") -> int:
     from ..excitation.design import check_limits, limits_of, optimise
 
     robot = load_robot(args.robot)
+    progress = Progress(quiet=args.quiet)
+    from ..output_paths import check_file
+
+    out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"
+    for path in (out, out.with_suffix(".png")):  # the output path policy, before any work
+        note = check_file(path, [args.robot, args.model])
+        if note:
+            progress.say(f"dyngen: {note}")
     limits = limits_of(robot)  # missing limits fail before anything runs
     workspace = None
     if args.workspace:
@@ -128,7 +138,6 @@ def main(argv, prog="dyngen excite") -> int:
         if len(workspace) != 6 or any(workspace[2 * k] >= workspace[2 * k + 1] for k in range(3)):
             raise InputError("--workspace", "", f'expected XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX with min < max, got "{args.workspace}"')
         settings = replace(settings, workspace=workspace)
-    progress = Progress(quiet=args.quiet)
     progress.say(f"dyngen excite: {robot.name}, {settings.harmonics} harmonics, period {settings.period:g} s, "
                  f"seed {settings.seed}")
     model = compiled_model(args, robot, progress)
@@ -145,7 +154,6 @@ def main(argv, prog="dyngen excite") -> int:
             problems.append(f"the flange leaves the workspace box at t = {t[outside[0]]:.4g} s")
     if problems:  # cannot happen by construction; never write a trajectory that breaks a limit
         raise InputError(args.robot, "joints[].limits", "; ".join(problems[:3]))
-    out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"
     from ..atomic import write_file
 
     write_file(out, csv_text(t, q, qd, qdd))

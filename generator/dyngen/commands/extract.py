@@ -50,9 +50,13 @@ def _generate_and_extract(argv, prog, required: bool, description: str) -> int:
     args = parser.parse_args(argv)
     robot = generate.load(args)
     extracting = required or (bool(robot.identified) and robot.lower is not None)
+    generate.check_output(args, Path(args.output) / robot.name)
     if not extracting:
         generate.generate_step(args, robot)
         return 0
+    compare_path = args.compare or robot.extraction.get("compare")
+    generate.check_output(args, Path(args.out) / robot.name,
+                          [args.compare or (Path(args.robot).parent / compare_path if compare_path else None)])
     _precheck(args, robot)  # bad bounds fail before anything runs or is written
     compare = _compared_solution(args, robot)
     # The model is generated into the per-user cache and copied to -o only once the extraction
@@ -102,12 +106,20 @@ def _run_extraction(args, robot, bases, folder):
 
 
 def _write_extraction(args, robot, folder, extraction, options, seconds, compare) -> None:
+    from ..output_paths import results_folder
+
+    target = Path(args.out) / robot.name
+    with results_folder(target) as staging:  # the folder is written as one unit
+        _write_results(args, robot, folder, extraction, options, seconds, compare, staging, target)
+
+
+def _write_results(args, robot, folder, extraction, options, seconds, compare, out, target) -> None:
     from ..atomic import write_file, write_folder
     from ..extraction.driver import standalone_files
     from ..extraction import report
+    from ..output_paths import shown
 
     progress = Progress(quiet=args.quiet)
-    out = Path(args.out) / robot.name
     write_file(out / "extracted.yaml", report.extracted_yaml(robot, extraction, options, seconds))
     write_folder(out / "extractor", standalone_files(folder))  # the driver as a program of its own
     columns = {"dyngen": extraction.p}
@@ -121,7 +133,7 @@ def _write_extraction(args, robot, folder, extraction, options, seconds, compare
     if not robot.gravity_symbols:  # simulators need a numeric gravity
         from ..export import write_all
 
-        exported = write_all(robot, extraction.p, out)
+        exported = [shown(p, out, target) for p in write_all(robot, extraction.p, out)]
     validation = _validate(robot, folder, extraction, out, progress)
     if not args.quiet:
         print(report.summary(robot, extraction, options, seconds))
@@ -130,12 +142,13 @@ def _write_extraction(args, robot, folder, extraction, options, seconds, compare
             print("\n".join("    " + line for line in residual_rows))
         print("  physical consistency per link (lambda_min of tr(I)/2 E - I must be >= 0):")
         print("\n".join("    " + line for line in table.splitlines()))
-        print(f"  parameters: {out}/extracted.yaml" + "".join(f", {p}" for p in exported))
+        print(f"  parameters: {target}/extracted.yaml" + "".join(f", {p}" for p in exported))
         if validation:
             worst = ", ".join(f"{x:.1e}" for x in validation["max_abs"])
             print(f"  Sec. IV validation on the Table V trajectory: max |N-E(extracted) - coefficients model| "
                   f"per joint [Nm]: {worst}")
-            print(f"  figures: {validation['paths']['trajectory']}, {validation['paths']['torques']}")
+            print(f"  figures: {shown(validation['paths']['trajectory'], out, target)}, "
+                  f"{shown(validation['paths']['torques'], out, target)}")
 
 
 def _validate(robot, folder, extraction, out, progress):

@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 
 from .. import __version__
+from ..errors import printable
 from ..progress import Progress
 
 
@@ -20,13 +21,26 @@ def parser(prog: str) -> argparse.ArgumentParser:
     result.add_argument("-o", "--output", default="generated", metavar="DIR",
                         help="parent folder of the robot's output folder (default: generated)")
     result.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    result.add_argument("--force", action="store_true",
+                        help="replace an output folder that holds files dyngen did not write (docs/untrusted-input.md)")
     return result
 
 
 def main(argv, prog="dyngen generate") -> int:
     args = parser(prog).parse_args(argv)
-    generate_step(args, load(args))
+    robot = load(args)
+    check_output(args, Path(args.output) / robot.name)
+    generate_step(args, robot)
     return 0
+
+
+def check_output(args, folder: Path, inputs=()) -> None:
+    """The output path policy (dyngen.output_paths), before any work; says what is replaced."""
+    from ..output_paths import check_folder
+
+    note = check_folder(folder, [args.robot, *inputs], args.force)
+    if note:
+        Progress(quiet=args.quiet).say(f"dyngen: {note}")
 
 
 def generate_step(args, robot, out_root="from args"):
@@ -35,7 +49,7 @@ def generate_step(args, robot, out_root="from args"):
 
     progress = Progress(quiet=args.quiet)
     start = time.perf_counter()
-    progress.say(f"dyngen {__version__}: generating {args.robot}")
+    progress.say(f"dyngen {__version__}: generating {printable(args.robot)}")
     result = generate(robot, args.output if out_root == "from args" else out_root, progress)
     if not args.quiet:
         summary(result, Path(args.output) / robot.name, time.perf_counter() - start)

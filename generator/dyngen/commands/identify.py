@@ -7,6 +7,7 @@ import argparse
 from pathlib import Path
 
 from ..options import add_arguments, resolve
+from ..errors import printable
 from ..progress import Progress
 from .recordings import add_data_options, compiled_model, conditioning_text, read_all
 
@@ -29,6 +30,9 @@ def parser(prog="dyngen identify") -> argparse.ArgumentParser:
     add_arguments(parser.add_argument_group("identification"), Options)
     parser.add_argument("-o", "--output", metavar="FILE",
                         help="where to write the YAML (default out/<robot>/identified_<kind>.yaml)")
+    parser.add_argument("--force", action="store_true",
+                        help="replace an output folder that holds files dyngen did not write (docs/untrusted-input.md)")
+
     group = parser.add_argument_group("physically consistent identification (--kind full, the default)")
     group.add_argument("--prior", metavar="P.yaml",
                        help="link parameters to regularise toward and to keep what the data do not see near "
@@ -54,7 +58,9 @@ def main(argv, prog="dyngen identify") -> int:
     kind = options.kind
     required = tuple(_inertia_names(robot)) if kind == "inertia" else ()
     # Bad input fails before anything is announced or written.
-    signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required)
+    out = check_outputs(args, robot, kind, options.ols)
+    signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required,
+                       need_motion=kind == "full")
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
     if kind == "full" and not options.ols:
@@ -63,10 +69,9 @@ def main(argv, prog="dyngen identify") -> int:
         assert stacked_inertia_columns(model.manifest) == list(required)
     with progress.step("least squares"):
         estimate = identify(model, signals, kind)
-    out = Path(args.output) if args.output else Path("out") / robot.name / f"identified_{kind}.yaml"
     from ..atomic import write_file
 
-    write_file(out, identified_yaml(robot.name, {kind: estimate}, [Path(p).name for p in args.data],
+    write_file(out, identified_yaml(robot.name, {kind: estimate}, [printable(Path(p).name) for p in args.data],
                                     conditioning_text(signals)))
     if not args.quiet:
         print(f"{robot.name}: {len(estimate.names)} {kind} coefficients from {estimate.rows} equations; "
@@ -77,6 +82,22 @@ def main(argv, prog="dyngen identify") -> int:
             print(f"  warning: {w}")
         print(f"  written: {out}")
     return 0
+
+
+def check_outputs(args, robot, kind: str, ols: bool) -> Path:
+    """The output path policy (dyngen.output_paths) for every file this run writes, before any work."""
+    from ..output_paths import check_file
+
+    consistent = kind == "full" and not ols
+    out = Path(args.output) if args.output else Path("out") / robot.name / (
+        "identified_consistent.yaml" if consistent else f"identified_{kind}.yaml")
+    files = [out, out.with_suffix(".md"), out.parent / f"{robot.name}.urdf", out.parent / f"{robot.name}.xml"]
+    inputs = [args.robot, *args.data, *(getattr(args, "select", None) or []), getattr(args, "prior", None), args.model]
+    for path in files if consistent else files[:1]:
+        note = check_file(path, inputs)
+        if note:
+            Progress(quiet=args.quiet).say(f"dyngen: {note}")
+    return out
 
 
 def _inertia_names(robot):

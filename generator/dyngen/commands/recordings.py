@@ -63,7 +63,12 @@ def compiled_model(args, robot, progress):
         return load(generated.folder)
 
 
-def read_all(paths, robot, args, require_torques=True, required=()):
+def read_all(paths, robot, args, require_torques=True, required=(), need_motion=True):
+    """need_motion: the recordings must move some joint (a model of motion is fitted), not only
+    hold one pose; with torques, some torque must be nonzero (an all-zero file fits nothing)."""
     from ..data import condition, read_recording
+    from ..data.recording import check_informative
 
-    return [condition(read_recording(p, robot.dof, require_torques, required), conditioning_of(args)) for p in paths]
+    recordings = [read_recording(p, robot.dof, require_torques, required) for p in paths]
+    check_informative(recordings, need_motion)
+    return [condition(r, conditioning_of(args)) for r in recordings]

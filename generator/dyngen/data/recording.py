@@ -17,14 +17,20 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, shorten
+from ..errors import InputError, printable, shorten
 from ..untrusted import MAX_CSV_BYTES, read_text
 
 # No robot's time [s], position [rad, m], velocity, acceleration or torque [Nm] comes near this;
 # larger values (1e308) would overflow the least squares instead of naming the cell.
 MAX_VALUE = 1e9
+# No joint sensor samples faster than 1 MHz; a step of 1e-12 s (or 1e-300) is a unit error, and
+# velocities from it would overflow. A column name is a short label; a row a few kB.
+MIN_STEP = 1e-6
+MAX_NAME = 64
+MAX_COLUMNS = 4000  # the stacked inertia matrix of 40 joints has 820
+MAX_CELL = 64  # characters of one number
 
-_NUMBERED = re.compile(r"^(q|qd|qdd|tau)(\d+)$")
+_NUMBERED = re.compile(r"^(q|qd|qdd|tau)(\d+)$", re.ASCII)  # ASCII digits only: "q\u0661" is not q1
 
 
 @dataclass
@@ -44,10 +50,12 @@ def read_recording(path, dof: int, require_torques: bool = True, required: tuple
     """Read and check `path` for a robot of `dof` joints. `required` names further columns
     (e.g. the stacked inertia entries) that must be present."""
     path = Path(path)
-    name = path.name
+    name = printable(path.name)  # the name reaches comments of written files and the terminal
     text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
+    if "\r" in text:  # Windows (CR LF) and old Mac (CR alone) line ends are line ends
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
     header_line, _, body = text.partition("\n")
-    header = [h.strip() for h in next(csv.reader([header_line]), [])]
+    header = _header(name, header_line)
     columns = _check_header(name, header, dof, require_torques, required)
     data = _numbers(body, name, header)
     _check_values(name, header, data)
@@ -62,6 +70,22 @@ def read_recording(path, dof: int, require_torques: bool = True, required: tuple
     numbered = {f"{p}{j}" for p in ("q", "qd", "qdd", "tau") for j in range(1, dof + 1)}
     extra = {h: data[:, k] for h, k in columns.items() if h != "t" and h not in numbered}
     return Recording(name, t, block("q"), block("tau"), block("qd"), block("qdd"), extra)
+
+
+def _header(name, line: str) -> list[str]:
+    where = "line 1 (header)"
+    if len(line) > MAX_COLUMNS * (MAX_NAME + 1):
+        raise InputError(name, where, f"{len(line)} characters; a header is a list of short column names")
+    try:
+        header = [h.strip() for h in next(csv.reader([line]), [])]
+    except csv.Error as err:
+        raise InputError(name, where, f"not CSV ({shorten(str(err))})") from None
+    if len(header) > MAX_COLUMNS:
+        raise InputError(name, where, f"{len(header)} columns (at most {MAX_COLUMNS})")
+    for k, h in enumerate(header):
+        if len(h) > MAX_NAME:
+            raise InputError(name, where, f"column {k + 1}'s name has {len(h)} characters (at most {MAX_NAME})")
+    return header
 
 
 def _check_header(name, header, dof, require_torques, required) -> dict:
@@ -116,22 +140,29 @@ def _numbers(body: str, name, header) -> np.ndarray:
     if data is not None and data.ndim == 2 and data.shape[1] == len(header) and data.shape[0] > 0:
         return data
     rows = []
-    for line, row in enumerate(csv.reader(io.StringIO(body)), start=2):
-        if not row or all(not cell.strip() for cell in row):
-            continue
-        if len(row) != len(header):
-            raise InputError(name, f"line {line}", f"{len(row)} values, the header has {len(header)} columns")
-        values = []
-        for cell, column in zip(row, header):
-            try:
-                values.append(float(cell))
-            except ValueError:
-                raise InputError(name, f"line {line}, column {shorten(column)}",
-                                 f'not a number ("{shorten(cell.strip())}")') from None
-        rows.append(values)
+    line = 1
+    try:
+        for line, row in enumerate(csv.reader(io.StringIO(body)), start=2):
+            if not row or all(not cell.strip() for cell in row):
+                continue
+            if len(row) != len(header):
+                raise InputError(name, f"line {line}", f"{len(row)} values, the header has {len(header)} columns")
+            rows.append([_cell(cell, name, line, column) for cell, column in zip(row, header)])
+    except csv.Error as err:
+        raise InputError(name, f"line {line + 1}", f"not CSV ({shorten(str(err))})") from None
     if not rows:
         raise InputError(name, "line 2", "no data rows after the header")
     return np.array(rows, dtype=float)
+
+
+def _cell(cell: str, name, line, column) -> float:
+    where = f"line {line}, column {shorten(column)}"
+    if len(cell) > MAX_CELL:
+        raise InputError(name, where, f"not a number ({len(cell)} characters)")
+    try:
+        return float(cell)
+    except ValueError:
+        raise InputError(name, where, f'not a number ("{shorten(cell.strip())}")') from None
 
 
 def _check_values(name, header, data) -> None:
@@ -155,3 +186,20 @@ def _check_time(name, t) -> None:
     if bad.size:
         k = bad[0]
         raise InputError(name, f"line {k + 3}, column t", f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})")
+    bad = np.flatnonzero(steps < MIN_STEP)
+    if bad.size:
+        k = bad[0]
+        raise InputError(name, f"line {k + 3}, column t", f"a time step of {float(steps[k]):.3g} s (at least "
+                         f"{MIN_STEP:g} s: t is in seconds, and no sensor samples faster than 1 MHz)")
+
+
+def check_informative(recordings, need_motion: bool = True) -> None:
+    """Refuse recordings that hold nothing to fit, naming them: every torque zero, or (when
+    motion is needed) every joint standing still in every recording."""
+    names = ", ".join(r.name for r in recordings)
+    if recordings and all(r.tau is not None and not np.any(r.tau) for r in recordings):
+        raise InputError(names, "columns tau*", "every torque is zero: nothing to fit (a recording of a robot "
+                         "switched off?)")
+    if need_motion and recordings and all(np.ptp(r.q, axis=0).max() == 0 for r in recordings):
+        raise InputError(names, "columns q*", "no joint moves (every position is constant): a model of motion "
+                         "cannot be fitted; record an exciting trajectory (dyngen excite)")

@@ -14,6 +14,7 @@ from __future__ import annotations
 import ast
 import math
 import re
+import unicodedata
 from typing import Callable, Mapping
 
 import sympy as sp
@@ -32,6 +33,45 @@ _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
 
 class ExpressionError(ValueError):
     pass
+
+
+# The characters an expression may hold. Python's parser would take more, and silently: it
+# NFKC-normalises identifiers (a fullwidth "ｍ２" is m2, a superscript "m²" is m2 too) and reads
+# "π" as a name. So the text is first rewritten here, one character at a time, to plain ASCII:
+# what a person plainly means is translated (the lookalikes below; any space, such as a
+# non-breaking one; fullwidth ASCII), everything else outside printable ASCII is refused with
+# its column. Nothing reaches ast.parse that is not ASCII.
+_ASCII = re.compile(r"[A-Za-z0-9_ .+\-*/()]", re.ASCII)
+_MEANT = {
+    "\u2212": "-",  # MINUS SIGN
+    "\u2215": "/",  # DIVISION SLASH
+    "\u00f7": "/",  # DIVISION SIGN
+    "\u00d7": "*",  # MULTIPLICATION SIGN
+    "\u22c5": "*",  # DOT OPERATOR
+    "\u00b7": "*",  # MIDDLE DOT
+    "\u2217": "*",  # ASTERISK OPERATOR
+    "\u03c0": "pi",  # GREEK SMALL LETTER PI
+}
+
+
+def _plain(text: str) -> str:
+    """`text` in the ASCII the parser reads, or ExpressionError naming the first column that is
+    neither ASCII dyngen reads nor a character it translates."""
+    out = []
+    for column, char in enumerate(text, start=1):
+        if "\uff01" <= char <= "\uff5e":  # fullwidth ASCII, as an East Asian keyboard types it
+            char = chr(ord(char) - 0xFEE0)
+        if _ASCII.fullmatch(char):
+            out.append(char)
+        elif char in _MEANT:
+            out.append(_MEANT[char])
+        elif char == "\t" or unicodedata.category(char) == "Zs":  # tab, no-break space, thin space, ...
+            out.append(" ")
+        else:
+            what = f"U+{ord(char):04X} {unicodedata.name(char, 'unnamed character')}"
+            raise ExpressionError(f'got "{shorten(text)}" (column {column}: {what} is not part of an '
+                                  "expression; numbers, names, pi and + - * / ** ( ) only)")
+    return "".join(out)
 
 
 def exact_number(value, allow_symbols: bool = False, reserved: Callable[[str], bool] | None = None) -> sp.Expr:
@@ -69,8 +109,9 @@ def parse(text: str, symbol: Callable[[str], sp.Expr | None]) -> sp.Expr:
         raise ExpressionError(f"expected text, got {type(text).__name__}")
     if len(text) > MAX_CHARACTERS:
         raise ExpressionError(f"got {len(text)} characters (at most {MAX_CHARACTERS} in one expression)")
+    plain = _plain(text)
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        tree = ast.parse(plain.strip(), mode="eval")
     except (SyntaxError, ValueError, RecursionError, MemoryError):
         raise ExpressionError(f'got "{shorten(text)}" (not an arithmetic expression)') from None
     _check_size(tree.body, text)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import sympy as sp
 
-from ..errors import InputError
+from ..errors import InputError, printable
 from ..extraction.options import Options as ExtractionOptions
 from ..options import check_yaml, yaml_keys
 from ..parameters import dynamic_symbols, standard_symbols
@@ -27,7 +27,7 @@ _LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
 _PARAMETER_KEYS = {"nominal", "bounds", "total_mass"}
 _IDENTIFIED_KINDS = ("gravity", "inertia", "full")
 _C_NAME = re.compile(r"[a-z][a-z0-9_]{0,39}")  # file names are <name>_kinds.h and the like
-MAX_JOINTS = 20
+MAX_JOINTS = 40  # snake arms and long gantries; the work is bounded by time and terms instead (docs/untrusted-input.md)
 # Ranges no real serial arm leaves (SI units); outside them a value is a typo or an attack, and
 # extreme magnitudes (1e308, 1e-320) would overflow or underflow the generated self-test.
 MAX_LENGTH = 100.0  # DH a, d and centres of mass [m]
@@ -45,7 +45,7 @@ _RESERVED = re.compile(r"(q|qd|qdd|s|c|x|a|b|p|m|mx|my|mz|XX|XY|XZ|YY|YZ|ZZ)\d+|
 
 def load_robot(path) -> Robot:
     path = Path(path)
-    return _Reader(path.name).robot(read_yaml(path))
+    return _Reader(printable(path.name)).robot(read_yaml(path))  # the name reaches comments and the terminal
 
 
 class _Reader:
@@ -65,9 +65,11 @@ class _Reader:
                           f"unknown field; expected one of {', '.join(sorted(allowed))}")
         return value
 
-    def sequence(self, value, field, length=None):
+    def sequence(self, value, field, length=None, at_most=None):
         if not isinstance(value, list):
             self.fail(field, f"expected a list, got {_describe(value)}")
+        if at_most is not None and len(value) > at_most:
+            self.fail(field, f"{len(value)} entries; at most {at_most}")
         if length is not None and len(value) != length:
             self.fail(field, f"expected {length} entries, got {len(value)}")
         return value
@@ -108,11 +110,9 @@ class _Reader:
             self.exact(g, f"gravity[{k}]", "a number or a symbol name", allow_symbols=True,
                        limit=MAX_GRAVITY, smallest=1e-9)
             for k, g in enumerate(self.sequence(gravity, "gravity", 3)))
-        raw_joints = self.sequence(doc["joints"], "joints")
+        raw_joints = self.sequence(doc["joints"], "joints", at_most=MAX_JOINTS)
         if not raw_joints:
             self.fail("joints", "expected at least one joint")
-        if len(raw_joints) > MAX_JOINTS:
-            self.fail("joints", f"{len(raw_joints)} joints; at most {MAX_JOINTS} are supported")
         joints = tuple(self.joint(j, f"joints[{i}]") for i, j in enumerate(raw_joints))
         n = len(joints)
         params = self.mapping(doc.get("parameters") or {}, "parameters", _PARAMETER_KEYS)
@@ -136,7 +136,7 @@ class _Reader:
         for kind in _IDENTIFIED_KINDS:
             if kind in ident:
                 identified[kind] = tuple(self.coefficient(c, f"identified.{kind}[{k}]", names)
-                                         for k, c in enumerate(self.sequence(ident[kind], f"identified.{kind}")))
+                                         for k, c in enumerate(self.sequence(ident[kind], f"identified.{kind}", at_most=10 * n)))
         extraction = self.extraction(doc.get("extraction") or {}, names)
         return Robot(name=name, source=self.source, convention=convention, joints=joints, gravity=gravity,
                      nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified,
@@ -146,7 +146,7 @@ class _Reader:
         value = dict(self.mapping(value, "extraction", _EXTRACTION_KEYS))
         value.update(check_yaml(ExtractionOptions, value, self.fail, "extraction"))
         if "identities" in value:
-            ids = self.sequence(value["identities"], "extraction.identities")
+            ids = self.sequence(value["identities"], "extraction.identities", at_most=10 * len(names))
             for k, text in enumerate(ids):
                 field = f"extraction.identities[{k}]"
                 if not isinstance(text, str) or text.count("=") != 1:

@@ -231,7 +231,7 @@ def _unexcited(normal, fit, weights, r) -> set:
     out = {k - r for k in range(r, G.shape[0]) if norms[k] == 0}
     while True:
         keep = [k for k in range(G.shape[0]) if k < r or k - r not in out]
-        scale = norms[keep]
+        scale = np.where(norms[keep] > 0, norms[keep], 1.0)  # a column of zeros stays zero
         ev, V = np.linalg.eigh(G[np.ix_(keep, keep)] / np.outer(scale, scale))
         if ev[0] > WEAK ** 2 * ev[-1]:
             return out

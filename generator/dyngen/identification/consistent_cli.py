@@ -31,7 +31,7 @@ def run_consistent(args, robot, model, signals, progress) -> int:
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
-    sources = [Path(p).name for p in args.data]
+    sources = [s.name for s in signals]  # printable: recording.read_recording
     write_file(out, consistent_yaml(robot, result, sources, conditioning_text(signals)))
     table = out.with_suffix(".md")
     write_file(table, f"# {robot.name}: consistent identification from {', '.join(sources)}\n\n"

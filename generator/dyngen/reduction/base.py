@@ -58,7 +58,19 @@ QUIET_STATES = 3  # fresh states in a row that must add nothing before the rank 
 def reduce(kind: str, sampled: SampledRegressor) -> BaseSet:
     """Exact rank and regrouping; samples one state at a time until QUIET_STATES fresh
     states in a row add nothing (each would, with probability ~1 - 1e-30, if the row space
-    were not complete)."""
+    were not complete). Long chains whose coefficients outgrow the first prime field are
+    reduced again in a larger one (the result, unique, is the same)."""
+    for prime in exact.PRIMES:
+        with exact.prime_field(prime):
+            try:
+                return _reduce(kind, sampled)
+            except exact.Reconstruction:
+                continue
+    raise exact.Reconstruction(f"{kind}: the regrouping coefficients need more than "
+                               f"{exact.PRIMES[-1].bit_length() // 2} bits")
+
+
+def _reduce(kind: str, sampled: SampledRegressor) -> BaseSet:
     echelon = exact.Echelon(sampled.n_cols)
     quiet = 0
     while quiet < QUIET_STATES:
@@ -77,7 +89,7 @@ def _check(kind, sampled, pivots, K):
         for j in range(sampled.n_cols):
             rebuilt = sum(row[b] * Kp[r][j] for r, b in enumerate(pivots)) % exact.P
             if rebuilt != row[j] % exact.P:
-                raise AssertionError(f"{kind}: regrouping check failed at column {j}")
+                raise exact.Reconstruction(f"{kind}: regrouping check failed at column {j}")
 
 
 def reduce_model(model, kind: str | None = None) -> BaseSet:

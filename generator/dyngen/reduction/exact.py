@@ -11,10 +11,31 @@ from __future__ import annotations
 
 import bisect
 import random
+from contextlib import contextmanager
 
 import sympy as sp
 
-P = (1 << 127) - 1  # a Mersenne prime
+# Mersenne primes, smallest first. Rational reconstruction recovers a/b with |a|, b below
+# sqrt(P/2): 63 bits for the first, which every arm of up to about 25 joints needs; longer
+# chains regroup with coefficients of 100 bits and more (a 30-joint arm: 111), so the reduction
+# is redone with the next prime when the first cannot hold them (reduction/base.py).
+PRIMES = ((1 << 127) - 1, (1 << 521) - 1, (1 << 1279) - 1)
+P = PRIMES[0]  # the field in use; switched only by prime_field below
+
+
+class Reconstruction(ArithmeticError):
+    """The field is too small for the exact rationals: try the next prime."""
+
+
+@contextmanager
+def prime_field(prime: int):
+    """Compute in GF(prime) inside the block (every function here reads P when called)."""
+    global P
+    previous, P = P, prime
+    try:
+        yield
+    finally:
+        P = previous
 
 
 def inverse(x: int) -> int:
@@ -69,14 +90,14 @@ def run(assignments, outputs, env: dict) -> list[int]:
 
 def rational(x: int) -> sp.Rational:
     """Rational reconstruction: the a/b with |a|, b < sqrt(P/2) and a = b x mod P."""
-    bound = 1 << 63
+    bound = 1 << ((P.bit_length() - 1) // 2)
     r0, r1, s0, s1 = P, x % P, 0, 1
     while r1 >= bound:
         quotient = r0 // r1
         r0, r1 = r1, r0 - quotient * r1
         s0, s1 = s1, s0 - quotient * s1
     if s1 == 0 or abs(s1) >= bound:
-        raise ValueError("no small rational")
+        raise Reconstruction("no small rational")
     return sp.Rational(r1, s1)
 
 
