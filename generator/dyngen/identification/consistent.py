@@ -10,7 +10,7 @@ joint j by 1 / sigma_j (its noise estimate); F holds the columns of columns.py: 
 friction (smoothing and lag chosen per joint on the fit data, filtered like the torque), viscous
 friction, an offset and rotor inertia (where the rigid body does not already carry it: joint 1's
 is part of link 1's inertia), and the optional groups, kept only where held-out data ask for them
-(selection.py): a position ripple per joint, a tilted base (a rotation, tilt.py).
+(selection.py): a position ripple per joint, a tilted base (a rotation, terms/tilt.py).
 
 The order of work, every step on the fit recordings only (test data are never seen here):
   1. the regressor and every column, once (columns.py), and the normal equations per contiguous
@@ -43,7 +43,9 @@ from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import consistency_margin
 from ..options import option
 from ..parameters import PER_LINK, dynamic_name
-from . import selection, tilt
+from ..terms import tilt
+from ..terms.friction import SCALE_GRID, SIMPLE_SCALE
+from . import selection
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
 from .normal import Normal, solve_unconstrained
 from .solver import Solver
@@ -54,7 +56,7 @@ CHOICES = ("coulomb", "viscous", "offset", "armature", "ripple")  # what options
 CANDIDATES = ("ripple", "tilt", "falling")  # optional groups, decided on held-out data
 BOUNDS = ("viscous", "dissipative")
 FRICTION_KINDS = PER_JOINT
-SMOOTHING_GRID = (1e-5, 1e-4, 0.0005, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
+SMOOTHING_GRID = SCALE_GRID  # rad/s, candidates for vs_j
 LAG_GRID = (0.0, 0.01, 0.02, 0.04)  # s, candidates for the Coulomb term's lag behind the velocity
 REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
 
@@ -198,7 +200,7 @@ def _coulomb(pieces, normal, fit, options, dof):
         return lambda p, value: coulomb_matrix(p.signals, np.broadcast_to(smoothing(value), (dof,)),
                                                np.broadcast_to(lags(value), (dof,)))[p.keep]
 
-    smoothing = np.full(dof, float(options.smoothing or 0.02))
+    smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
     if not any(kind == "coulomb" for kind, _ in normal.labels):
         return smoothing, lags, normal
@@ -279,7 +281,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     pieces += [piece(model, s, folds) for s in (select or [])]
     parts = folds + (1 if select else 0)
     fit = list(range(folds))
-    smoothing0 = np.full(dof, float(options.smoothing or 0.02))
+    smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     fill(pieces, labels, smoothing0, np.zeros(dof), lambda q: tilt.rotation_columns(robot, prior, q, g_vec))
     normal = Normal.build(pieces, labels, r, parts, dof)
 
@@ -400,7 +402,7 @@ def _final(solver, normal, pieces, fit, weights, active, cone, lam, robot, prior
         if tilt.angle_deg(g_vec, a) > tilt.MAX_TILT_DEG:
             notes.append(f"a base tilt of {tilt.angle_deg(g_vec, a):.1f} deg was refused (above {tilt.MAX_TILT_DEG:g} "
                          "deg it is no mounting error: check the YAML's gravity and the torque signs)")
-            dropped += ["tilt dg_x", "tilt dg_y"]
+            dropped += [name_of(("tilt", 0)), name_of(("tilt", 1))]
             active = [k for k in active if labels[k][0] != "tilt"]
             x, rounds, result = fit_with(active)
     return result, x, rounds, normal, active

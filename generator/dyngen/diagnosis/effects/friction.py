@@ -1,4 +1,5 @@
-"""Joint friction and rotor inertia: per joint, linear in their values.
+"""Joint friction and rotor inertia as candidates of the diagnosis: per joint, linear in their
+values (the laws, their ranges and columns: terms/friction.py).
 
     Coulomb:   Fc * tanh(qd / vc)                 [Nm] at a velocity scale vc (variants; refined once selected)
     viscous:   Fv * qd                            [Nm s/rad]
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ... import terms
 from .base import Effect
 
 # A Stribeck velocity below this many Coulomb velocity scales only reshapes the Coulomb law:
@@ -32,16 +34,14 @@ RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many p
 
 
 class _Dissipative(Effect):
-    """Friction opposes motion and a rotor inertia is positive: only positive values qualify."""
+    """Friction opposes motion and a rotor inertia is positive: only positive values qualify
+    (the term's range)."""
 
     local = True
 
-    def plausible(self, values):
-        return bool(np.all(values > 0))
-
 
 class Coulomb(_Dissipative):
-    name, parameters, units = "coulomb", ("Fc",), ("Nm",)
+    term = terms.Coulomb
     refinable = switching = True
     simulator = ("friction", "Fc")
 
@@ -68,36 +68,31 @@ class Coulomb(_Dissipative):
 
     @classmethod
     def friction_terms(cls, values, variant):
-        return {"Fc": values["Fc"], "eps": variant["vc"]}  # the fitted velocity scale (the Stribeck term shares it)
+        return {"Fc": values["Fc"], "vc": variant["vc"]}  # the fitted velocity scale
 
     def columns(self, context, signals, tau_model):
-        return np.tanh(signals.qd / self.velocity)[:, :, None]
+        return self.term.columns(signals.qd, self.velocity)
 
 
 class Direction(Effect):
-    name, parameters, units = "direction", ("dFc",), ("Nm",)
+    term = terms.Direction
     secondary = switching = local = True
 
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"dFc": values["dFc"]}  # its sign's smoothing: the context's (friction_vector)
+
     def columns(self, context, signals, tau_model):
-        return np.abs(context.sign(signals.qd))[:, :, None]
+        return self.term.columns(signals.qd, context.sign_velocity)
 
 
 class Ripple(Effect):
-    HARMONICS = (1, 2, 3)
-    name = "ripple"
+    term = terms.Ripple
+    HARMONICS = terms.Ripple.HARMONICS
     ranged = True
-    parameters = tuple(f"{ab}{k}" for k in HARMONICS for ab in ("a", "b"))
-    units = ("Nm",) * (2 * len(HARMONICS))
 
     def columns(self, context, signals, tau_model):
-        q = signals.q
-        if context.q_range is not None:
-            q = np.clip(q, *context.q_range)
-        out = np.stack([f(k * q) for k in self.HARMONICS for f in (np.cos, np.sin)], axis=-1)
-        for j, joint in enumerate(context.robot.joints):
-            if not joint.revolute:  # harmonics of a position in metres mean nothing
-                out[:, j, :] = 0.0
-        return out
+        return self.term.columns(signals.q, [joint.revolute for joint in context.robot.joints], context.q_range)
 
     def derived(self, robot, values, std, torque_rms):
         if None in values.values():
@@ -120,7 +115,7 @@ class Ripple(Effect):
 
 
 class Viscous(_Dissipative):
-    name, parameters, units = "viscous", ("Fv",), ("Nm s/rad",)
+    term = terms.Viscous
     simple_term = "Fv"
     simulator = ("damping", "Fv")
 
@@ -129,11 +124,11 @@ class Viscous(_Dissipative):
         return {"Fv": values["Fv"]}
 
     def columns(self, context, signals, tau_model):
-        return signals.qd[:, :, None]
+        return self.term.columns(signals.qd)
 
 
 class Stribeck(_Dissipative):
-    name, parameters, units = "stribeck", ("Fs",), ("Nm",)
+    term = terms.Stribeck
     refinable = switching = True
     # Static friction above the Coulomb level. Alone, it would be friction that vanishes at
     # speed, which no joint has, and the viscous law would then take the Coulomb level's place
@@ -184,16 +179,15 @@ class Stribeck(_Dissipative):
 
     @classmethod
     def friction_terms(cls, values, variant):
-        return {"Fs": values["Fs"], "vs": variant["vs"]}
+        return {"Fs": values["Fs"], "vs": variant["vs"]}  # its sign's smoothing: the context's (friction_vector)
 
     def columns(self, context, signals, tau_model):
-        qd = signals.qd
-        return (context.sign(qd) * np.exp(-(qd / self.velocity) ** 2))[:, :, None]
+        return self.term.columns(signals.qd, self.velocity, context.sign_velocity)
 
 
 class Armature(_Dissipative):
-    name, parameters, units = "armature", ("Ia",), ("kg m^2",)
+    term = terms.Armature
     simulator = ("armature", "Ia")
 
     def columns(self, context, signals, tau_model):
-        return signals.qdd[:, :, None]
+        return self.term.columns(signals.qdd)
