@@ -33,6 +33,7 @@ from scipy.optimize import minimize
 from ..errors import InputError
 from ..options import option
 from ..terms import Armature, Coulomb, Offset, RigidBody, Viscous
+from ..terms.body import armature_identifiable
 from ..terms.friction import EXCITATION_SCALE
 from ..validation.excitation import FourierTrajectory
 
@@ -160,12 +161,6 @@ def _inside(points, box) -> np.ndarray:
     return np.all((points >= box[:, 0]) & (points <= box[:, 1]), axis=1)
 
 
-def identifiable_armature(model, dof: int) -> list:
-    from ..identification.consistent import identifiable_armature as check
-
-    return check(model, dof)
-
-
 def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, armature=None) -> np.ndarray:
     """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major:
     the terms' columns (terms/), each on its own joint's rows."""
@@ -204,7 +199,7 @@ def optimise(robot, model, settings: Settings | None = None, flange=None) -> Des
     start = time.perf_counter()
     limits = limits_of(robot)
     shape = _Shape(limits, settings, flange)
-    armature = identifiable_armature(model, robot.dof)
+    armature = armature_identifiable(model, robot.dof)
     times = np.arange(settings.points) * settings.period / settings.points
     evaluations = 0
 

@@ -4,7 +4,7 @@ One line per field, `key value...`, in the order of SCHEMA. The Python writer (`
 and reader (`read_problem_text`) below and the C++ reader, writer and the members of the
 driver's Problem (generator/dyngen/extractor/protocol.hpp, rendered from SCHEMA by `cpp_header`
 through templates/protocol.hpp.j2) all follow it, so an option is added by one line here (and
-its field in extraction/options.py), then `python3 -m dyngen.extraction.protocol`.
+its field in description/extraction_options.py), then `python3 -m dyngen.extraction.protocol`.
 
 The result file the driver writes back follows RESULT the same way: the C++ Result, its writer
 and reader (`--echo-result`) are rendered into protocol.hpp, the Python reader
@@ -47,7 +47,7 @@ class Field:
 
 
 def _opt(name, kind, cpp=""):
-    """An extraction option (extraction/options.py) the driver reads."""
+    """An extraction option (description/extraction_options.py) the driver reads."""
     return Field(name, kind, lambda problem, stage, options: getattr(options, name), cpp)
 
 

@@ -40,10 +40,11 @@ import numpy as np
 from ..arguments import real
 from ..errors import InputError
 from ..extraction.problem import Options as ExtractOptions
-from ..extraction.problem import consistency_margin
+from ..extraction.problem import consistency_margin, pinned
 from ..options import option
-from ..parameters import PER_LINK, dynamic_name
+from ..parameters import PER_LINK
 from ..terms import tilt
+from ..terms.body import armature_identifiable
 from ..terms.friction import SCALE_GRID, SIMPLE_SCALE
 from . import selection
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
@@ -155,22 +156,6 @@ def _nz(x) -> float:
     return 0.0 if not np.isfinite(x) else float(x)
 
 
-def identifiable_armature(model, dof: int, seed: int = 0) -> list[bool]:
-    """Whether joint j's rotor inertia Ia_j qdd_j is independent of the rigid-body base columns."""
-    rng = np.random.default_rng(seed)
-    states = 40
-    q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))
-    Y = model.batch("regressor", q, qd, qdd).reshape(states * dof, -1)
-    ok = []
-    for j in range(dof):
-        col = np.zeros((states, dof))
-        col[:, j] = qdd[:, j]
-        col = col.reshape(-1)
-        x, *_ = np.linalg.lstsq(Y, col, rcond=None)
-        ok.append(bool(np.linalg.norm(Y @ x - col) > 1e-8 * np.linalg.norm(col)))
-    return ok
-
-
 # ---------------------------------------------------------------------------------------------
 # step 2: the Coulomb term's smoothing and lag
 
@@ -272,7 +257,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
                          f"under-determined: {rows} equations for {unknowns} coefficients and friction values; "
                          f"record at least {2 * unknowns // dof + 1} samples (many more, on an exciting trajectory, "
                          "for a usable estimate)")
-    armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
+    armature_ok = armature_identifiable(model, dof) if "armature" in kinds else [False] * dof
     labels = _labels(kinds, armature_ok, dof, with_tilt)
 
     # 1. regressor, columns and normal equations per part and joint
@@ -416,24 +401,3 @@ def velocity_limits(robot, signals_list) -> np.ndarray:
         lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
         out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
     return np.array(out, dtype=float)
-
-
-def pinned(problem, p, rel: float = 1e-6) -> list:
-    """Names of the parameters at (within rel of the range from) one of their bounds."""
-    span = np.maximum(problem.upper - problem.lower, 1e-300)
-    at = (np.abs(p - problem.lower) < rel * span) | (np.abs(problem.upper - p) < rel * span)
-    return [dynamic_name(j // PER_LINK + 1, j % PER_LINK) for j in np.flatnonzero(at)]
-
-
-def robot_with_default_bounds(robot):
-    """The YAML's bounds, or (none given) wide ones: a link 1 g to 1000 kg, its centre of mass
-    within 2 m of its frame, inertias within 100 kg m^2 (consistency does the real work)."""
-    if robot.lower is not None:
-        return robot
-    from dataclasses import replace
-
-    from ..description.robot import LinkValues
-
-    lo = LinkValues(1e-3, (-2.0, -2.0, -2.0), (0.0, -100.0, -100.0, 0.0, -100.0, 0.0))
-    hi = LinkValues(1000.0, (2.0, 2.0, 2.0), (100.0, 100.0, 100.0, 100.0, 100.0, 100.0))
-    return replace(robot, lower=(lo,) * robot.dof, upper=(hi,) * robot.dof)

@@ -43,3 +43,20 @@ class Payload(Term):
             s[PER_LINK * (n - 1):] = unit
             out[:, :, k] = model.batch("rnea", q, qd, qdd, s)
         return out
+
+
+def armature_identifiable(model, dof: int, seed: int = 0) -> list[bool]:
+    """Per joint, whether its rotor inertia Ia_j qdd_j (terms.Armature) is independent of the rigid
+    body's base columns (at random states of the compiled model)."""
+    rng = np.random.default_rng(seed)
+    states = 40
+    q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))
+    Y = model.batch("regressor", q, qd, qdd).reshape(states * dof, -1)
+    ok = []
+    for j in range(dof):
+        col = np.zeros((states, dof))
+        col[:, j] = qdd[:, j]
+        col = col.reshape(-1)
+        x, *_ = np.linalg.lstsq(Y, col, rcond=None)
+        ok.append(bool(np.linalg.norm(Y @ x - col) > 1e-8 * np.linalg.norm(col)))
+    return ok
