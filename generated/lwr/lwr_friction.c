@@ -7,7 +7,7 @@
  * sgn(v, e) = tanh(v / e), or the plain sign of v when e <= 0:
  *   Coulomb friction Fc tanh(qd / vc), vc fitted (real joints do not switch sharply)
  *   viscous friction Fv qd
- *   Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): static friction above Coulomb's
+ *   Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): breakaway friction above Coulomb's
  *   direction-dependent Coulomb friction dFc |tanh(qd / ed)| (Fc + dFc forwards, Fc - dFc back)
  *
  * f: 8 values per joint, joint 1 first: Fc, vc, Fv, Fs, vs, es, dFc, ed
@@ -31,18 +31,12 @@
 #define LWR_TANH tanh
 #endif
 
-/* |x| without libm's fabs (firmware links only the functions it must) */
-static lwr_real lwr_abs(lwr_real x)
-{
-    return x < LWR_K(0) ? -x : x;
-}
-
-/* sign(v) smoothed as tanh(v / e); the plain sign when e <= 0 */
-static lwr_real lwr_sgn(lwr_real v, lwr_real e)
-{
-    if (e > LWR_K(0)) return LWR_TANH(v / e);
-    return (v > LWR_K(0)) ? LWR_K(1) : ((v < LWR_K(0)) ? LWR_K(-1) : LWR_K(0));
-}
+/* sign(v) smoothed as tanh(v / e); the plain sign when e <= 0. |x| without libm's fabs (the
+ * firmware links only the functions it must). Macros: the generated code defines no functions
+ * of its own beyond the API. */
+#define LWR_SGN(v, e) ((e) > LWR_K(0) ? LWR_TANH((v) / (e)) : \
+    ((v) > LWR_K(0) ? LWR_K(1) : ((v) < LWR_K(0) ? LWR_K(-1) : LWR_K(0))))
+#define LWR_ABS(x) ((x) < LWR_K(0) ? -(x) : (x))
 
 void lwr_friction(const lwr_real *qd, const lwr_real *f, lwr_real *tau)
 {
@@ -50,9 +44,9 @@ void lwr_friction(const lwr_real *qd, const lwr_real *f, lwr_real *tau)
     for (j = 0; j < LWR_DOF; ++j) {
         const lwr_real *fj = f + 8 * j;
         const lwr_real v = qd[j];
-        tau[j] = fj[0] * lwr_sgn(v, fj[1])
+        tau[j] = fj[0] * LWR_SGN(v, fj[1])
                + fj[2] * v
-               + (fj[4] > LWR_K(0) ? fj[3] * lwr_sgn(v, fj[5]) * LWR_EXP(-(v / fj[4]) * (v / fj[4])) : LWR_K(0))
-               + fj[6] * lwr_abs(lwr_sgn(v, fj[7]));
+               + (fj[4] > LWR_K(0) ? fj[3] * LWR_SGN(v, fj[5]) * LWR_EXP(-(v / fj[4]) * (v / fj[4])) : LWR_K(0))
+               + fj[6] * LWR_SGN(LWR_ABS(v), fj[7]);
     }
 }

@@ -7,7 +7,7 @@
  * sgn(v, e) = tanh(v / e), or the plain sign of v when e <= 0:
  *   Coulomb friction Fc tanh(qd / vc), vc fitted (real joints do not switch sharply)
  *   viscous friction Fv qd
- *   Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): static friction above Coulomb's
+ *   Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): breakaway friction above Coulomb's
  *   direction-dependent Coulomb friction dFc |tanh(qd / ed)| (Fc + dFc forwards, Fc - dFc back)
  *
  * f: 8 values per joint, joint 1 first: Fc, vc, Fv, Fs, vs, es, dFc, ed
@@ -31,18 +31,12 @@
 #define STANFORD_TANH tanh
 #endif
 
-/* |x| without libm's fabs (firmware links only the functions it must) */
-static stanford_real stanford_abs(stanford_real x)
-{
-    return x < STANFORD_K(0) ? -x : x;
-}
-
-/* sign(v) smoothed as tanh(v / e); the plain sign when e <= 0 */
-static stanford_real stanford_sgn(stanford_real v, stanford_real e)
-{
-    if (e > STANFORD_K(0)) return STANFORD_TANH(v / e);
-    return (v > STANFORD_K(0)) ? STANFORD_K(1) : ((v < STANFORD_K(0)) ? STANFORD_K(-1) : STANFORD_K(0));
-}
+/* sign(v) smoothed as tanh(v / e); the plain sign when e <= 0. |x| without libm's fabs (the
+ * firmware links only the functions it must). Macros: the generated code defines no functions
+ * of its own beyond the API. */
+#define STANFORD_SGN(v, e) ((e) > STANFORD_K(0) ? STANFORD_TANH((v) / (e)) : \
+    ((v) > STANFORD_K(0) ? STANFORD_K(1) : ((v) < STANFORD_K(0) ? STANFORD_K(-1) : STANFORD_K(0))))
+#define STANFORD_ABS(x) ((x) < STANFORD_K(0) ? -(x) : (x))
 
 void stanford_friction(const stanford_real *qd, const stanford_real *f, stanford_real *tau)
 {
@@ -50,9 +44,9 @@ void stanford_friction(const stanford_real *qd, const stanford_real *f, stanford
     for (j = 0; j < STANFORD_DOF; ++j) {
         const stanford_real *fj = f + 8 * j;
         const stanford_real v = qd[j];
-        tau[j] = fj[0] * stanford_sgn(v, fj[1])
+        tau[j] = fj[0] * STANFORD_SGN(v, fj[1])
                + fj[2] * v
-               + (fj[4] > STANFORD_K(0) ? fj[3] * stanford_sgn(v, fj[5]) * STANFORD_EXP(-(v / fj[4]) * (v / fj[4])) : STANFORD_K(0))
-               + fj[6] * stanford_abs(stanford_sgn(v, fj[7]));
+               + (fj[4] > STANFORD_K(0) ? fj[3] * STANFORD_SGN(v, fj[5]) * STANFORD_EXP(-(v / fj[4]) * (v / fj[4])) : STANFORD_K(0))
+               + fj[6] * STANFORD_SGN(STANFORD_ABS(v), fj[7]);
     }
 }

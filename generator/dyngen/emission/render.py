@@ -36,7 +36,7 @@ def _friction_c_names(P: str):
     from types import SimpleNamespace
 
     M = P.upper()
-    return SimpleNamespace(sgn=f"{P}_sgn", exp=f"{M}_EXP", fabs=f"{P}_abs", zero=f"{M}_K(0)")
+    return SimpleNamespace(sgn=f"{M}_SGN", exp=f"{M}_EXP", abs=f"{M}_ABS", zero=f"{M}_K(0)")
 
 
 def environment() -> jinja2.Environment:

@@ -83,7 +83,7 @@ class Viscous(Term):
 
 
 class Stribeck(Term):
-    name, doc = "stribeck", "Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): static friction above Coulomb's"
+    name, doc = "stribeck", "Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): breakaway friction above Coulomb's"
     values = (Value("Fs", "Nm", **POSITIVE),)
     settings = (Value("vs", "rad/s", **POSITIVE), Value("es", "rad/s", **POSITIVE))
     friction = (FrictionField("Fs", "value", "Stribeck friction (breakaway minus Coulomb) [Nm or N]"),
@@ -119,7 +119,7 @@ class Direction(Term):
 
     @classmethod
     def c(cls, v, f, c):
-        return f"{f('dFc')} * {c.fabs}({c.sgn}({v}, {f('ed')}))"
+        return f"{f('dFc')} * {c.sgn}({c.abs}({v}), {f('ed')})"  # |tanh(v / ed)| = tanh(|v| / ed)
 
     @classmethod
     def torque(cls, m, v, f):
@@ -176,7 +176,7 @@ def friction_torque(m, qd, f) -> list:
 
 def c_terms(names, v: str = "v", vector: str = "fj") -> list[dict]:
     """The friction routine's terms for its template: each term's doc line, fields and C on one
-    joint (v its velocity, vector[k] its k-th field; names: the C names of sgn, exp, fabs and
+    joint (v its velocity, vector[k] its k-th field; names: the C names of sgn, exp, abs and
     zero, attributes of one object)."""
     index = {name: k for k, name in enumerate(FRICTION_NAMES)}
     return [{"name": term.name, "doc": term.doc, "fields": term.friction,
