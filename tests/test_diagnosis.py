@@ -367,8 +367,8 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
     samples with numpy, cut by cut."""
     from types import SimpleNamespace
 
-    from dyngen.diagnosis import design as dz
-    from dyngen.diagnosis.run import Design
+    from dyngen.diagnosis import moments as dz
+    from dyngen.diagnosis.fit import Design
     from dyngen.diagnosis.selection import selection_mse
 
     rng = np.random.default_rng(4)

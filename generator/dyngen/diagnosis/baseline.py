@@ -5,7 +5,7 @@
 (offset, Coulomb and viscous friction: three numbers per joint) fitted by least squares to the
 nominal model's residual on the fit samples. Its columns go through the recording's filter
 like the torques. A diagnosis that does worse than this on a joint has not explained that
-joint; run.py then keeps the simple model there.
+joint; the pipeline then keeps the simple model there (joints.py).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Per joint j (its rows only), each a term of terms/ (TERM_OF):
   coulomb      tanh(qd_j(t - lag_j) / vs_j)   Coulomb friction, smoothed, following the velocity
                with a lag; a switching signal, so it is passed through the recording's own
                low-pass, like the torque it explains (a filtered friction step is compared with
-               a filtered step, not a sharp one; as the diagnosis does, diagnosis/design.py)
+               a filtered step, not a sharp one; as the diagnosis does, diagnosis/moments.py)
   viscous      qd_j
   offset       1
   armature     qdd_j (rotor inertia, where the rigid body does not carry it already)

@@ -20,7 +20,6 @@ dt0 <- dt (refine.py), which also reaches negative shifts (torques leading the p
 from __future__ import annotations
 
 from ... import terms
-from ...terms.sensor import MAX_SHIFT  # noqa: F401 (kept importable here)
 from .base import Effect
 
 

@@ -4,7 +4,7 @@ G(q) and the directions: terms/tilt.py).
 tilt: the residual is G(q) d gvec across gravity (dg1, dg2), with the shortening along gravity
   that keeps |gvec| linearised at the current estimate, refined by fixed-point iteration once
   the tilt is selected (refine.py). The angles are named by the base axes they turn gravity
-  towards (tilt_axes). Tilts beyond MAX_TILT_DEG are not a mounting error and are refused.
+  towards (tilt_axes). Tilts beyond terms.tilt.MAX_TILT_DEG are not a mounting error and are refused.
 gravity_scale: always reported as suspect (a symptom, not a cause).
 """
 
@@ -14,8 +14,8 @@ import numpy as np
 
 from ... import terms
 from ...description.joint_model import forward_kinematics
-from ...terms.tilt import (MAX_GRAVITY_SCALE, MAX_TILT_DEG, body_gravity_matrix, gravity_matrix, gravity_norm,  # noqa: F401
-                           tilt_angles_deg, tilt_axes, tilt_directions)
+from ...terms.tilt import (body_gravity_matrix, gravity_matrix, gravity_norm, tilt_angles_deg, tilt_axes,
+                           tilt_directions)
 from .base import Effect
 
 
