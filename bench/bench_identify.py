@@ -172,7 +172,7 @@ def speed(lines):
     from dyngen.extraction.problem import Options as ExtractOptions
     from dyngen.extraction.problem import Stage, build_problem
     from dyngen.extraction.targets import Target
-    from dyngen.identification import consistent as C
+    from dyngen.identification.solver import robot_with_default_bounds
     from dyngen.parameters import dynamic_from_standard, standard_from_dynamic
 
     robot, s = synthetic()
@@ -202,7 +202,7 @@ def speed(lines):
     Y = model.batch("regressor", s.q, s.qd, s.qdd).reshape(-1, r)
     W = np.linalg.cholesky(Y.T @ Y / Y.shape[0]).T
     v = np.linalg.solve(W.T, Y.T @ s.tau.reshape(-1) / Y.shape[0])
-    problem = build_problem(C.robot_with_default_bounds(robot), ExtractOptions(global_algorithm="none", restarts=2))
+    problem = build_problem(robot_with_default_bounds(robot), ExtractOptions(global_algorithm="none", restarts=2))
     exe = driver.build(FOLDER)
     start = time.perf_counter()
     result = driver.run(exe, problem, Stage("x", [Target("full", W, v)], np.ones(70, bool), problem.reference.copy()),

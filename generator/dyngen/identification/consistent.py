@@ -27,134 +27,29 @@ The order of work, every step on the fit recordings only (test data are never se
      unconstrained weighted fit (statistics.py: a sandwich estimate that holds for correlated
      residuals).
 
-Public entry point: identify_consistent(robot, model, folder, signals, options, select=None) -> Consistent.
+Public entry point: identify_consistent(robot, model, folder, signals, options, select=None) -> Consistent
+(its options: options.py ConsistentOptions; the result and its YAML: consistent_output.py).
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import real
 from ..errors import InputError
-from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import consistency_margin, pinned
-from ..options import option
 from ..parameters import PER_LINK
 from ..terms import tilt
 from ..terms.body import armature_identifiable
-from ..terms.friction import SCALE_GRID, SIMPLE_SCALE
+from ..terms.friction import SIMPLE_SCALE
 from . import selection
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
+from .consistent_output import Consistent
 from .normal import Normal, solve_unconstrained
+from .options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
 from .solver import Solver
 from .statistics import estimate
-
-DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
-CHOICES = ("coulomb", "viscous", "offset", "armature", "ripple")  # what options.friction may name
-CANDIDATES = ("ripple", "tilt", "falling")  # optional groups, decided on held-out data
-BOUNDS = ("viscous", "dissipative")
-FRICTION_KINDS = PER_JOINT
-SMOOTHING_GRID = SCALE_GRID  # rad/s, candidates for vs_j
-LAG_GRID = (0.0, 0.01, 0.02, 0.04)  # s, candidates for the Coulomb term's lag behind the velocity
-REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
-
-
-@dataclass
-class ConsistentOptions:
-    """Options of the consistent identification; those declared with option(...) are also
-    `dyngen identify` flags (dyngen.options), the rest the method's own settings."""
-
-    friction: tuple = option(DEFAULT_KINDS, "per-joint columns always in: " + ", ".join(CHOICES)
-                             + " (ripple: cos q_j, sin q_j)", metavar="LIST", listed=True, choices=CHOICES)
-    candidates: tuple = option(CANDIDATES, "optional parts of the model, each kept only where held-out stretches "
-                               "of the fit data ask for it: ripple (cos q_j, sin q_j per joint), tilt (a tilted "
-                               "base), falling (friction falling with speed per joint: viscous below 0, still "
-                               "opposing motion up to the velocity limit); 'none' for none", metavar="LIST",
-                               listed=True, choices=CANDIDATES + ("none",))
-    smoothing: float | None = option(None, "Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint "
-                                     "(default: chosen per joint on the fit data)", metavar="V",
-                                     parse=real(0, 100, above=True))
-    margin: float = ExtractOptions.margin  # consistency margin [kg m^2]: the extraction's
-    restarts: int = 2
-    seed: int = 1
-    threads: int = 0
-    max_rounds: int = 8  # active-set rounds for the signs of the friction values
-    weighted: bool = True  # rows scaled by 1 / sigma_joint
-    prior: np.ndarray | None = None  # dynamic parameters (10N); default the YAML's nominal
-    regularisation: float | None = option(None, "weight of the prior (default: chosen on held-out data: "
-                                          "contiguous parts of the fit data, or --select data)", metavar="L",
-                                          parse=real(0, 1e9))  # None: chosen from `grid`
-    grid: tuple = REGULARISATION_GRID
-    folds: int = 5  # contiguous parts for the choices on held-out data when no select data are given
-    rule: str = "1se"  # "1se" (one-standard-error rule) or "min" (the best held-out score)
-    tilt: bool | None = option(None, "always fit a tilted base (a rotation of gravity; by default a candidate, "
-                               "see --candidates)", const=True)  # True always, False never, None a candidate
-    friction_lag: bool = True  # Coulomb term follows the velocity with a per-joint lag from LAG_GRID
-    friction_bound: str = "viscous"  # "viscous": Fc, Fv >= 0 but where "falling" is chosen; "dissipative":
-    # Fc + Fv v_max >= 0 on every joint (solver.py)
-    workers: int = 0  # driver runs at once in the cross-validation (0: up to 2, as the cores allow)
-
-
-@dataclass
-class Consistent:
-    """The result: full link parameters, friction per joint, and the statistics of the fit."""
-
-    p: np.ndarray  # dynamic parameters (10N), physically consistent
-    pi: np.ndarray  # full base coefficients of p
-    names: list  # base coefficient expressions (standard parameters)
-    friction: dict  # kind -> (N,) values (nan where the column is not in the model); "tilt": (a1, a2)
-    smoothing: np.ndarray  # (N,) vs_j [rad/s]
-    sigma: np.ndarray  # (N,) per-joint noise estimate used as weight [Nm]
-    ols: object  # least_squares.Estimate of the unconstrained weighted fit (coefficients, then friction)
-    column_names: list  # names of the OLS columns
-    residual_rms: np.ndarray  # (N,) RMS of the consistent model's residual on the fit data
-    ols_residual_rms: np.ndarray  # (N,) the same for the unconstrained fit
-    lambda_min: np.ndarray  # (N,) consistency margin of each link
-    regularisation: float
-    selection: list  # (lambda, held-out weighted mean square) tried
-    rounds: int
-    dropped_armature: list = field(default_factory=list)  # joints whose rotor inertia the body carries
-    at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
-    velocity_limits: np.ndarray | None = None
-    tilt_model: tuple | None = None  # (robot, parameters) the tilt's torques are evaluated with
-    dropped_columns: list = field(default_factory=list)  # columns the data cannot separate, or refused
-    lags: np.ndarray | None = None  # (N,) lag of the Coulomb term behind the velocity [s]
-    groups: list = field(default_factory=list)  # (group, joint or None, gain, its se, kept) decided on held-out data
-    notes: list = field(default_factory=list)  # what a user must know (e.g. a tilt refused)
-
-    def joint_dynamics(self) -> list:
-        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
-        damping must be >= 0: a negative Fv is left out there, and said so by the caller)."""
-        f = self.friction
-        return [{"damping": max(_nz(f["viscous"][j]), 0.0), "friction": _nz(f["coulomb"][j]),
-                 "armature": _nz(f["armature"][j])} for j in range(len(self.sigma))]
-
-    def tilt_deg(self) -> float:
-        if self.tilt_model is None:
-            return 0.0
-        return tilt.angle_deg(tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
-
-    def predict(self, model, signals) -> np.ndarray:
-        """Torques (T, N) of this model (rigid body + friction + offset + rotor inertia + optional
-        groups) on signals (Coulomb through the recording's filter, as in the fit)."""
-        f = {k: np.nan_to_num(v) for k, v in self.friction.items()}
-        out = model.batch("regressor", signals.q, signals.qd, signals.qdd) @ self.pi
-        if np.any(f["coulomb"]):
-            out = out + f["coulomb"] * coulomb_matrix(signals, self.smoothing, self.lags)
-        out = out + (f["viscous"] * signals.qd + f["offset"] + f["armature"] * signals.qdd
-                     + f["ripple_cos"] * np.cos(signals.q) + f["ripple_sin"] * np.sin(signals.q))
-        if self.tilt_model is not None:
-            robot, p = self.tilt_model
-            out = out + tilt.torque(robot, p, signals.q, tilt.gravity_of(robot), self.friction["tilt"])
-        return out
-
-
-def _nz(x) -> float:
-    return 0.0 if not np.isfinite(x) else float(x)
-
 
 # ---------------------------------------------------------------------------------------------
 # step 2: the Coulomb term's smoothing and lag
