@@ -1,5 +1,5 @@
 """Does a diagnosis (diagnosis.json, docs/conventions.md) match the truth of a withheld case
-(truth.json, bench/simulation/withheld_cases.py)? `problems(truth, diagnosis, noise)` lists every
+(truth.json, tests/simulation/withheld_cases.py)? `problems(truth, diagnosis, noise)` lists every
 mismatch as a sentence; an empty list is a pass.
 
 The verdict must name exactly the injected effects on exactly their joints, recover each
