@@ -8,7 +8,7 @@
 Modules: consistent (weighted least squares over consistent link parameters, friction, offsets and
 rotor inertia through the extraction's solver: the order of work), columns (the terms' columns per
 recording: friction, ripple, tilt, terms/), normal (normal equations per part and joint), solver (the consistent
-fit of normal equations by the extraction's driver), selection (lambda and the optional parts on
+fit of normal equations by the extraction's driver), held_out (lambda and the optional parts on
 held-out data), statistics (sandwich standard deviations), options (identify's and the consistent
 identification's options), consistent_output (the result, its YAML and tables; the command:
 commands/identify_consistent.py); samples (stacked regressors and

@@ -10,7 +10,7 @@ joint j by 1 / sigma_j (its noise estimate); F holds the columns of columns.py: 
 friction (smoothing and lag chosen per joint on the fit data, filtered like the torque), viscous
 friction, an offset and rotor inertia (where the rigid body does not already carry it: joint 1's
 is part of link 1's inertia), and the optional groups, kept only where held-out data ask for them
-(selection.py): a position ripple per joint, a tilted base (a rotation, terms/tilt.py).
+(held_out.py): a position ripple per joint, a tilted base (a rotation, terms/tilt.py).
 
 The order of work, every step on the fit recordings only (test data are never seen here):
   1. the regressor and every column, once (columns.py), and the normal equations per contiguous
@@ -18,7 +18,7 @@ The order of work, every step on the fit recordings only (test data are never se
   2. the Coulomb smoothing and lag per joint (the unconstrained fit's residual per joint);
   3. the noise per joint sigma_j (the unconstrained fit's residual), the weights; columns the data
      cannot tell from the rest are left out and named;
-  4. lambda on held-out data (selection.py: cross-validation over contiguous parts, or the
+  4. lambda on held-out data (held_out.py: cross-validation over contiguous parts, or the
      `select` recordings), with every optional group in;
   5. each optional group kept or left out at that lambda, on the same held-out data;
   6. the consistent fit on all fit data (solver.py: the extraction's driver, one solver); a tilt
@@ -43,7 +43,7 @@ from ..parameters import PER_LINK
 from ..terms import tilt
 from ..terms.body import armature_identifiable
 from ..terms.friction import SIMPLE_SCALE
-from . import selection
+from . import held_out
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
 from .consistent_output import Consistent
 from .normal import Normal, solve_unconstrained
@@ -183,7 +183,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     # 4. lambda; 5. optional groups
     solver = Solver(robot, model, folder, options, r, velocity_limits(robot, signals_list), prior)
     workers = options.workers or min(2, os.cpu_count() or 1)
-    splits = selection.Folds.make(parts, bool(select), weights)
+    splits = held_out.Folds.make(parts, bool(select), weights)
     # joints whose friction may fall with speed (a candidate, or all with friction_bound "dissipative")
     cone = set()
     if options.friction_bound == "dissipative" or "falling" in options.candidates:
@@ -193,13 +193,13 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     if lam is None:
         lam = 0.0
         if prior is not None and len(options.grid) > 1:
-            lam, table, kept = selection.choose_lambda(solver, normal, splits, active, options.grid, options.rule,
+            lam, table, kept = held_out.choose_lambda(solver, normal, splits, active, options.grid, options.rule,
                                                        workers, cone)
     undecided = [k for k in active if (labels[k][0] in optional) or (labels[k][0] == "tilt" and tilt_mode == "auto")]
     falling = cone if options.friction_bound != "dissipative" and "falling" in options.candidates else set()
     groups = []
     if undecided or falling:
-        base = kept.get(lam) or selection.scores(solver, normal, splits, active, lam, workers=workers, cone=cone)
+        base = kept.get(lam) or held_out.scores(solver, normal, splits, active, lam, workers=workers, cone=cone)
         active, cone, groups = _decide(solver, normal, splits, active, cone, undecided, falling, base, lam, workers)
 
     # 6. the consistent fit on all fit data
@@ -236,17 +236,17 @@ def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam,
     for group in ("tilt", "ripple", "falling"):
         members = [k for k in undecided if group_of(labels[k]) == group]
         if group == "falling" and falling:
-            without = selection.scores(solver, normal, splits, active, lam, workers=workers, cone=cone - falling)
+            without = held_out.scores(solver, normal, splits, active, lam, workers=workers, cone=cone - falling)
             joints = sorted(falling)
         elif members:
-            without = selection.scores(solver, normal, splits, [k for k in active if k not in members], lam,
+            without = held_out.scores(solver, normal, splits, [k for k in active if k not in members], lam,
                                        workers=workers, cone=cone)
             joints = [None] if group == "tilt" else sorted({labels[k][1] for k in members})
         else:
             continue
         for j in joints:
-            gain = selection.gains(base, without, j)
-            keep = selection.keeps(gain, splits)
+            gain = held_out.gains(base, without, j)
+            keep = held_out.keeps(gain, splits)
             decisions.append((group, None if j is None else j + 1, gain[0], gain[1], keep))
             if not keep and group == "falling":
                 out_cone.discard(j)
