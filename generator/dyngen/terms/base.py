@@ -4,7 +4,9 @@ A term is a torque linear in its fitted values: tau_term = columns @ values. Its
 settings (a velocity scale, a lag) are fixed while it is fitted. Columns are computed from
 samples (q, qd, qdd, t, the model's torque) with numpy; a `pointwise` term's columns of a
 chunk of samples need that chunk alone, so the normal equations A^T A, A^T b of any fit that
-uses it accumulate chunk by chunk (a time shift needs the samples up to its lag before).
+uses it accumulate chunk by chunk (a time shift needs the samples up to its lag before; a
+`switching` term's columns go through the recording's low-pass like the torque, which needs
+the filter's overlap at a chunk's ends).
 """
 
 from __future__ import annotations
@@ -51,6 +53,7 @@ class Term:
     values: tuple = ()
     settings: tuple = ()
     pointwise = True
+    switching = False  # switches with the sign of the velocity: filtered like the torque it explains
     friction: tuple = ()  # FrictionField, in the order of the vector
 
     @classmethod

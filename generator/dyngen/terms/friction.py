@@ -46,6 +46,7 @@ def direction(qd, ed):
 
 class Coulomb(Term):
     name, doc = "coulomb", "Coulomb friction Fc tanh(qd / vc), vc fitted (real joints do not switch sharply)"
+    switching = True
     values = (Value("Fc", "Nm", **POSITIVE),)
     settings = (Value("vc", "rad/s", **POSITIVE),)
     friction = (FrictionField("Fc", "value", "Coulomb friction [Nm or N]"),
@@ -84,6 +85,7 @@ class Viscous(Term):
 
 class Stribeck(Term):
     name, doc = "stribeck", "Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): breakaway friction above Coulomb's"
+    switching = True
     values = (Value("Fs", "Nm", **POSITIVE),)
     settings = (Value("vs", "rad/s", **POSITIVE), Value("es", "rad/s", **POSITIVE))
     friction = (FrictionField("Fs", "value", "Stribeck friction (breakaway minus Coulomb) [Nm or N]"),
@@ -107,6 +109,7 @@ class Stribeck(Term):
 
 class Direction(Term):
     name, doc = "direction", "direction-dependent Coulomb friction dFc |tanh(qd / ed)| (Fc + dFc forwards, Fc - dFc back)"
+    switching = True
     values = (Value("dFc", "Nm"),)
     settings = (Value("ed", "rad/s", **POSITIVE),)
     friction = (FrictionField("dFc", "value", "Coulomb level's excess moving forwards over moving backwards, halved "

@@ -73,7 +73,7 @@ class Effect:
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         if "term" in cls.__dict__ and cls.term is not None:
-            cls.name, cls.scope = cls.term.name, cls.term.scope
+            cls.name, cls.scope, cls.switching = cls.term.name, cls.term.scope, cls.term.switching
             cls.parameters, cls.units = cls.term.parameters(), cls.term.units()
 
     @classmethod

@@ -1,16 +1,8 @@
 """Joint friction and rotor inertia as candidates of the diagnosis: per joint, linear in their
 values (the laws, their ranges and columns: terms/friction.py).
 
-    Coulomb:   Fc * tanh(qd / vc)                 [Nm] at a velocity scale vc (variants; refined once selected)
-    viscous:   Fv * qd                            [Nm s/rad]
-    Stribeck:  Fs * sign(qd) * exp(-(qd/vs)^2)    [Nm] at a fixed vs (variants; vs refined once selected)
-    direction: dFc * |sign(qd)|                   [Nm]: Coulomb levels Fc + dFc moving forwards and
-                                                  Fc - dFc backwards (gears and seals are not symmetric)
-    ripple:    sum_k a_k cos(k q) + b_k sin(k q)  [Nm], k = 1..3: a torque that depends on the joint's
-                                                  own position (gear and cogging harmonics); known only
-                                                  where the fit data went, so q is clipped to that
-                                                  range (harmonics extrapolated beyond it are guesses)
-    armature:  Ia * qdd                           [kg m^2] (reflected rotor inertia)
+Variants: Coulomb at a few velocity scales vc and Stribeck at a few velocities vs, refined once
+selected (refine.py); the ripple's positions clipped to the fit data's (Context.q_range).
 
 The Coulomb velocity scale vc is fitted because real joints do not switch sharply: in stick
 phases and reversals friction takes any value in [-Fc, Fc], which a smooth law with a wider
@@ -42,7 +34,7 @@ class _Dissipative(Effect):
 
 class Coulomb(_Dissipative):
     term = terms.Coulomb
-    refinable = switching = True
+    refinable = True
     simulator = ("friction", "Fc")
 
     def __init__(self, velocity: float):
@@ -76,7 +68,7 @@ class Coulomb(_Dissipative):
 
 class Direction(Effect):
     term = terms.Direction
-    secondary = switching = local = True
+    secondary = local = True
 
     @classmethod
     def friction_terms(cls, values, variant):
@@ -129,7 +121,7 @@ class Viscous(_Dissipative):
 
 class Stribeck(_Dissipative):
     term = terms.Stribeck
-    refinable = switching = True
+    refinable = True
     # Static friction above the Coulomb level. Alone, it would be friction that vanishes at
     # speed, which no joint has, and the viscous law would then take the Coulomb level's place
     # (extrapolating steeply beyond the fit speeds).

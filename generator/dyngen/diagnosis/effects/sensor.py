@@ -1,9 +1,5 @@
 """Errors of the measurement itself, as candidates of the diagnosis (the terms: terms/sensor.py).
 
-    offset:      b                                  per joint [Nm]: torque-sensor zero offset
-    gain:        (k - 1) * tau_model                per joint [1]: the sensor reads k times the torque
-    time shift:  tau(t - dt) - tau(t)               whole arm [s]: torques lag positions by dt
-
 The time shift is linear in dt only to first order, -dt * d tau_model / dt, which fails
 wherever tau_model jumps (an acceleration step): the measured torque keeps the value before
 the jump for dt, while the sampled derivative puts a spike of jump * dt / (2 h) on the two
