@@ -99,3 +99,26 @@ def test_every_term_states_its_values_ranges_and_doc():
     assert C.inside([0.3]) and not C.inside([-0.1])  # friction opposes motion
     assert Gain.inside([0.2]) and not Gain.inside([0.6])  # a sensor reads 0.5 to 1.5 times the torque
     assert not TimeShift.pointwise and C.pointwise  # a lag needs samples before a chunk
+
+
+def test_one_tilt_for_identify_and_diagnose():
+    """identify's rotation columns (terms.tilt.rotation_columns) and the diagnosis's Tilt are the
+    same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
+    gravity along -z), and the turned gravity vector keeps its size."""
+    from oracles.random_params import random_parameters
+
+    from dyngen.diagnosis.effects import Tilt
+    from dyngen.terms import tilt
+
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    p = random_parameters(7, 3, mass=(0.5, 3.0), second_moment=(0.002, 0.02))
+    q = np.random.default_rng(8).uniform(-2, 2, (30, 7))
+    g = tilt.gravity_of(robot)
+    assert np.allclose(tilt.directions(g), [[1, 0, 0], [0, -1, 0], [0, 0, -1]])
+    assert tilt.tilt_axes(robot) == ("base +x", "base -y")
+    context = Context(None, robot, p, None, 0.002)
+    estimate = (0.3, -0.5)
+    ours = Tilt.of(context).at(estimate).columns(context, SimpleNamespace(q=q), None)
+    assert np.allclose(tilt.rotation_columns(robot, p, q, g, estimate), ours, rtol=1e-12, atol=1e-12)
+    turned = g + tilt.directions(g).T @ tilt.change(g, estimate)
+    assert np.linalg.norm(turned) == pytest.approx(np.linalg.norm(g), rel=1e-12)
