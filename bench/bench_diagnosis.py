@@ -17,14 +17,13 @@ default threads on this loaded 2-core machine, the same diagnosis took 17 s inst
 
 from __future__ import annotations
 
-import argparse
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "generator"))
+from common import arguments, on_path, table  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from dyngen import blas  # noqa: E402
 
@@ -78,7 +77,7 @@ def timed(robot, model, p, fit, test):
 
 
 def main():
-    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
+    arguments(__doc__, whole=True).parse_args()
     robot = load_robot(ROOT / "examples" / "lwr.yaml")
     model = load(ROOT / "generated" / "lwr")
     p = read_link_parameters(ROOT / "examples" / "lwr_paper_solution.yaml", 7)
@@ -128,7 +127,7 @@ def main():
         f"joint's Coulomb term). Twice: with exact qd, qdd "
         "columns (no filter), and with positions from a 20-bit encoder with 1e-5 rad noise and no qd, qdd "
         f"(cutoff chosen from the data: {efit.cutoff:.3g} Hz; every effect column filtered like the torque).", "",
-        "| step | time [s] |", "|---|---:|",
+        *table(["step", "time [s]"], "lr"),
         f"| diagnosis, fit + select + test (residual, columns, moments, selection, refinement, pruning, final "
         f"fit, simple model, per joint choice), recorded qd, qdd, best of 3 | {min(runs):.2f} |",
         f"| the same, all three runs | {', '.join(f'{x:.2f}' for x in runs)} |",

@@ -28,7 +28,6 @@ cached in bench/.build/ (the first run spends about a minute compiling it).
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import os
@@ -48,9 +47,8 @@ import yaml
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-from common import arm_yaml, compiler_version, example_arms, log, machine  # noqa: E402
-sys.path.insert(0, str(ROOT / "tests"))
-sys.path.insert(0, str(BENCH))
+from common import arguments, arm_yaml, compiler_version, example_arms, log, machine, on_path  # noqa: E402  (bench/ is sys.path[0])
+on_path()
 
 from peak_memory import run_measured  # noqa: E402
 
@@ -459,7 +457,7 @@ def main(argv=None) -> int:
 
 
 def parse_args(argv):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arms", nargs="+", default=None,
                     help="example names (examples/NAME.yaml) or YAML paths; default: all examples")
     ap.add_argument("--callgrind", action="store_true", help="also count instructions per call with valgrind")

@@ -14,9 +14,7 @@ exact solution, and their ratio.
 
 from __future__ import annotations
 
-import argparse
 import resource
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -24,8 +22,9 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import dual_annealing, minimize
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+from common import arguments, on_path  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from dyngen.description import load_robot  # noqa: E402
 from dyngen.extraction.problem import Options, build_problem, consistency_margin  # noqa: E402
@@ -161,7 +160,7 @@ def table(rows, restarts, scipy_restarts, problems) -> str:
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = arguments(__doc__)
     parser.add_argument("--arms", nargs="+", default=["lwr", "panda", "puma560", "ur5", "stanford"])
     parser.add_argument("--restarts", type=int, default=16, help="dyngen restarts per problem")
     parser.add_argument("--scipy-restarts", type=int, default=2, help="SciPy restarts per problem")

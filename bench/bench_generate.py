@@ -32,8 +32,7 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-sys.path.insert(0, str(BENCH))
-from common import arm_yaml, compiler_version, example_arms, log, machine  # noqa: E402
+from common import arguments, arm_yaml, compiler_version, example_arms, log, machine, table  # noqa: E402  (bench/ is sys.path[0])
 STAGES = ("load", "derive", "reduce", "emit")
 
 
@@ -98,7 +97,7 @@ def compile_once(cc: str, flags: list, folder: Path) -> tuple[float, dict]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arms", nargs="+", help="example names or YAML paths; default: all examples")
     ap.add_argument("--repeat", type=int, default=3, help="repetitions per arm, medians reported (default 3)")
     ap.add_argument("--flags", default="-O2", help="C compiler flags (default: -O2)")
@@ -140,11 +139,11 @@ def main(argv=None) -> int:
                          f"{statistics.median(per_file[largest]):.2f} ({largest})"])
     head = ["arm", "dof", "load s", "derive s", "reduce s", "emit s", "generate s",
             ".c files / lines", f"cc {args.flags} s", "slowest .c s"]
-    table = [head, *rows]
-    widths = [max(len(r[i]) for r in table) for i in range(len(head))]
+    printed = [head, *rows]
+    widths = [max(len(r[i]) for r in printed) for i in range(len(head))]
     print()
     print("\n".join("  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths)))
-                    for r in table))
+                    for r in printed))
     info = [
         f"- machine: {machine()}",
         f"- dyngen {dyngen.__version__}, Python {platform.python_version()}; each generation in a fresh "
@@ -157,8 +156,7 @@ def main(argv=None) -> int:
     print()
     print("\n".join(info))
     if args.output:
-        md = ["| " + " | ".join(head) + " |", "|---|" + "---:|" * (len(head) - 1)]
-        md += ["| " + " | ".join(r) + " |" for r in rows]
+        md = table(head, "l" + "r" * (len(head) - 1), rows)
         out = Path(args.output)
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text("# dyngen generation and compile times\n\nWritten by `python bench/bench_generate.py`.\n\n"

@@ -24,13 +24,12 @@ Part 3, `dyngen excite` for the LWR: time and condition numbers.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "generator"))
-sys.path.insert(0, str(ROOT / "tests"))
+from common import machine, on_path, table  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from dyngen import blas  # noqa: E402
 
@@ -38,7 +37,6 @@ blas.use_one_thread()
 
 import numpy as np  # noqa: E402
 
-from common import machine  # noqa: E402
 from dyngen.data import Conditioning, condition, read_recording  # noqa: E402
 from dyngen.data.parameters_file import read_link_parameters  # noqa: E402
 from dyngen.description import load_robot  # noqa: E402
@@ -172,7 +170,7 @@ def speed(lines):
     from dyngen.extraction.problem import Options as ExtractOptions
     from dyngen.extraction.problem import Stage, build_problem
     from dyngen.extraction.targets import Target
-    from dyngen.identification import consistent as C
+    from dyngen.identification.solver import robot_with_default_bounds
     from dyngen.parameters import dynamic_from_standard, standard_from_dynamic
 
     robot, s = synthetic()
@@ -191,7 +189,7 @@ def speed(lines):
             identify_consistent(robot, model, FOLDER, [s], options)
             best = min(best, time.perf_counter() - start)
         times[label] = best
-    lines += ["| identify_consistent | best of 2 [s] |", "|---|---:|"]
+    lines += table(["identify_consistent", "best of 2 [s]"], "lr")
     # (the regressor, the columns and the normal equations per part and joint are formed once; the
     # cross-validation's fits skip the driver's nearest-to-prior step and run two at a time)
     lines += [f"| {k} | {v:.2f} |" for k, v in times.items()]
@@ -202,7 +200,7 @@ def speed(lines):
     Y = model.batch("regressor", s.q, s.qd, s.qdd).reshape(-1, r)
     W = np.linalg.cholesky(Y.T @ Y / Y.shape[0]).T
     v = np.linalg.solve(W.T, Y.T @ s.tau.reshape(-1) / Y.shape[0])
-    problem = build_problem(C.robot_with_default_bounds(robot), ExtractOptions(global_algorithm="none", restarts=2))
+    problem = build_problem(robot_with_default_bounds(robot), ExtractOptions(global_algorithm="none", restarts=2))
     exe = driver.build(FOLDER)
     start = time.perf_counter()
     result = driver.run(exe, problem, Stage("x", [Target("full", W, v)], np.ones(70, bool), problem.reference.copy()),
@@ -213,7 +211,7 @@ def speed(lines):
                          for k in range(70)])
     cost_b = float(np.sum((W @ model("pi_full", result.p) - v) ** 2))
     value, t_sdp, status = sdp(W, v, problem, K, 1e-7)
-    lines += ["| reduced problem (43 coefficients, 7 links) | time [s] | cost ||W pi - v||^2 |", "|---|---:|---:|",
+    lines += [*table(["reduced problem (43 coefficients, 7 links)", "time [s]", "cost ||W pi - v||^2"], "lrr"),
               f"| extraction's barrier driver (2 restarts + nearest-to-prior step, process start included) | {t_barrier:.2f} | {cost_b:.6g} |",
               f"| cvxpy + Clarabel SDP (no inertia bounds about the CoM), {status} | {t_sdp:.2f} | {value:.6g} |", ""]
 

@@ -9,14 +9,13 @@ model (offset + Coulomb + viscous per joint, fitted on the same fit data).
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "generator"))
+from common import arguments, on_path  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from dyngen import blas  # noqa: E402
 
@@ -40,7 +39,7 @@ def simple_of(d):
 
 
 def main() -> int:
-    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
+    arguments(__doc__, whole=True).parse_args()
     robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(ROOT / "generated" / "lwr")
     p = read_link_parameters(ROOT / "examples" / "lwr_paper_solution.yaml", 7)
 

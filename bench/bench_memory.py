@@ -18,7 +18,6 @@ Writes bench/results/memory.md.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import sys
@@ -27,8 +26,7 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-from common import log  # noqa: E402
-sys.path.insert(0, str(BENCH))
+from common import arguments, log, table  # noqa: E402  (bench/ is sys.path[0])
 
 from peak_memory import run_measured  # noqa: E402
 
@@ -94,7 +92,7 @@ def collected() -> list:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arm", default="lwr", help="example name (examples/NAME.yaml) or YAML path (default lwr)")
     ap.add_argument("--output", default=str(BENCH / "results" / "memory.md"),
                     help="markdown results (default bench/results/memory.md); '' to skip")
@@ -114,7 +112,7 @@ def main(argv=None) -> int:
              "(bench/peak_memory.py) whose own peak, about 10 MiB, is the floor: '<= N (floor)' means the step "
              "needs at most that. Rows marked (collected) come from the last run of "
              "bench_dynamics.py / bench_scaling.py.", "",
-             "| step | what | wall s | peak MiB |", "|---|---|---:|---:|"]
+             *table(["step", "what", "wall s", "peak MiB"], "llrr")]
     for i, (step, what, seconds, peak) in enumerate(rows):
         tag = "" if i < measured_here else " (collected)"
         lines.append(f"| {step}{tag} | {what} | {'' if seconds is None else f'{seconds:.2f}'} | {peak} |")

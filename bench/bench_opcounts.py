@@ -10,7 +10,6 @@ Writes bench/results/opcounts.md and opcounts.json.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import tempfile
@@ -18,8 +17,7 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-from common import log  # noqa: E402
-sys.path.insert(0, str(BENCH))
+from common import arguments, log  # noqa: E402  (bench/ is sys.path[0])
 
 
 def arm_counts(yaml_path: Path, tmp: Path) -> dict:
@@ -54,7 +52,7 @@ def table(arms: list) -> str:
 def main(argv=None) -> int:
     from common import arm_yaml, example_arms
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arms", nargs="+", help="example names or YAML paths; default: all examples")
     ap.add_argument("--output", default=str(BENCH / "results" / "opcounts.md"),
                     help="markdown results (default bench/results/opcounts.md; the .json next to it); '' to skip")

@@ -18,7 +18,6 @@ Writes bench/results/scaling.md, scaling.json and scaling.png (log-log plot).
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import platform
@@ -33,8 +32,7 @@ import numpy as np
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-from common import log  # noqa: E402
-sys.path.insert(0, str(BENCH))
+from common import arguments, log, table  # noqa: E402  (bench/ is sys.path[0])
 
 from peak_memory import run_measured  # noqa: E402
 from synthetic_arm import synthetic_arm_yaml  # noqa: E402
@@ -203,11 +201,11 @@ def report(rows: list, k: dict, args, cc: str) -> str:
             f"{r['mul']['regressor_inertia']} | {r['base']['gravity']} / {r['base']['inertia']} / {r['base']['full']} | "
             f"{r['compile_cpu_s']:.2f} ({r['compile_s']:.2f}) | {r['compile_peak_mib']:.0f} |")
     lines += ["", "Growth exponents (value ~ n^k) of code size and generation cost (the issue's target: k <= 2):", "",
-              "| quantity | k | k <= 2 |", "|---|---:|---|"]
+              *table(["quantity", "k", "k <= 2"], "lrl")]
     lines += [f"| {name} | {k[name]:.2f} | {'yes' if k[name] <= TARGET_EXPONENT else 'NO'} |" for name in COST]
     lines += ["", "Growth exponents of the run-time multiplications of generated functions (no target: each is "
               "bound below by the size of what it computes):", "",
-              "| function | k | its output grows like |", "|---|---:|---|"]
+              *table(["function", "k", "its output grows like"], "lrl")]
     lines += [f"| {f} | {k[f + ' mul']:.2f} | {OUTPUT_BOUND[f]} |" for f in TRACKED]
     ok_time = last["generate_s"] < TARGET_SECONDS
     lines += ["", "Targets:", "",
@@ -237,7 +235,7 @@ def report(rows: list, k: dict, args, cc: str) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--joints", type=int, nargs="+", default=list(JOINTS), help="arm sizes (default 2 4 6 7 9 12)")
     ap.add_argument("--repeat", type=int, default=1, help="repetitions per arm, medians reported (default 1)")
     ap.add_argument("--flags", default="-O2", help="C compiler flags (default -O2)")

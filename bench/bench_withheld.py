@@ -3,30 +3,30 @@
     python bench/bench_withheld.py                    # 200, 500 and 1000 Hz, encoder positions
     python bench/bench_withheld.py --rates 500        # one rate
 
-For every case of bench/simulation/withheld_cases.py (CASES: the LWR in MuJoCo, torques from
+For every case of tests/simulation/withheld_cases.py (CASES: the LWR in MuJoCo, torques from
 mj_inverse with effects the nominal model lacks; TRACKED_CASES: a forward simulation of the arm
 tracking its reference, with friction that sticks at reversals; COMPOSED_CASES: a sensor's lag
 or gain beside friction or a tilt; OFF_GRID_CASES: settings between the diagnosis's variants), positions as a 20-bit encoder records them (1e-5 rad noise,
 quantised), no qd or qdd columns, torque noise 0.05 Nm. Each case runs through
 `dyngen diagnose`'s function with default options, in both directions: fit on the Fourier
 excitation (selection on blocks of it) and test on Table V, and the reverse. The verdict
-(bench/simulation/withheld_verdict.py) asks for exactly the injected effects on their joints,
+(tests/simulation/withheld_verdict.py) asks for exactly the injected effects on their joints,
 every magnitude within 20 %, and a test RMS after within 1.5 x what the perfect model leaves
-on the same conditioned test data (bench/simulation/perfect.py). The noise-free variant (exact
+on the same conditioned test data (tests/simulation/perfect.py). The noise-free variant (exact
 q, qd, qdd columns, 1 kHz) runs as well (--noise-free-rate). Tables to
 bench/results/withheld.md (--results).
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "generator"))
+from common import arguments, on_path  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from dyngen import blas  # noqa: E402
 
@@ -85,7 +85,7 @@ def summary(rows) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--rates", default="200,500,1000", help="encoder recordings at these rates [Hz]")
     ap.add_argument("--noise-free-rate", type=float, default=1000.0, help="rate of the noise-free variant (0: none)")
     ap.add_argument("--seed", type=int, default=0)

@@ -8,7 +8,7 @@ bench/bench_withheld.py runs a fixed list of cases, which the diagnosis was deve
 each case draws one or two effects (Coulomb, viscous, Stribeck beside Coulomb, rotor inertia,
 sensor offset, sensor gain, payload, tilt, time shift) with random joints and magnitudes in
 the ranges below, and a third of them track their reference in a forward simulation (friction
-that sticks). Otherwise as bench_withheld.py: the LWR in MuJoCo (bench/simulation), positions
+that sticks). Otherwise as bench_withheld.py: the LWR in MuJoCo (tests/simulation), positions
 from a 20-bit encoder with 1e-5 rad noise, no qd or qdd columns, torque noise 0.05 Nm, default
 options, both directions (fit on the Fourier excitation, test on Table V, and the reverse), the
 same verdict. Table to bench/results/withheld_random.md (--results).
@@ -19,15 +19,15 @@ joints, with a second Fourier excitation in place of Table V, which is the LWR's
 
 from __future__ import annotations
 
-import argparse
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "generator"))
+from common import arguments, on_path  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from dyngen import blas  # noqa: E402
 
@@ -88,7 +88,7 @@ def random_cases(count: int, seed: int, dof: int = 7) -> list[Case]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--rate", type=float, default=1000.0, help="sample rate [Hz] (default 1000)")
     ap.add_argument("--cases", type=int, default=12, help="number of random cases (default 12)")
     ap.add_argument("--seed", type=int, default=101, help="draws the cases and the noise (default 101)")

@@ -1,7 +1,9 @@
-"""What the benchmark scripts share: logging, the machine and compiler description, the arms."""
+"""What the benchmark scripts share: their set-up (on_path), arguments (arguments) and result tables
+(table), logging, the machine and compiler description, the arms."""
 
 from __future__ import annotations
 
+import argparse
 import os
 import platform
 import subprocess
@@ -9,6 +11,31 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+BENCH = ROOT / "bench"
+
+
+def on_path() -> Path:
+    """generator/ (this checkout's dyngen, installed or not) and tests/ (the tests' simulation
+    and oracles, which the benchmarks share) first on sys.path; returns the repository root."""
+    for folder in (ROOT / "tests", ROOT / "generator"):
+        if str(folder) not in sys.path:
+            sys.path.insert(0, str(folder))
+    return ROOT
+
+
+def arguments(doc: str, whole: bool = False, **kwargs) -> argparse.ArgumentParser:
+    """The script's argument parser, described by the first paragraph of its docstring (whole:
+    by all of it, as written)."""
+    if whole:
+        return argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter, **kwargs)
+    return argparse.ArgumentParser(description=doc.split("\n\n")[0], **kwargs)
+
+
+def table(header: list, align: str = "", rows: list = ()) -> list[str]:
+    """A Markdown table's lines: its header, the rule (align: "l" or "r" per column; default all
+    left) and rows (lists of cells)."""
+    rule = "|" + "".join("---:|" if a == "r" else "---|" for a in (align or "l" * len(header)))
+    return ["| " + " | ".join(map(str, header)) + " |", rule, *("| " + " | ".join(map(str, r)) + " |" for r in rows)]
 
 
 def log(msg: str) -> None:

@@ -39,8 +39,7 @@ from pathlib import Path
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-sys.path.insert(0, str(BENCH))
-from common import cpu_model, log  # noqa: E402
+from common import arguments, cpu_model, log  # noqa: E402  (bench/ is sys.path[0])
 RESULTS = BENCH / "results"
 PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory")
 TITLES = {
@@ -253,7 +252,7 @@ def write_benchmarks(outcomes: dict, args, total: float) -> Path:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+    ap = arguments(__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=__doc__.split("\n\n", 2)[2])
     ap.add_argument("--parts", nargs="+", choices=PARTS, default=list(PARTS), help="parts to run (default: all)")

@@ -3,8 +3,8 @@
     python bench/withheld_cases.py --out /tmp/withheld              # 1 kHz, about 300 MB
     python bench/withheld_cases.py --out /tmp/withheld --rate 200   # the real LWR data's rate
 
-The cases are bench/simulation/withheld_cases.py's CASES, simulated in MuJoCo
-(bench/simulation/mujoco_measurements.py); see bench/README.md. After writing, the script reads
+The cases are tests/simulation/withheld_cases.py's CASES, simulated in MuJoCo
+(tests/simulation/mujoco_measurements.py); see bench/README.md. After writing, the script reads
 every CSV back and reports, per case, the residual of the nominal model (params.yaml through
 the generated rnea of generated/lwr) on the fit and the held-out trajectory: the RMS per joint
 that a diagnosis starts from, and its ratio to the noise sigma. Table to
@@ -13,15 +13,15 @@ bench/results/withheld_cases.md (--results).
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "generator"))
+from common import arguments, on_path  # noqa: E402  (bench/ is sys.path[0])
+
+ROOT = on_path()
 
 from simulation.mujoco_measurements import read_csv  # noqa: E402
 from simulation.withheld_cases import write_cases  # noqa: E402
@@ -52,7 +52,7 @@ def residual_rms(model, s, path) -> np.ndarray:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--out", type=Path, required=True, help="the case folder to write (replaced)")
     ap.add_argument("--rate", type=float, default=1000.0, help="sample rate [Hz] (default 1000)")
     ap.add_argument("--noise", type=float, default=0.05, help="torque noise sigma [Nm] (default 0.05)")

@@ -1,7 +1,7 @@
 """Diagnosis on synthetic data with known, independently injected effects (tests/synthetic.py):
 it names the effect and joint, recovers the values, shrinks the held-out residual to the
 noise level, and claims nothing when there is nothing. Also the effect models' building blocks
-against oracles, the friction routine of the generated C, and the command line."""
+against oracles, and the command line (the friction routine of the generated C: test_terms.py)."""
 
 from __future__ import annotations
 
@@ -237,19 +237,6 @@ def test_gravity_matrix_against_pinocchio(name):
         assert np.allclose(G @ gvec, expected, atol=1e-10 * max(1.0, np.abs(expected).max()))
 
 
-def test_generated_friction_routine_against_numpy():
-    model = load(ROOT / "generated" / "lwr")
-    rng = np.random.default_rng(4)
-    f = np.column_stack([rng.uniform(0, 2, 7), rng.uniform(0, 1, 7), rng.uniform(0, 1, 7),
-                         [0.1, 0.0, 0.2, 0.05, 0.1, 0.3, 0.0], [0.01, 0.0, 0.02, 0.0, 0.05, 0.01, 0.0]])
-    for qd in rng.normal(0, 0.5, (20, 7)):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sgn = np.where(f[:, 4] > 0, np.tanh(qd / np.where(f[:, 4] > 0, f[:, 4], 1.0)), np.sign(qd))
-            stribeck = np.where(f[:, 3] > 0, f[:, 2] * np.exp(-(qd / np.where(f[:, 3] > 0, f[:, 3], 1.0)) ** 2), 0.0)
-        expected = (f[:, 0] + stribeck) * sgn + f[:, 1] * qd
-        assert np.allclose(model("friction", qd, f.ravel()), expected, rtol=1e-13, atol=1e-15)
-
-
 def test_diagnose_cli_writes_report_json_figures_and_model(lwr, tmp_path):
     model, robot, arm, p, trajectories = lwr
     paths = []
@@ -380,8 +367,8 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
     samples with numpy, cut by cut."""
     from types import SimpleNamespace
 
-    from dyngen.diagnosis import design as dz
-    from dyngen.diagnosis.run import Design
+    from dyngen.diagnosis import moments as dz
+    from dyngen.diagnosis.fit import Design
     from dyngen.diagnosis.selection import selection_mse
 
     rng = np.random.default_rng(4)

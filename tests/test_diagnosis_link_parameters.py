@@ -2,10 +2,10 @@
 predict another trajectory, and not where they are not (diagnosis/reidentify.py).
 
 With the opt-in Options(reidentify=True): the withheld "coefficients" case of
-bench/simulation/withheld_cases.py (the simulated LWR's link masses and inertias scaled by 10 %,
+tests/simulation/withheld_cases.py (the simulated LWR's link masses and inertias scaled by 10 %,
 signs per link) at 500 Hz with encoder positions, fit on one trajectory (selection on blocks of
 it), test on the other; `none`, `payload` and `coulomb` beside it, which must not claim it (the
-verdict, bench/simulation/withheld_verdict.py, refuses a false "link parameters off")."""
+verdict, tests/simulation/withheld_verdict.py, refuses a false "link parameters off")."""
 
 from __future__ import annotations
 

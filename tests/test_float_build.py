@@ -15,6 +15,7 @@ from oracles.random_params import random_parameters
 
 from dyngen.emission.selftest import TOLERANCE
 from dyngen.runtime import load
+from dyngen.terms import FRICTION_FIELDS
 
 TOL = TOLERANCE["float"]
 assert TOL == 2e-5  # the documented value
@@ -59,9 +60,9 @@ def test_float_build_agrees_with_double(built, tmp_path_factory):
             compare("regressor_gravity", q, *g)
             compare("regressor_inertia", q)
             compare("regressor", q, qd, qdd, *g)
-            # friction: per joint Fc, Fv, Fs, vs, eps (templates/friction.c.j2)
-            (f,) = float_inputs(np.column_stack([rng.uniform(0, 2, n), rng.uniform(0, 1, n), rng.uniform(0, 1, n),
-                                                 rng.uniform(0.01, 0.5, n), rng.uniform(1e-3, 0.05, n)]).ravel())
+            # friction: per joint its terms' fields (terms/friction.py): values and velocity scales
+            (f,) = float_inputs(np.column_stack([rng.uniform(0, 2, n) if field.kind == "value" else
+                                                 rng.uniform(1e-3, 0.5, n) for field in FRICTION_FIELDS]).ravel())
             compare("friction", qd, f)
     assert len(worst) == len(double.functions)  # every generated function was compared
     assert max(worst.values()) < TOL, {k: f"{v:.1e}" for k, v in worst.items()}

@@ -23,7 +23,7 @@ from dyngen.errors import InputError
 from dyngen.commands.excite import Sampling
 from dyngen.commands.excite import parser as excite_parser
 from dyngen.excitation.design import Settings
-from dyngen.extraction.options import Options
+from dyngen.description.extraction_options import Options
 from dyngen.identification.consistent import ConsistentOptions
 from dyngen.identification.options import Options as IdentifyOptions
 from dyngen.commands.diagnose import parser as diagnose_parser

@@ -1,5 +1,5 @@
 """A non-editable install (pip install .) must carry the templates and the static extractor
-driver: they are package data (generator/dyngen/templates/, generator/dyngen/extractor/), one
+driver: they are package data (generator/dyngen/templates/, generator/dyngen/extraction/driver_cpp/), one
 real place each, declared in pyproject's package-data."""
 
 import tomllib
@@ -21,7 +21,7 @@ def test_every_template_is_declared_as_package_data():
     globs = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["dyngen"]
     package = ROOT / "generator" / "dyngen"
     shipped = {p.resolve() for g in globs for p in package.glob(g)}  # setuptools' glob: * stays in one folder
-    templates = [p.resolve() for folder in ("templates", "extractor") for p in (package / folder).rglob("*")
+    templates = [p.resolve() for folder in ("templates", "extraction/driver_cpp") for p in (package / folder).rglob("*")
                  if p.is_file()]
     assert templates
     missing = [str(t) for t in templates if t not in shipped]

@@ -16,7 +16,7 @@ from conftest import ROOT
 from test_options import CHANGED
 
 from dyngen.extraction import driver
-from dyngen.extraction.options import Options
+from dyngen.description.extraction_options import Options
 from dyngen.extraction.problem import Problem, Stage
 from dyngen.extraction.protocol import RESULT, SCHEMA, problem_text, read_problem_text, read_result_text, result_text
 from dyngen.extraction.targets import Target

@@ -26,6 +26,7 @@ from pathlib import Path
 
 
 from dyngen.runtime import library_sources
+from dyngen.terms import FRICTION_FIELDS
 
 N_STATES = 100_000
 SANITIZE = ["-fsanitize=address,undefined,float-divide-by-zero,float-cast-overflow", "-fno-sanitize-recover=all",
@@ -107,17 +108,18 @@ static void parameters(long k, real *p)
     }
 }
 
-/* Friction parameters (Fc, Fv, Fs, vs, eps per joint, templates/friction.c.j2): up to 1e3, with
- * every 4th set using the plain sign and no Stribeck term (vs = eps = 0), and the next one
- * velocities of 1e-300 (their quotients overflow to infinity inside exp and tanh, which must
- * still give finite torques). */
+/* Friction parameters (per joint the friction terms' fields, terms/friction.py): values up to
+ * 1e3, velocity scales up to 10, with every 4th set using the plain sign and no Stribeck term
+ * (every velocity 0), and the next one velocities of 1e-300 (their quotients overflow to
+ * infinity inside exp and tanh, which must still give finite torques). */
+static const int velocity_field[%(per_joint)d] = { %(velocity_fields)s };
 static void friction_parameters(long k, real *f)
 {
-    for (int i = 0; i < 5 * %(dof)d; ++i) {
-        int field = i %% 5;
-        double v = field < 3 ? uniform(0, 1e3) : uniform(0, 10);
-        if (field >= 3 && k %% 4 == 1) v = 0;
-        if (field >= 3 && k %% 4 == 2) v = 1e-300;
+    for (int i = 0; i < %(per_joint)d * %(dof)d; ++i) {
+        int velocity = velocity_field[i %% %(per_joint)d];
+        double v = velocity ? uniform(0, 10) : uniform(0, 1e3);
+        if (velocity && k %% 4 == 1) v = 0;
+        if (velocity && k %% 4 == 2) v = 1e-300;
         f[i] = (real)v;
     }
 }
@@ -136,7 +138,7 @@ int main(int argc, char **argv)
     real *q = block(%(dof)d), *qd = block(%(dof)d), *qdd = block(%(dof)d);
     real *p = block(%(n_parameters)d), *s = block(%(n_parameters)d);
     real *gravity = block(%(n_gravity_alloc)d);
-    real *f = block(5 * %(dof)d);
+    real *f = block(%(per_joint)d * %(dof)d);
 %(outputs)s
     long calls = 0;
     int failed = 0;
@@ -185,6 +187,8 @@ def driver_source(manifest: dict, robot) -> str:
     calls = first + [c for c in calls if c not in first]
     return DRIVER % {
         "header": f"{prefix}.h", "real": f"{prefix}_real", "dof": n, "n_parameters": 10 * n,
+        "per_joint": len(FRICTION_FIELDS),
+        "velocity_fields": ", ".join("1" if field.kind == "velocity" else "0" for field in FRICTION_FIELDS),
         "n_gravity_alloc": max(n_gravity, 1), "lower": ", ".join(repr(float(lo)) for lo, _ in limits),
         "upper": ", ".join(repr(float(hi)) for _, hi in limits), "outputs": "\n".join(outputs),
         "calls": "\n".join(calls), "frees": "\n".join(frees)}

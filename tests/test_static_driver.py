@@ -1,4 +1,4 @@
-"""The extractor driver is one static program (generator/dyngen/extractor/): its protocol part is
+"""The extractor driver is one static program (generator/dyngen/extraction/driver_cpp/): its protocol part is
 current with the schema, it names no arm, and `dyngen extract` writes it as a standalone copy
 with the arm's build line; its behaviour is tested in test_extraction.py and test_protocol.py."""
 
@@ -9,7 +9,7 @@ from dyngen.extraction import driver, protocol
 
 def test_the_checked_in_protocol_header_is_rendered_from_the_schema():
     assert protocol.HEADER.read_text() == protocol.cpp_header(), \
-        "extractor/protocol.hpp is stale: run `python3 -m dyngen.extraction.protocol`"
+        "extraction/driver_cpp/protocol.hpp is stale: run `python3 -m dyngen.extraction.protocol`"
 
 
 def test_the_static_driver_names_no_arm():

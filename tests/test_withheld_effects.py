@@ -1,13 +1,13 @@
 """The diagnosis proven on data whose effects were withheld from it, recorded as arms record.
 
-Cases of bench/simulation/withheld_cases.py (the LWR in MuJoCo with effects the nominal model
+Cases of tests/simulation/withheld_cases.py (the LWR in MuJoCo with effects the nominal model
 lacks; TRACKED_CASES: a forward simulation under a controller, so friction sticks at
 reversals) are written at 200 Hz with positions as a 20-bit encoder gives them (1e-5 rad
 noise, quantised) and no qd or qdd columns, and diagnosed with default options: fit on one
-trajectory (selection on blocks of it), test on the other (bench/simulation/withheld_run.py).
+trajectory (selection on blocks of it), test on the other (tests/simulation/withheld_run.py).
 The verdict must name exactly the injected effects on their joints, recover their magnitudes
 within 20 % and leave a test RMS within 1.5 x what the perfect model leaves on the same
-conditioned data (bench/simulation/perfect.py); with no effect it must claim nothing. The checker
+conditioned data (tests/simulation/perfect.py); with no effect it must claim nothing. The checker
 is shown to fail on wrong truths, so the passing cases are not vacuous. The full table (three
 rates, both directions, the noise-free variant): bench/bench_withheld.py.
 """

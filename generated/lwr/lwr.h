@@ -166,7 +166,7 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
- *   qd [7], f [35] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */
+ *   qd [7], f [56] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */
 void lwr_friction(const lwr_real *qd, const lwr_real *f, lwr_real *tau);
 
 #ifdef __cplusplus

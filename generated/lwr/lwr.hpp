@@ -26,7 +26,7 @@
  *   RegressorGravity          7 x 12   Y_g(q): g = Y_g pi_gravity
  *   RegressorInertia         28 x 39   Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)
  *   Regressor                 7 x 43   Y(q, qd, qdd): tau = Y pi_full
- *   Friction                 35 x 1    friction values, 5 per joint: Fc, Fv, Fs, vs, eps
+ *   Friction                 56 x 1    friction values, 8 per joint: Fc, vc, Fv, Fs, vs, es, dFc, ed
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -54,7 +54,7 @@ using PiFullJacobian = Eigen::Matrix<Real, 43, 70, Eigen::RowMajor>;
 using RegressorGravity = Eigen::Matrix<Real, 7, 12, Eigen::RowMajor>;
 using RegressorInertia = Eigen::Matrix<Real, 28, 39, Eigen::RowMajor>;
 using Regressor = Eigen::Matrix<Real, 7, 43, Eigen::RowMajor>;
-using Friction = Eigen::Matrix<Real, 35, 1, Eigen::ColMajor>;
+using Friction = Eigen::Matrix<Real, 56, 1, Eigen::ColMajor>;
 
 namespace detail {
 
@@ -300,7 +300,7 @@ inline MassMatrix mass_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::Matri
     return M;
 }
 
-/* Joint friction (Coulomb, viscous, Stribeck), templates/friction.c.j2.
+/* Joint friction (Coulomb, viscous, Stribeck, direction), the terms of terms/friction.py.
  * lwr_friction(qd: Joints, f: Friction, tau: Joints written) */
 template <typename A0, typename A1, typename Out>
 inline void friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<A1> &f, const Eigen::MatrixBase<Out> &tau)

@@ -166,7 +166,7 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
- *   qd [6], f [30] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */
+ *   qd [6], f [48] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */
 void stanford_friction(const stanford_real *qd, const stanford_real *f, stanford_real *tau);
 
 #ifdef __cplusplus

@@ -26,7 +26,7 @@
  *   RegressorGravity          6 x 9    Y_g(q): g = Y_g pi_gravity
  *   RegressorInertia         21 x 31   Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)
  *   Regressor                 6 x 33   Y(q, qd, qdd): tau = Y pi_full
- *   Friction                 30 x 1    friction values, 5 per joint: Fc, Fv, Fs, vs, eps
+ *   Friction                 48 x 1    friction values, 8 per joint: Fc, vc, Fv, Fs, vs, es, dFc, ed
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -54,7 +54,7 @@ using PiFullJacobian = Eigen::Matrix<Real, 33, 60, Eigen::RowMajor>;
 using RegressorGravity = Eigen::Matrix<Real, 6, 9, Eigen::RowMajor>;
 using RegressorInertia = Eigen::Matrix<Real, 21, 31, Eigen::RowMajor>;
 using Regressor = Eigen::Matrix<Real, 6, 33, Eigen::RowMajor>;
-using Friction = Eigen::Matrix<Real, 30, 1, Eigen::ColMajor>;
+using Friction = Eigen::Matrix<Real, 48, 1, Eigen::ColMajor>;
 
 namespace detail {
 
@@ -300,7 +300,7 @@ inline MassMatrix mass_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::Matri
     return M;
 }
 
-/* Joint friction (Coulomb, viscous, Stribeck), templates/friction.c.j2.
+/* Joint friction (Coulomb, viscous, Stribeck, direction), the terms of terms/friction.py.
  * stanford_friction(qd: Joints, f: Friction, tau: Joints written) */
 template <typename A0, typename A1, typename Out>
 inline void friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<A1> &f, const Eigen::MatrixBase<Out> &tau)

@@ -35,13 +35,13 @@ static const double p_data[STANFORD_N_PARAMETERS] = {
     0.51, 0.0, 0.0, 1.554, 0.013, 0.0, 0.0, 0.013, 0.0, 0.0003
 };
 /* Friction values f: Fc, Fv, Fs, vs, eps per joint. */
-static const double f_data[5 * STANFORD_DOF] = {
-    0.5, 0.2, 0.3, 0.1, 0.02,
-    0.75, 0.25, 0.3, 0.1, 0.0,
-    1.0, 0.30000000000000004, 0.3, 0.0, 0.02,
-    1.25, 0.35000000000000003, 0.3, 0.1, 0.0,
-    1.5, 0.4, 0.3, 0.1, 0.02,
-    1.75, 0.45, 0.3, 0.0, 0.0
+static const double f_data[8 * STANFORD_DOF] = {
+    0.5, 0.04, 0.3, 0.19999999999999996, 0.1, 0.0, -0.10000000000000009, 0.16,
+    0.75, 0.0, 0.55, 0.44999999999999996, 0.0, 0.12, 0.1499999999999999, 0.0,
+    1.0, 0.04, 0.8, 0.7, 0.1, 0.12, 0.3999999999999999, 0.16,
+    1.25, 0.04, 1.05, 0.95, 0.1, 0.0, 0.6499999999999999, 0.16,
+    1.5, 0.0, 1.3, 1.2, 0.0, 0.12, 0.8999999999999999, 0.0,
+    1.75, 0.04, 1.55, 1.45, 0.1, 0.12, 1.15, 0.16
 };
 static const double q_data[N_STATES][STANFORD_DOF] = {
     { -1.25, 0.5, -0.5, 1.25, 0.25, -0.75 },
@@ -557,13 +557,13 @@ static const double mass_matrix_expected[N_STATES][36] = {
       0.00011859995490917289, 0.0002524412954423689, 0.0, 0.0001620906917604419, 0.0, 0.0003 },
 };
 static const double friction_expected[N_STATES][6] = {
-    { -0.7, 0.8130791362408684, -1.225, 1.4250000000041665, -1.7000000000041664, 2.0875 },
-    { -0.6000000000041664, 0.9375, -1.0749999999722242, 1.6, 0.0, -2.2 },
-    { 0.0, -1.0, 1.0749999999722242, -1.5125, 1.7000000000041664, -1.975 },
+    { -0.8999992546721433, 1.0374999999999999, -1.200067848833379, 2.422495244916148, -1.25, 4.062304934604035 },
+    { -0.7496146530562242, 1.3125, -0.8349727853927866, 2.9499951553689305, 0.0, -2.150008571270354 },
+    { 0.0, -1.1500000000000001, 1.5676324207277963, -1.3876102543542406, 3.05, -1.3794314896971733 },
 };
 
 /* Work arrays: static rather than on the stack, for small firmware stacks. */
-static stanford_real p[STANFORD_N_PARAMETERS], f[5 * STANFORD_DOF];
+static stanford_real p[STANFORD_N_PARAMETERS], f[8 * STANFORD_DOF];
 static stanford_real q[STANFORD_DOF], qd[STANFORD_DOF], qdd[STANFORD_DOF];
 static stanford_real standard_from_dynamic_out[60];
 static stanford_real pi_gravity_out[9];
@@ -634,7 +634,7 @@ int main(void)
 {
     int failures = 0, checks = 0;
     load(p_data, p, STANFORD_N_PARAMETERS);
-    load(f_data, f, 5 * STANFORD_DOF);
+    load(f_data, f, 8 * STANFORD_DOF);
     stanford_standard_from_dynamic(p, standard_from_dynamic_out);
     failures += !compare("standard_from_dynamic", 0, standard_from_dynamic_out, standard_from_dynamic_expected, 60);
     ++checks;

@@ -16,12 +16,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .parameters import PER_LINK
+from .terms.friction import FRICTION_NAMES
 
 KINDS = ("gravity", "inertia", "full")
 KIND_LABELS = {"gravity": "gravity vector g(q) = Y_g(q) pi_gravity",
                "inertia": "stacked inertia matrix m~(q) = Y_m(q) pi_inertia",
                "full": "inverse dynamics tau = Y(q, qd, qdd) pi_full"}
-FRICTION_PER_JOINT = 5  # Fc, Fv, Fs, vs, eps (templates/friction.c.j2)
+FRICTION_PER_JOINT = len(FRICTION_NAMES)  # the friction terms' fields (terms/friction.py)
 
 
 @dataclass(frozen=True)
@@ -38,7 +39,7 @@ ARGUMENTS = {
     "p": Argument(("parameters",), "dynamic parameters, 10 per link", "Parameters"),
     "s": Argument(("parameters",), "standard parameters, 10 per link (docs/conventions.md)", "Parameters"),
     "gravity": Argument(("gravity_symbols",), "gravity symbols", "GravitySymbols"),  # only when gravity has symbols
-    "f": Argument(("friction",), "per joint Fc, Fv, Fs, vs, eps", "Friction"),
+    "f": Argument(("friction",), "per joint " + ", ".join(FRICTION_NAMES), "Friction"),
 }
 
 
@@ -124,7 +125,7 @@ MASS_MATRIX = Function(
 FRICTION = Function(
     "friction", "friction", "template", ("qd", "f"),
     Output("tau", ("dof",), "friction torques", "Joints"),
-    "Joint friction (Coulomb, viscous, Stribeck), templates/friction.c.j2.", Check())
+    "Joint friction (Coulomb, viscous, Stribeck, direction), the terms of terms/friction.py.", Check())
 
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,

@@ -14,25 +14,11 @@ from ..progress import Progress
 
 
 def forward_flange(robot):
-    """q (T, N) -> flange position (T, 3) in the base frame, from the DH table (numeric)."""
-    from ..export.frames import placements
+    """q (T, N) -> flange position (T, 3) in the base frame: the last link frame's origin (the
+    joint model's forward kinematics, description/joint_model.py)."""
+    from ..description.joint_model import forward_kinematics
 
-    places = placements(robot)
-
-    def flange(q):
-        q = np.atleast_2d(np.asarray(q, dtype=float))
-        T = np.broadcast_to(np.eye(4), (q.shape[0], 4, 4)).copy()
-        for i, (joint, place) in enumerate(zip(robot.joints, places)):
-            J = np.broadcast_to(np.eye(4), T.shape).copy()
-            if joint.revolute:
-                c, s = np.cos(q[:, i]), np.sin(q[:, i])
-                J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1] = c, -s, s, c
-            else:
-                J[:, 2, 3] = q[:, i]
-            T = T @ place.origin @ J
-        return (T @ places[-1].post)[:, :3, 3]
-
-    return flange
+    return lambda q: forward_kinematics(robot.joint_models, q)[-1].origin
 
 
 def csv_text(t, q, qd, qdd) -> str:

@@ -12,7 +12,7 @@ from . import generate
 
 
 def _extract_options(parser: argparse.ArgumentParser) -> None:
-    from ..extraction.options import Options
+    from ..description.extraction_options import Options
     from ..options import add_arguments
 
     group = parser.add_argument_group("extraction (defaults: the YAML's `extraction:` block, then these)")
@@ -24,7 +24,7 @@ def _extract_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _options_from(args, robot):
-    from ..extraction.options import Options
+    from ..description.extraction_options import Options
     from ..options import resolve
 
     return resolve(Options, args, robot.extraction)

@@ -45,7 +45,7 @@ def parser(prog="dyngen identify") -> argparse.ArgumentParser:
 
 def main(argv, prog="dyngen identify") -> int:
     args = parser(prog).parse_args(argv)
-    from ..identification.consistent_cli import run_consistent
+    from .identify_consistent import run_consistent
     from ..identification.options import Options
 
     options = resolve(Options, args, {})

@@ -13,7 +13,7 @@ from pathlib import Path
 import sympy as sp
 
 from ..errors import InputError, printable
-from ..extraction.options import Options as ExtractionOptions
+from .extraction_options import Options as ExtractionOptions
 from ..options import check_yaml, yaml_keys
 from ..parameters import dynamic_symbols, standard_symbols
 from ..untrusted import read_yaml

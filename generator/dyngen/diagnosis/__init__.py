@@ -1,14 +1,26 @@
 """Diagnosis of the sim-to-real gap: where the residual tau_measured - tau_model lies, which
 unmodelled effect explains it (chosen on held-out data), and how far it shrinks.
 
-    result = diagnose(robot, model, p, fit_signals, holdout_signals)
-    write_outputs(result, robot, out_dir)   # report.md, diagnosis.json, figures, updated model
+    result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
+    write_outputs(result, robot, p, out_dir, sources, sign_velocity)   # outputs.py
 
-Modules: effects/ (the library of candidate effects), design (moments of every candidate),
-selection (forward selection on held-out data), phases (where), run (the whole diagnosis),
-report (markdown, JSON), figures (PNG), model (the updated model).
+The stages, in order (pipeline.py runs them):
+
+    0. roles.py      recordings cut into fit, selection and test samples; the nominal residual
+    1. fit.py        the moments of every candidate (moments.py) from the library of effects
+                     (effects/: each a torque term of dyngen.terms with the diagnosis's rules)
+    2. selection.py  forward selection on the selection data
+    3. settle.py     nonlinear settings refined (refine.py), insignificant effects pruned,
+                     implausible ones refused
+    4. choose.py     per joint: effects, the simple model (baseline.py), both, or re-identified
+                     link parameters (joints.py, reidentify.py)
+    5. judge.py      the figures on the judged data, per phase of the motion (phases.py)
+    6. findings.py   the findings, notes.py the warnings, record.py the result (Diagnosis);
+                     report.py, figures.py and model.py write them (outputs.py)
 """
 
-from .run import Diagnosis, Options, diagnose
+from .options import Options
+from .pipeline import diagnose
+from .record import Diagnosis
 
 __all__ = ["Diagnosis", "Options", "diagnose"]

@@ -5,7 +5,7 @@
 (offset, Coulomb and viscous friction: three numbers per joint) fitted by least squares to the
 nominal model's residual on the fit samples. Its columns go through the recording's filter
 like the torques. A diagnosis that does worse than this on a joint has not explained that
-joint; run.py then keeps the simple model there.
+joint; the pipeline then keeps the simple model there (joints.py).
 """
 
 from __future__ import annotations
@@ -14,7 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-VELOCITY = 0.02  # rad/s: the simple model's tanh scale (fixed, not fitted)
+from ..terms.friction import SIMPLE_SCALE, coulomb
+
+VELOCITY = SIMPLE_SCALE  # rad/s: the simple model's tanh scale (fixed, not fitted)
 NAMES = ("b", "Fc", "Fv")
 
 
@@ -32,7 +34,7 @@ def columns(signals) -> np.ndarray:
     if hit is not None and hit[0] is signals:
         return hit[1]
     qd = signals.qd
-    out = np.stack([np.ones_like(qd), signals.filtered(np.tanh(qd / VELOCITY)), qd], axis=-1)
+    out = np.stack([np.ones_like(qd), signals.filtered(coulomb(qd, VELOCITY)), qd], axis=-1)
     if len(_CACHE) > 16:  # recordings of earlier diagnoses
         _CACHE.clear()
     _CACHE[id(signals)] = (signals, out)

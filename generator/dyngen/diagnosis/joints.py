@@ -31,7 +31,7 @@ by 0-1.5 % on the fit trajectory, depending on the selection blocks, and only ex
 differently to a faster one.
 
 With selection on blocks of the fit data, the errors are summed over the three cuts
-(run._decide_on_folds), so every fit sample is judged once and the sums are far less noisy
+(choose.on_folds), so every fit sample is judged once and the sums are far less noisy
 than one selection set's: there an extra value must gain FOLDS_PER_VALUE (2 %) instead. Values
 that fit noise change a held-out error by about 2 sqrt(k) / N_eff of it (N_eff: independent
 samples, a few hundred in 25 s at 200 Hz), so 2 % per value is still several times that.
@@ -42,7 +42,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import baseline
-from . import design as dz
+from . import moments as dz
 
 EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple", "consistent parameters"
 TIED = "simple (effects not shown better)"  # the simple model predicts; the effects stay findings

@@ -14,16 +14,20 @@ from __future__ import annotations
 import numpy as np
 
 from ..parameters import PER_LINK, dynamic_from_standard, standard_from_dynamic
+from ..terms.friction import FRICTION_NAMES
 from .effects import effect_class
 from .joints import COMPLETED, SIMPLE, TIED
 
-FRICTION_FIELDS = ("Fc", "Fv", "Fs", "vs", "eps")  # templates/friction.c.j2
+FRICTION_FIELDS = FRICTION_NAMES  # the emitted <robot>_friction's vector, per joint
 
 
 def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
-    """f (5N) for <robot>_friction: Fc, Fv, Fs, vs, eps per joint (each effect's friction_terms)."""
+    """f for <robot>_friction, FRICTION_FIELDS per joint (each effect's friction_terms): the laws
+    as fitted, each term's velocity scales included (Stribeck's and direction's signs are smoothed
+    with sign_velocity, as in the diagnosis's columns: Context.sign)."""
     f = np.zeros((diagnosis.joints, len(FRICTION_FIELDS)))
-    f[:, 4] = sign_velocity
+    for name in ("vc", "es", "ed"):
+        f[:, FRICTION_FIELDS.index(name)] = sign_velocity
     for e in diagnosis.selected:
         for name, value in effect_class(e["effect"]).friction_terms(e["values"], e["variant"]).items():
             f[e["joints"][0] - 1, FRICTION_FIELDS.index(name)] = value

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..options import option
+from ..terms.friction import SIGN_SCALE
 from .effects import DEFAULT_NAMES, NAMES
 from .selection import ALPHA, MIN_GAIN
 
@@ -18,7 +19,7 @@ class Options:
     min_gain: float = option(MIN_GAIN, "least selection gain to select an effect, as a share of a joint's mean "
                              "square", metavar="G", bounds=(0.0, 1.0))
     alpha: float = ALPHA  # significance level of the selection and the pruning (selection.py)
-    sign_velocity: float = option(0.002, "sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V), "
+    sign_velocity: float = option(SIGN_SCALE, "sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V), "
                                   "V in rad/s (Coulomb's own scale is fitted)", metavar="V", bounds=(0.0, 1e3),
                                   above=True)
     block_seconds: float = 2.0  # without selection recordings: blocks of this length, each third selects in turn

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from . import design as dz
+from . import moments as dz
 from .selection import solve
 
 REFINE_TOLERANCE = 1e-3  # relative (fixed point)

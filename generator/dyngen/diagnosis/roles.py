@@ -68,7 +68,7 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
     return out, split
 
 
-FOLDS = 3  # every third block selects; the per-joint models are compared over all three (run.py)
+FOLDS = 3  # every third block selects; the per-joint models are compared over all three (choose.py)
 
 
 def blocks(sig, block_seconds: float, phase: int = FOLDS - 1) -> tuple[np.ndarray, np.ndarray]:

@@ -23,7 +23,7 @@ An effect that only adds to another on its joint (Effect.extends: Stribeck's sta
 above the Coulomb level) is tried once that one is selected, and goes when it goes.
 
 Then prune() drops, one by one, selected effects that no longer pay their way with all the
-others in (settings refined, run.py): first those whose selection gain has fallen below the
+others in (settings refined, settle.py): first those whose selection gain has fallen below the
 price they paid to enter, then those whose values are not significant once the deviations are
 scaled for the correlation in time of the residual they leave.
 

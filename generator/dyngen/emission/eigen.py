@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..catalogue import ARGUMENTS, FUNCTIONS
+from ..catalogue import ARGUMENTS, FRICTION_PER_JOINT, FUNCTIONS
+from ..terms.friction import FRICTION_NAMES
 
 TYPE_DOCS = {
     "Joints": "one entry per joint: q, qd, qdd, tau, g",
@@ -19,7 +20,7 @@ TYPE_DOCS = {
     "RegressorGravity": "Y_g(q): g = Y_g pi_gravity",
     "RegressorInertia": "Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)",
     "Regressor": "Y(q, qd, qdd): tau = Y pi_full",
-    "Friction": "friction values, 5 per joint: Fc, Fv, Fs, vs, eps",
+    "Friction": f"friction values, {FRICTION_PER_JOINT} per joint: " + ", ".join(FRICTION_NAMES),
 }
 
 

@@ -14,6 +14,7 @@ from ..catalogue import FRICTION_PER_JOINT, KIND_LABELS, KINDS
 from ..derivation.models import base_regressor_outputs, coefficient_jacobian_model, coefficient_model
 from ..parameters import PER_LINK, dynamic_name, standard_name
 from ..reduction.identifiability import classify
+from ..terms.friction import c_terms
 from .c_code import CFunction, render_function
 from .coefficients import dynamic_names_text, grouped_text
 from .eigen import eigen_interface
@@ -28,6 +29,14 @@ class Emitted:
     files: dict  # file name -> text
     functions: list  # CFunction
     manifest: dict
+
+
+def _friction_c_names(P: str):
+    """The C names the friction terms' expressions use (defined in templates/friction.c.j2)."""
+    from types import SimpleNamespace
+
+    M = P.upper()
+    return SimpleNamespace(sgn=f"{M}_SGN", exp=f"{M}_EXP", abs=f"{M}_ABS", zero=f"{M}_K(0)")
 
 
 def environment() -> jinja2.Environment:
@@ -69,7 +78,8 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
     for filename, (summary, fns) in sources.items():
         files[filename] = env.get_template("source.c.j2").render(filename=filename, summary=summary,
                                                                   functions=fns, **common)
-    files[f"{P}_friction.c"] = env.get_template("friction.c.j2").render(**common)
+    files[f"{P}_friction.c"] = env.get_template("friction.c.j2").render(
+        friction_terms=c_terms(_friction_c_names(P)), **common)
     files[f"{P}_kinds.h"] = env.get_template("kinds.h.j2").render(
         standard_from_dynamic=catalogue.STANDARD_FROM_DYNAMIC.name,
         kinds=[{"name": kind, "pi": catalogue.COEFFICIENTS[kind].name, "jacobian": catalogue.JACOBIANS[kind].name}

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import mpmath
 
-from ..catalogue import BY_NAME, FRICTION_PER_JOINT, FUNCTIONS
+from ..catalogue import BY_NAME, FUNCTIONS
+from ..terms.friction import FRICTION_FIELDS, friction_torque
 from ..derivation.evaluate import evaluate
 from ..parameters import PER_LINK
 
@@ -29,7 +30,7 @@ TOLERANCE = {"double": 1e-9, "float": 2e-5}
 class SelfTestData:
     p: list  # dynamic parameters
     gravity: list  # values of the gravity symbols (empty when gravity is numeric)
-    f: list  # friction values, 5 per joint
+    f: list  # friction values per joint (terms/friction.py FRICTION_FIELDS)
     states: list  # [(q, qd, qdd)]
     once: dict  # function name -> expected output, for the functions of p alone
     per_state: dict  # function name -> [expected output per state]
@@ -66,25 +67,23 @@ def fixed_states(robot) -> list[tuple[list, list, list]]:
 
 
 def fixed_friction(dof: int) -> list[float]:
-    """Fc, Fv, Fs, vs, eps per joint; every other joint with the plain sign (eps = 0), every
-    third without the Stribeck term (vs = 0), so both branches of the C are run."""
+    """Every joint's friction fields (terms/friction.py): values 0.5 + 0.25 j and the like;
+    velocity scales 0.02 to 0.3, every other one <= 0 in turn on the joints (the plain sign, no
+    Stribeck term), so every branch of the C is run."""
     f = []
     for j in range(dof):
-        f += [0.5 + 0.25 * j, 0.2 + 0.05 * j, 0.3, 0.0 if j % 3 == 2 else 0.1, 0.0 if j % 2 else 0.02]
+        for k, field in enumerate(FRICTION_FIELDS):
+            if field.kind == "value":
+                f.append(0.5 + 0.25 * j - 0.1 * k)
+            else:
+                f.append(0.0 if (j + k) % 3 == 2 else 0.02 * (k + 1))
     return f
 
 
 def friction_torques(qd, f) -> list[float]:
-    """The friction law of templates/friction.c.j2, in 40-digit arithmetic."""
-    out = []
+    """The friction terms' laws (terms/friction.py) in 40-digit arithmetic."""
     with mpmath.workdps(40):
-        for j, v in enumerate(qd):
-            Fc, Fv, Fs, vs, eps = (mpmath.mpf(x) for x in f[FRICTION_PER_JOINT * j: FRICTION_PER_JOINT * (j + 1)])
-            v = mpmath.mpf(v)
-            sgn = mpmath.tanh(v / eps) if eps > 0 else mpmath.sign(v)
-            level = Fc + (Fs * mpmath.exp(-(v / vs) ** 2) if vs > 0 else 0)
-            out.append(float(level * sgn + Fv * v))
-    return out
+        return [float(x) for x in friction_torque(mpmath, [mpmath.mpf(v) for v in qd], [mpmath.mpf(x) for x in f])]
 
 
 def selftest_data(robot, programs: dict) -> SelfTestData:

@@ -14,9 +14,11 @@ then checked again on the written samples), and the whole motion shrinks further
 would leave the optional workspace box. The optimiser therefore sees only feasible trajectories;
 motion at the limits is what excites best, so the scaling is where the optimum lies anyway.
 
-Criterion: log cond(A), A = [Y(q, qd, qdd), friction and offset columns] on `points` samples of
-one period, the matrix that `dyngen identify --consistent` fits (columns as they are, as in
-Swevers 1997 and Gaz 2019; the condition with unit-norm columns is reported too). Minimised by
+Criterion: log cond(A), A = [Y(q, qd, qdd), per joint Coulomb, viscous, offset and (where the
+rigid body does not carry it) rotor-inertia columns] on `points` samples of one period: the
+columns of the terms (terms/) that `dyngen identify` fits by default, as they are (Swevers 1997,
+Gaz 2019; the condition with unit-norm columns is reported too), with a fixed Coulomb scale
+(terms.friction.EXCITATION_SCALE) where identify searches one per joint, unfiltered and unlagged. Minimised by
 L-BFGS-B (finite differences) from the best of `candidates` random starts; all draws come from
 `seed`, so the design is deterministic.
 """
@@ -30,6 +32,9 @@ from scipy.optimize import minimize
 
 from ..errors import InputError
 from ..options import option
+from ..terms import Armature, Coulomb, Offset, RigidBody, Viscous
+from ..terms.body import armature_identifiable
+from ..terms.friction import EXCITATION_SCALE
 from ..validation.excitation import FourierTrajectory
 
 GRID_PER_HARMONIC = 200  # samples per period of the highest harmonic for the peaks
@@ -47,7 +52,7 @@ class Settings:
     points: int = 200  # samples of one period in the criterion
     candidates: int = 16  # random starts; the best is refined
     max_iterations: int = option(60, "optimiser (L-BFGS-B) iterations", flag="--iterations", metavar="N", bounds=(1, 100_000))
-    coulomb_velocity: float = 0.01  # rad/s, tanh smoothing of the Coulomb column
+    coulomb_velocity: float = EXCITATION_SCALE  # rad/s, the Coulomb column's scale
     workspace: tuple | None = None  # (xmin, xmax, ymin, ymax, zmin, zmax) of the flange [m]
     criterion: str = option("cond", "cond: minimise the condition number; logdet: maximise log det A^T A "
                             "(columns unit norm)", choices=("cond", "logdet"))
@@ -156,24 +161,21 @@ def _inside(points, box) -> np.ndarray:
     return np.all((points >= box[:, 0]) & (points <= box[:, 1]), axis=1)
 
 
-def identifiable_armature(model, dof: int) -> list:
-    from ..identification.consistent import identifiable_armature as check
-
-    return check(model, dof)
-
-
-def identification_matrix(model, q, qd, qdd, coulomb_velocity=0.01, armature=None) -> np.ndarray:
-    """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major."""
+def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, armature=None) -> np.ndarray:
+    """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major:
+    the terms' columns (terms/), each on its own joint's rows."""
     T, n = q.shape
-    Y = model.batch("regressor", q, qd, qdd).reshape(T * n, -1)
+    Y = RigidBody.columns(model, q, qd, qdd).reshape(T * n, -1)
+    per_joint = {"coulomb": lambda j: Coulomb.columns(qd[:, j], coulomb_velocity)[:, 0],
+                 "viscous": lambda j: Viscous.columns(qd[:, j])[:, 0], "offset": lambda j: Offset.columns((T,))[:, 0],
+                 "armature": lambda j: Armature.columns(qdd[:, j])[:, 0]}
     cols = []
     for j in range(n):
-        for kind in ("coulomb", "viscous", "offset", "armature"):
+        for kind, column in per_joint.items():
             if kind == "armature" and not (armature and armature[j]):
                 continue
             col = np.zeros((T, n))
-            col[:, j] = {"coulomb": lambda: np.tanh(qd[:, j] / coulomb_velocity), "viscous": lambda: qd[:, j],
-                         "offset": lambda: np.ones(T), "armature": lambda: qdd[:, j]}[kind]()
+            col[:, j] = column(j)
             cols.append(col.reshape(-1))
     return np.hstack([Y, np.column_stack(cols)])
 
@@ -197,7 +199,7 @@ def optimise(robot, model, settings: Settings | None = None, flange=None) -> Des
     start = time.perf_counter()
     limits = limits_of(robot)
     shape = _Shape(limits, settings, flange)
-    armature = identifiable_armature(model, robot.dof)
+    armature = armature_identifiable(model, robot.dof)
     times = np.arange(settings.points) * settings.period / settings.points
     evaluations = 0
 

@@ -1,4 +1,4 @@
-"""Build the static NLopt driver (extractor/driver.cpp) for one arm and run it on a problem file."""
+"""Build the static NLopt driver (driver_cpp/driver.cpp) for one arm and run it on a problem file."""
 
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ def eigen_include() -> str:
         raise DriverError("Eigen 3 not found: run scripts/setup.sh (apt package libeigen3-dev)") from None
 
 
-DRIVER = Path(__file__).resolve().parents[1] / "extractor"  # the static driver's sources (package data)
+DRIVER = Path(__file__).resolve().parent / "driver_cpp"  # the static driver's sources (package data)
 CORE_SOURCES = ("driver.cpp", "protocol.hpp", "robot.h")
 
 

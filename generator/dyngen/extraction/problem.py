@@ -14,9 +14,9 @@ import sympy as sp
 from scipy.optimize import linprog
 
 from ..description.expressions import ExpressionError, parse_expression, shorten
+from ..description.extraction_options import Options  # noqa: F401  (re-exported: the problem is built from them)
 from ..errors import Infeasible, InputError
 from ..parameters import PER_LINK, dynamic_name, dynamic_symbols
-from .options import Options  # noqa: F401  (re-exported: the problem is built from them)
 from .targets import Target
 
 
@@ -176,3 +176,10 @@ def is_consistent(p: np.ndarray, margin: float = 0.0) -> np.ndarray:
 
 def consistency_margin(link10) -> float:
     return inertia_margin(link10[4:10])
+
+
+def pinned(problem, p, rel: float = 1e-6) -> list:
+    """Names of the parameters at (within rel of the range from) one of their bounds."""
+    span = np.maximum(problem.upper - problem.lower, 1e-300)
+    at = (np.abs(p - problem.lower) < rel * span) | (np.abs(problem.upper - p) < rel * span)
+    return [dynamic_name(j // PER_LINK + 1, j % PER_LINK) for j in np.flatnonzero(at)]

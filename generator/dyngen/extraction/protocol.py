@@ -2,9 +2,9 @@
 
 One line per field, `key value...`, in the order of SCHEMA. The Python writer (`problem_text`)
 and reader (`read_problem_text`) below and the C++ reader, writer and the members of the
-driver's Problem (generator/dyngen/extractor/protocol.hpp, rendered from SCHEMA by `cpp_header`
+driver's Problem (generator/dyngen/extraction/driver_cpp/protocol.hpp, rendered from SCHEMA by `cpp_header`
 through templates/protocol.hpp.j2) all follow it, so an option is added by one line here (and
-its field in extraction/options.py), then `python3 -m dyngen.extraction.protocol`.
+its field in description/extraction_options.py), then `python3 -m dyngen.extraction.protocol`.
 
 The result file the driver writes back follows RESULT the same way: the C++ Result, its writer
 and reader (`--echo-result`) are rendered into protocol.hpp, the Python reader
@@ -47,7 +47,7 @@ class Field:
 
 
 def _opt(name, kind, cpp=""):
-    """An extraction option (extraction/options.py) the driver reads."""
+    """An extraction option (description/extraction_options.py) the driver reads."""
     return Field(name, kind, lambda problem, stage, options: getattr(options, name), cpp)
 
 
@@ -271,7 +271,7 @@ def read_result_text(text: str) -> dict:
 
 
 def cpp_header() -> str:
-    """protocol.hpp of the static driver (generator/dyngen/extractor/), rendered from SCHEMA."""
+    """protocol.hpp of the static driver (generator/dyngen/extraction/driver_cpp/), rendered from SCHEMA."""
     from ..emission.render import environment
 
     return environment().get_template("protocol.hpp.j2").render(
@@ -280,7 +280,7 @@ def cpp_header() -> str:
         protocol_magic=MAGIC, result_magic=RESULT_MAGIC, protocol_version=VERSION)
 
 
-HEADER = Path(__file__).resolve().parents[1] / "extractor" / "protocol.hpp"
+HEADER = Path(__file__).resolve().parent / "driver_cpp" / "protocol.hpp"
 
 if __name__ == "__main__":  # rewrite the checked-in header after a schema change
     HEADER.write_text(cpp_header())

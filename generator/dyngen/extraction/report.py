@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..parameters import PER_LINK
-from .problem import consistency_margin
+from .problem import consistency_margin, pinned
 
 
 def links_yaml(p) -> str:
@@ -26,8 +26,6 @@ def unreachable(robot, extraction, threshold: float = UNREACHABLE, top: int = 6)
     the identified coefficients: the relative residual of a kind above `threshold`, the coefficients
     missed most (target and the closest consistent value) and the parameters pinned at a bound.
     "N/N restarts consistent" alone is not a success."""
-    from ..identification.consistent import pinned
-
     lines = []
     for kind, r in (extraction.stages[-1].residuals or {}).items():
         t = extraction.targets[kind]

@@ -6,11 +6,12 @@
     result = identify_consistent(robot, model, folder, signals)   # physically consistent, with friction
 
 Modules: consistent (weighted least squares over consistent link parameters, friction, offsets and
-rotor inertia through the extraction's solver: the order of work), columns (friction, ripple and
-tilt columns per recording), normal (normal equations per part and joint), solver (the consistent
-fit of normal equations by the extraction's driver), selection (lambda and the optional parts on
-held-out data), statistics (sandwich standard deviations), tilt (a tilted base as a rotation),
-consistent_cli and consistent_output (the command); samples (stacked regressors and
+rotor inertia through the extraction's solver: the order of work), columns (the terms' columns per
+recording: friction, ripple, tilt, terms/), normal (normal equations per part and joint), solver (the consistent
+fit of normal equations by the extraction's driver), held_out (lambda and the optional parts on
+held-out data), statistics (sandwich standard deviations), options (identify's and the consistent
+identification's options), consistent_output (the result, its YAML and tables; the command:
+commands/identify_consistent.py); samples (stacked regressors and
 measurements from recordings), least_squares (the fit, condition number, standard deviations,
 unexcited coefficients), output (YAML, table).
 """

@@ -1,20 +1,20 @@
 """The identification's columns beside the rigid body's base regressor, per recording.
 
-Per joint j (its rows only):
+Per joint j (its rows only), each a term of terms/ (TERM_OF):
   coulomb      tanh(qd_j(t - lag_j) / vs_j)   Coulomb friction, smoothed, following the velocity
                with a lag; a switching signal, so it is passed through the recording's own
                low-pass, like the torque it explains (a filtered friction step is compared with
-               a filtered step, not a sharp one; as the diagnosis does, diagnosis/design.py)
+               a filtered step, not a sharp one; as the diagnosis does, diagnosis/moments.py)
   viscous      qd_j
   offset       1
   armature     qdd_j (rotor inertia, where the rigid body does not carry it already)
   ripple_cos   cos q_j   }  a first harmonic of position (cables, gear ripple):
   ripple_sin   sin q_j   }  the optional group "ripple"
 and for the arm, the optional group "tilt": ("tilt", 0) and ("tilt", 1), the torques of a
-horizontal gravity component (identification/tilt.py), in every joint's rows.
+gravity component across it (terms/tilt.py: the diagnosis's tilt), in every joint's rows.
 The smooth columns are functions of the filtered motion, filtered already.
 
-A label is (kind, j): j the joint (0-based), or for the tilt the direction (0, 1).
+A label is (kind, j): j the joint (0-based), or for the tilt the direction (0, 1: u1, u2).
 """
 
 from __future__ import annotations
@@ -24,9 +24,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from .. import terms
+from ..terms.friction import coulomb
+
 PER_JOINT = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
+TERM_OF = {"coulomb": terms.Coulomb, "viscous": terms.Viscous, "offset": terms.Offset, "armature": terms.Armature,
+           "ripple_cos": terms.Ripple, "ripple_sin": terms.Ripple}  # each kind's term (terms/)
 GROUPS = {"ripple": ("ripple_cos", "ripple_sin"), "tilt": ("tilt",)}  # optional groups and their kinds
-BOUNDED = ("coulomb", "viscous", "armature")  # kinds whose value is held >= 0 (see consistent.py)
+# kinds whose value is held >= 0 (see consistent.py): the terms whose range is the positive values
+BOUNDED = tuple(k for k in PER_JOINT if TERM_OF[k].values[0].low == 0.0)
 
 
 def kinds_of(names) -> tuple:
@@ -45,7 +51,7 @@ def group_of(label) -> str | None:
 
 def name_of(label) -> str:
     kind, j = label
-    return f"tilt dg_{'xy'[j]}" if kind == "tilt" else f"{kind} j{j + 1}"
+    return f"tilt dg{j + 1}" if kind == "tilt" else f"{kind} j{j + 1}"  # dg1, dg2: along u1, u2 (terms/tilt.py)
 
 
 def lagged(t, x, lag: float) -> np.ndarray:
@@ -75,7 +81,7 @@ def coulomb_matrix(signals, smoothing, lags) -> np.ndarray:
     """(T, N): tanh(qd_j(t - lag_j) / vs_j), through the recording's filter."""
     qd = signals.qd
     lags = np.zeros(qd.shape[1]) if lags is None else lags
-    raw = np.column_stack([np.tanh(lagged(signals.t, qd[:, j], lags[j]) / smoothing[j]) for j in range(qd.shape[1])])
+    raw = np.column_stack([coulomb(lagged(signals.t, qd[:, j], lags[j]), smoothing[j]) for j in range(qd.shape[1])])
     return switching_filter(signals)(raw)
 
 
@@ -89,10 +95,8 @@ def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
         return np.ones(len(signals.t))
     if kind == "armature":
         return signals.qdd[:, j]
-    if kind == "ripple_cos":
-        return np.cos(signals.q[:, j])
-    if kind == "ripple_sin":
-        return np.sin(signals.q[:, j])
+    if kind in ("ripple_cos", "ripple_sin"):  # the first harmonic, over every position
+        return terms.Ripple.harmonic(signals.q[:, j], 1, kind[-3:])
     raise ValueError(kind)
 
 

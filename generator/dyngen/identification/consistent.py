@@ -10,7 +10,7 @@ joint j by 1 / sigma_j (its noise estimate); F holds the columns of columns.py: 
 friction (smoothing and lag chosen per joint on the fit data, filtered like the torque), viscous
 friction, an offset and rotor inertia (where the rigid body does not already carry it: joint 1's
 is part of link 1's inertia), and the optional groups, kept only where held-out data ask for them
-(selection.py): a position ripple per joint, a tilted base (a rotation, tilt.py).
+(held_out.py): a position ripple per joint, a tilted base (a rotation, terms/tilt.py).
 
 The order of work, every step on the fit recordings only (test data are never seen here):
   1. the regressor and every column, once (columns.py), and the normal equations per contiguous
@@ -18,7 +18,7 @@ The order of work, every step on the fit recordings only (test data are never se
   2. the Coulomb smoothing and lag per joint (the unconstrained fit's residual per joint);
   3. the noise per joint sigma_j (the unconstrained fit's residual), the weights; columns the data
      cannot tell from the rest are left out and named;
-  4. lambda on held-out data (selection.py: cross-validation over contiguous parts, or the
+  4. lambda on held-out data (held_out.py: cross-validation over contiguous parts, or the
      `select` recordings), with every optional group in;
   5. each optional group kept or left out at that lambda, on the same held-out data;
   6. the consistent fit on all fit data (solver.py: the extraction's driver, one solver); a tilt
@@ -27,147 +27,29 @@ The order of work, every step on the fit recordings only (test data are never se
      unconstrained weighted fit (statistics.py: a sandwich estimate that holds for correlated
      residuals).
 
-Public entry point: identify_consistent(robot, model, folder, signals, options, select=None) -> Consistent.
+Public entry point: identify_consistent(robot, model, folder, signals, options, select=None) -> Consistent
+(its options: options.py ConsistentOptions; the result and its YAML: consistent_output.py).
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import real
 from ..errors import InputError
-from ..extraction.problem import Options as ExtractOptions
-from ..extraction.problem import consistency_margin
-from ..options import option
-from ..parameters import PER_LINK, dynamic_name
-from . import selection, tilt
+from ..extraction.problem import consistency_margin, pinned
+from ..parameters import PER_LINK
+from ..terms import tilt
+from ..terms.body import armature_identifiable
+from ..terms.friction import SIMPLE_SCALE
+from . import held_out
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
+from .consistent_output import Consistent
 from .normal import Normal, solve_unconstrained
+from .options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
 from .solver import Solver
 from .statistics import estimate
-
-DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
-CHOICES = ("coulomb", "viscous", "offset", "armature", "ripple")  # what options.friction may name
-CANDIDATES = ("ripple", "tilt", "falling")  # optional groups, decided on held-out data
-BOUNDS = ("viscous", "dissipative")
-FRICTION_KINDS = PER_JOINT
-SMOOTHING_GRID = (1e-5, 1e-4, 0.0005, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # rad/s, candidates for vs_j
-LAG_GRID = (0.0, 0.01, 0.02, 0.04)  # s, candidates for the Coulomb term's lag behind the velocity
-REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
-
-
-@dataclass
-class ConsistentOptions:
-    """Options of the consistent identification; those declared with option(...) are also
-    `dyngen identify` flags (dyngen.options), the rest the method's own settings."""
-
-    friction: tuple = option(DEFAULT_KINDS, "per-joint columns always in: " + ", ".join(CHOICES)
-                             + " (ripple: cos q_j, sin q_j)", metavar="LIST", listed=True, choices=CHOICES)
-    candidates: tuple = option(CANDIDATES, "optional parts of the model, each kept only where held-out stretches "
-                               "of the fit data ask for it: ripple (cos q_j, sin q_j per joint), tilt (a tilted "
-                               "base), falling (friction falling with speed per joint: viscous below 0, still "
-                               "opposing motion up to the velocity limit); 'none' for none", metavar="LIST",
-                               listed=True, choices=CANDIDATES + ("none",))
-    smoothing: float | None = option(None, "Coulomb friction as tanh(qd / V) with this V [rad/s] on every joint "
-                                     "(default: chosen per joint on the fit data)", metavar="V",
-                                     parse=real(0, 100, above=True))
-    margin: float = ExtractOptions.margin  # consistency margin [kg m^2]: the extraction's
-    restarts: int = 2
-    seed: int = 1
-    threads: int = 0
-    max_rounds: int = 8  # active-set rounds for the signs of the friction values
-    weighted: bool = True  # rows scaled by 1 / sigma_joint
-    prior: np.ndarray | None = None  # dynamic parameters (10N); default the YAML's nominal
-    regularisation: float | None = option(None, "weight of the prior (default: chosen on held-out data: "
-                                          "contiguous parts of the fit data, or --select data)", metavar="L",
-                                          parse=real(0, 1e9))  # None: chosen from `grid`
-    grid: tuple = REGULARISATION_GRID
-    folds: int = 5  # contiguous parts for the choices on held-out data when no select data are given
-    rule: str = "1se"  # "1se" (one-standard-error rule) or "min" (the best held-out score)
-    tilt: bool | None = option(None, "always fit a tilted base (a rotation of gravity; by default a candidate, "
-                               "see --candidates)", const=True)  # True always, False never, None a candidate
-    friction_lag: bool = True  # Coulomb term follows the velocity with a per-joint lag from LAG_GRID
-    friction_bound: str = "viscous"  # "viscous": Fc, Fv >= 0 but where "falling" is chosen; "dissipative":
-    # Fc + Fv v_max >= 0 on every joint (solver.py)
-    workers: int = 0  # driver runs at once in the cross-validation (0: up to 2, as the cores allow)
-
-
-@dataclass
-class Consistent:
-    """The result: full link parameters, friction per joint, and the statistics of the fit."""
-
-    p: np.ndarray  # dynamic parameters (10N), physically consistent
-    pi: np.ndarray  # full base coefficients of p
-    names: list  # base coefficient expressions (standard parameters)
-    friction: dict  # kind -> (N,) values (nan where the column is not in the model); "tilt": (a1, a2)
-    smoothing: np.ndarray  # (N,) vs_j [rad/s]
-    sigma: np.ndarray  # (N,) per-joint noise estimate used as weight [Nm]
-    ols: object  # least_squares.Estimate of the unconstrained weighted fit (coefficients, then friction)
-    column_names: list  # names of the OLS columns
-    residual_rms: np.ndarray  # (N,) RMS of the consistent model's residual on the fit data
-    ols_residual_rms: np.ndarray  # (N,) the same for the unconstrained fit
-    lambda_min: np.ndarray  # (N,) consistency margin of each link
-    regularisation: float
-    selection: list  # (lambda, held-out weighted mean square) tried
-    rounds: int
-    dropped_armature: list = field(default_factory=list)  # joints whose rotor inertia the body carries
-    at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
-    velocity_limits: np.ndarray | None = None
-    tilt_model: tuple | None = None  # (robot, parameters) the tilt's torques are evaluated with
-    dropped_columns: list = field(default_factory=list)  # columns the data cannot separate, or refused
-    lags: np.ndarray | None = None  # (N,) lag of the Coulomb term behind the velocity [s]
-    groups: list = field(default_factory=list)  # (group, joint or None, gain, its se, kept) decided on held-out data
-    notes: list = field(default_factory=list)  # what a user must know (e.g. a tilt refused)
-
-    def joint_dynamics(self) -> list:
-        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
-        damping must be >= 0: a negative Fv is left out there, and said so by the caller)."""
-        f = self.friction
-        return [{"damping": max(_nz(f["viscous"][j]), 0.0), "friction": _nz(f["coulomb"][j]),
-                 "armature": _nz(f["armature"][j])} for j in range(len(self.sigma))]
-
-    def tilt_deg(self) -> float:
-        if self.tilt_model is None:
-            return 0.0
-        return tilt.angle_deg(tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
-
-    def predict(self, model, signals) -> np.ndarray:
-        """Torques (T, N) of this model (rigid body + friction + offset + rotor inertia + optional
-        groups) on signals (Coulomb through the recording's filter, as in the fit)."""
-        f = {k: np.nan_to_num(v) for k, v in self.friction.items()}
-        out = model.batch("regressor", signals.q, signals.qd, signals.qdd) @ self.pi
-        if np.any(f["coulomb"]):
-            out = out + f["coulomb"] * coulomb_matrix(signals, self.smoothing, self.lags)
-        out = out + (f["viscous"] * signals.qd + f["offset"] + f["armature"] * signals.qdd
-                     + f["ripple_cos"] * np.cos(signals.q) + f["ripple_sin"] * np.sin(signals.q))
-        if self.tilt_model is not None:
-            robot, p = self.tilt_model
-            out = out + tilt.torque(robot, p, signals.q, tilt.gravity_of(robot), self.friction["tilt"])
-        return out
-
-
-def _nz(x) -> float:
-    return 0.0 if not np.isfinite(x) else float(x)
-
-
-def identifiable_armature(model, dof: int, seed: int = 0) -> list[bool]:
-    """Whether joint j's rotor inertia Ia_j qdd_j is independent of the rigid-body base columns."""
-    rng = np.random.default_rng(seed)
-    states = 40
-    q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))
-    Y = model.batch("regressor", q, qd, qdd).reshape(states * dof, -1)
-    ok = []
-    for j in range(dof):
-        col = np.zeros((states, dof))
-        col[:, j] = qdd[:, j]
-        col = col.reshape(-1)
-        x, *_ = np.linalg.lstsq(Y, col, rcond=None)
-        ok.append(bool(np.linalg.norm(Y @ x - col) > 1e-8 * np.linalg.norm(col)))
-    return ok
-
 
 # ---------------------------------------------------------------------------------------------
 # step 2: the Coulomb term's smoothing and lag
@@ -198,7 +80,7 @@ def _coulomb(pieces, normal, fit, options, dof):
         return lambda p, value: coulomb_matrix(p.signals, np.broadcast_to(smoothing(value), (dof,)),
                                                np.broadcast_to(lags(value), (dof,)))[p.keep]
 
-    smoothing = np.full(dof, float(options.smoothing or 0.02))
+    smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
     if not any(kind == "coulomb" for kind, _ in normal.labels):
         return smoothing, lags, normal
@@ -270,7 +152,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
                          f"under-determined: {rows} equations for {unknowns} coefficients and friction values; "
                          f"record at least {2 * unknowns // dof + 1} samples (many more, on an exciting trajectory, "
                          "for a usable estimate)")
-    armature_ok = identifiable_armature(model, dof) if "armature" in kinds else [False] * dof
+    armature_ok = armature_identifiable(model, dof) if "armature" in kinds else [False] * dof
     labels = _labels(kinds, armature_ok, dof, with_tilt)
 
     # 1. regressor, columns and normal equations per part and joint
@@ -279,7 +161,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     pieces += [piece(model, s, folds) for s in (select or [])]
     parts = folds + (1 if select else 0)
     fit = list(range(folds))
-    smoothing0 = np.full(dof, float(options.smoothing or 0.02))
+    smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     fill(pieces, labels, smoothing0, np.zeros(dof), lambda q: tilt.rotation_columns(robot, prior, q, g_vec))
     normal = Normal.build(pieces, labels, r, parts, dof)
 
@@ -301,7 +183,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     # 4. lambda; 5. optional groups
     solver = Solver(robot, model, folder, options, r, velocity_limits(robot, signals_list), prior)
     workers = options.workers or min(2, os.cpu_count() or 1)
-    splits = selection.Folds.make(parts, bool(select), weights)
+    splits = held_out.Folds.make(parts, bool(select), weights)
     # joints whose friction may fall with speed (a candidate, or all with friction_bound "dissipative")
     cone = set()
     if options.friction_bound == "dissipative" or "falling" in options.candidates:
@@ -311,13 +193,13 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     if lam is None:
         lam = 0.0
         if prior is not None and len(options.grid) > 1:
-            lam, table, kept = selection.choose_lambda(solver, normal, splits, active, options.grid, options.rule,
+            lam, table, kept = held_out.choose_lambda(solver, normal, splits, active, options.grid, options.rule,
                                                        workers, cone)
     undecided = [k for k in active if (labels[k][0] in optional) or (labels[k][0] == "tilt" and tilt_mode == "auto")]
     falling = cone if options.friction_bound != "dissipative" and "falling" in options.candidates else set()
     groups = []
     if undecided or falling:
-        base = kept.get(lam) or selection.scores(solver, normal, splits, active, lam, workers=workers, cone=cone)
+        base = kept.get(lam) or held_out.scores(solver, normal, splits, active, lam, workers=workers, cone=cone)
         active, cone, groups = _decide(solver, normal, splits, active, cone, undecided, falling, base, lam, workers)
 
     # 6. the consistent fit on all fit data
@@ -354,17 +236,17 @@ def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam,
     for group in ("tilt", "ripple", "falling"):
         members = [k for k in undecided if group_of(labels[k]) == group]
         if group == "falling" and falling:
-            without = selection.scores(solver, normal, splits, active, lam, workers=workers, cone=cone - falling)
+            without = held_out.scores(solver, normal, splits, active, lam, workers=workers, cone=cone - falling)
             joints = sorted(falling)
         elif members:
-            without = selection.scores(solver, normal, splits, [k for k in active if k not in members], lam,
+            without = held_out.scores(solver, normal, splits, [k for k in active if k not in members], lam,
                                        workers=workers, cone=cone)
             joints = [None] if group == "tilt" else sorted({labels[k][1] for k in members})
         else:
             continue
         for j in joints:
-            gain = selection.gains(base, without, j)
-            keep = selection.keeps(gain, splits)
+            gain = held_out.gains(base, without, j)
+            keep = held_out.keeps(gain, splits)
             decisions.append((group, None if j is None else j + 1, gain[0], gain[1], keep))
             if not keep and group == "falling":
                 out_cone.discard(j)
@@ -400,7 +282,7 @@ def _final(solver, normal, pieces, fit, weights, active, cone, lam, robot, prior
         if tilt.angle_deg(g_vec, a) > tilt.MAX_TILT_DEG:
             notes.append(f"a base tilt of {tilt.angle_deg(g_vec, a):.1f} deg was refused (above {tilt.MAX_TILT_DEG:g} "
                          "deg it is no mounting error: check the YAML's gravity and the torque signs)")
-            dropped += ["tilt dg_x", "tilt dg_y"]
+            dropped += [name_of(("tilt", 0)), name_of(("tilt", 1))]
             active = [k for k in active if labels[k][0] != "tilt"]
             x, rounds, result = fit_with(active)
     return result, x, rounds, normal, active
@@ -414,24 +296,3 @@ def velocity_limits(robot, signals_list) -> np.ndarray:
         lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
         out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
     return np.array(out, dtype=float)
-
-
-def pinned(problem, p, rel: float = 1e-6) -> list:
-    """Names of the parameters at (within rel of the range from) one of their bounds."""
-    span = np.maximum(problem.upper - problem.lower, 1e-300)
-    at = (np.abs(p - problem.lower) < rel * span) | (np.abs(problem.upper - p) < rel * span)
-    return [dynamic_name(j // PER_LINK + 1, j % PER_LINK) for j in np.flatnonzero(at)]
-
-
-def robot_with_default_bounds(robot):
-    """The YAML's bounds, or (none given) wide ones: a link 1 g to 1000 kg, its centre of mass
-    within 2 m of its frame, inertias within 100 kg m^2 (consistency does the real work)."""
-    if robot.lower is not None:
-        return robot
-    from dataclasses import replace
-
-    from ..description.robot import LinkValues
-
-    lo = LinkValues(1e-3, (-2.0, -2.0, -2.0), (0.0, -100.0, -100.0, 0.0, -100.0, 0.0))
-    hi = LinkValues(1000.0, (2.0, 2.0, 2.0), (100.0, 100.0, 100.0, 100.0, 100.0, 100.0))
-    return replace(robot, lower=(lo,) * robot.dof, upper=(hi,) * robot.dof)

@@ -6,9 +6,71 @@ summary lines printed."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from ..extraction.report import links_yaml
+from ..terms import tilt
+from .columns import coulomb_matrix
+
+
+@dataclass
+class Consistent:
+    """The result: full link parameters, friction per joint, and the statistics of the fit."""
+
+    p: np.ndarray  # dynamic parameters (10N), physically consistent
+    pi: np.ndarray  # full base coefficients of p
+    names: list  # base coefficient expressions (standard parameters)
+    friction: dict  # kind -> (N,) values (nan where the column is not in the model); "tilt": (a1, a2)
+    smoothing: np.ndarray  # (N,) vs_j [rad/s]
+    sigma: np.ndarray  # (N,) per-joint noise estimate used as weight [Nm]
+    ols: object  # least_squares.Estimate of the unconstrained weighted fit (coefficients, then friction)
+    column_names: list  # names of the OLS columns
+    residual_rms: np.ndarray  # (N,) RMS of the consistent model's residual on the fit data
+    ols_residual_rms: np.ndarray  # (N,) the same for the unconstrained fit
+    lambda_min: np.ndarray  # (N,) consistency margin of each link
+    regularisation: float
+    selection: list  # (lambda, held-out weighted mean square) tried
+    rounds: int
+    dropped_armature: list = field(default_factory=list)  # joints whose rotor inertia the body carries
+    at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
+    velocity_limits: np.ndarray | None = None
+    tilt_model: tuple | None = None  # (robot, parameters) the tilt's torques are evaluated with
+    dropped_columns: list = field(default_factory=list)  # columns the data cannot separate, or refused
+    lags: np.ndarray | None = None  # (N,) lag of the Coulomb term behind the velocity [s]
+    groups: list = field(default_factory=list)  # (group, joint or None, gain, its se, kept) decided on held-out data
+    notes: list = field(default_factory=list)  # what a user must know (e.g. a tilt refused)
+
+    def joint_dynamics(self) -> list:
+        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
+        damping must be >= 0: a negative Fv is left out there, and said so by the caller)."""
+        f = self.friction
+        return [{"damping": max(_nz(f["viscous"][j]), 0.0), "friction": _nz(f["coulomb"][j]),
+                 "armature": _nz(f["armature"][j])} for j in range(len(self.sigma))]
+
+    def tilt_deg(self) -> float:
+        if self.tilt_model is None:
+            return 0.0
+        return tilt.angle_deg(tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
+
+    def predict(self, model, signals) -> np.ndarray:
+        """Torques (T, N) of this model (rigid body + friction + offset + rotor inertia + optional
+        groups) on signals (Coulomb through the recording's filter, as in the fit)."""
+        f = {k: np.nan_to_num(v) for k, v in self.friction.items()}
+        out = model.batch("regressor", signals.q, signals.qd, signals.qdd) @ self.pi
+        if np.any(f["coulomb"]):
+            out = out + f["coulomb"] * coulomb_matrix(signals, self.smoothing, self.lags)
+        out = out + (f["viscous"] * signals.qd + f["offset"] + f["armature"] * signals.qdd
+                     + f["ripple_cos"] * np.cos(signals.q) + f["ripple_sin"] * np.sin(signals.q))
+        if self.tilt_model is not None:
+            robot, p = self.tilt_model
+            out = out + tilt.torque(robot, p, signals.q, tilt.gravity_of(robot), self.friction["tilt"])
+        return out
+
+
+def _nz(x) -> float:
+    return 0.0 if not np.isfinite(x) else float(x)
 
 
 def _f(x) -> str:
@@ -62,7 +124,7 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
 
 def tilt_change(c) -> np.ndarray:
     """The tilt's change of the gravity vector in the base frame [m/s^2]."""
-    from .tilt import change, directions, gravity_of
+    from ..terms.tilt import change, directions, gravity_of
 
     g = gravity_of(c.tilt_model[0])
     return directions(g).T @ change(g, c.friction["tilt"])

@@ -75,8 +75,6 @@ class Solver:
     """The reduced problems of one identification: the extraction's problem and driver, built once."""
 
     def __init__(self, robot, model, folder, options, r: int, V, prior):
-        from .consistent import robot_with_default_bounds
-
         self.model, self.options, self.r, self.V = model, options, r, V
         self.extract_options = ExtractOptions(restarts=options.restarts, seed=options.seed, threads=options.threads,
                                               global_algorithm="none", margin=options.margin)
@@ -139,3 +137,15 @@ class Solver:
             free |= wants
         natural = M[r:, r:] @ (y_f / scale[r:])
         return np.concatenate([pi, natural]), free, rounds, result
+
+
+def robot_with_default_bounds(robot):
+    """The YAML's bounds, or (none given) wide ones: a link 1 g to 1000 kg, its centre of mass
+    within 2 m of its frame, inertias within 100 kg m^2 (consistency does the real work)."""
+    if robot.lower is not None:
+        return robot
+    from ..description.robot import LinkValues
+
+    lo = LinkValues(1e-3, (-2.0, -2.0, -2.0), (0.0, -100.0, -100.0, 0.0, -100.0, 0.0))
+    hi = LinkValues(1000.0, (2.0, 2.0, 2.0), (100.0, 100.0, 100.0, 100.0, 100.0, 100.0))
+    return replace(robot, lower=(lo,) * robot.dof, upper=(hi,) * robot.dof)

@@ -12,14 +12,14 @@ fixed variants of one effect, refined once the effect is selected (diagnosis/ref
 
 from __future__ import annotations
 
+from ...terms.friction import SCALE_VARIANTS as COULOMB_VELOCITIES
+from ...terms.friction import STRIBECK_VARIANTS as STRIBECK_VELOCITIES
 from .base import Context, Effect
 from .body import Coefficients, Payload
 from .friction import Armature, Coulomb, Direction, Ripple, Stribeck, Viscous
 from .sensor import Gain, Offset, TimeShift
 from .tilt import GravityScale, Tilt, gravity_matrix
 
-COULOMB_VELOCITIES = (0.002, 0.01, 0.05)  # rad/s (m/s): Coulomb's velocity scale, variants (refined once selected)
-STRIBECK_VELOCITIES = (0.03, 0.1, 0.3)  # rad/s (m/s): the variants tried (well above Context.sign_velocity)
 TIME_SHIFTS = (0.001, 0.004, 0.016, 0.064)  # s: the variants tried (factors of 4; refined once selected)
 # Errors in every base coefficient: dozens of values that fit anything a little, and over-fit
 # real data (a repeated trajectory selects 43 of them). Tried only when asked for by name.

@@ -49,6 +49,7 @@ class Effect:
     `simulator`, `last_link`, read from a report entry: classmethods) and when it is reported
     with a warning (`suspect`, `warnings`)."""
 
+    term = None  # the terms.Term it is: its name, scope, parameters, units and physical range
     name = ""
     scope = "joint"
     parameters: tuple = ()
@@ -68,6 +69,12 @@ class Effect:
     scales = False  # its setting is its joint's sensor gain, which scales the arm's other torques on it
     shapes_others = False  # its setting enters other effects' columns (Context: delay, scale, load)
     simulator: tuple | None = None  # (URDF/MJCF joint attribute, value name) this effect is, e.g. ("damping", "Fv")
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "term" in cls.__dict__ and cls.term is not None:
+            cls.name, cls.scope, cls.switching = cls.term.name, cls.term.scope, cls.term.switching
+            cls.parameters, cls.units = cls.term.parameters(), cls.term.units()
 
     @classmethod
     def of(cls, context: Context) -> "Effect":
@@ -90,8 +97,13 @@ class Effect:
         return None
 
     def plausible(self, values: np.ndarray) -> bool:
-        """Whether fitted values can be this effect at all (e.g. friction opposes motion)."""
-        return True
+        """Whether fitted values can be this effect at all (e.g. friction opposes motion): inside
+        its term's physical range."""
+        return True if self.term is None else self.term.inside(values, self.range_scales())
+
+    def range_scales(self) -> dict:
+        """What its term's range is relative to (base.Value.per), e.g. {"g": 9.81}."""
+        return {}
 
     def refusal_beside(self, values: np.ndarray, base: np.ndarray) -> str:
         """Why fitted values cannot be this effect beside those of the effect it extends on its

@@ -11,15 +11,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...catalogue import REGRESSOR, RNEA
-from ...parameters import PER_LINK, STANDARD_NAMES_PER_LINK
+from ... import terms
+from ...parameters import PER_LINK
 from .base import Effect
 
 
 class Payload(Effect):
-    name, scope = "payload", "arm"
-    parameters = STANDARD_NAMES_PER_LINK
-    units = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
+    term = terms.Payload
     # Its setting (m, mx, my, mz, refined to the fitted values) is the body whose gravity a tilt
     # turns with the arm's (Context.load): the product of the two enters the tilt's columns.
     refinable = shapes_others = True
@@ -46,11 +44,8 @@ class Payload(Effect):
     def load(self):
         return self.weight
 
-    def plausible(self, values):
-        """A body has a positive mass, not more than the arm's, and its centre of mass
-        within a metre of the flange frame."""
-        m = values[0]
-        return bool(0 < m < self.max_mass and np.linalg.norm(values[1:4]) < 1.0 * m)
+    def range_scales(self):
+        return {"arm mass": self.max_mass}
 
     def simplified(self, values):
         """A fitted inertia that is no body's (about its centre of mass: a negative principal
@@ -76,13 +71,7 @@ class Payload(Effect):
     @staticmethod
     def body_columns(context, signals, units) -> np.ndarray:
         """(T, N, k): Newton-Euler torques of the last link's standard parameters units[k]."""
-        n = signals.q.shape[1]
-        out = np.empty(signals.q.shape + (len(units),))
-        for k, unit in enumerate(units):
-            s = np.zeros(PER_LINK * n)
-            s[PER_LINK * (n - 1):] = unit
-            out[:, :, k] = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, s)
-        return out
+        return terms.Payload.columns(context.model, signals.q, signals.qd, signals.qdd, units)
 
     def derived(self, robot, values, std, torque_rms):
         m = values.get("m")
@@ -188,6 +177,8 @@ def standard_of_payload(values: dict, variant=None) -> np.ndarray:
 
 
 class Coefficients(Effect):
+    """Errors in every base coefficient of the full dynamics: the rigid body's columns."""
+
     name, scope = "coefficients", "arm"
 
     def __init__(self, parameters):
@@ -199,4 +190,4 @@ class Coefficients(Effect):
         return cls(e["standard"] for e in context.model.manifest["coefficients"]["full"]["expressions"])
 
     def columns(self, context, signals, tau_model):
-        return context.model.batch(REGRESSOR.name, signals.q, signals.qd, signals.qdd)
+        return terms.RigidBody.columns(context.model, signals.q, signals.qd, signals.qdd)

@@ -1,15 +1,8 @@
-"""Joint friction and rotor inertia: per joint, linear in their values.
+"""Joint friction and rotor inertia as candidates of the diagnosis: per joint, linear in their
+values (the laws, their ranges and columns: terms/friction.py).
 
-    Coulomb:   Fc * tanh(qd / vc)                 [Nm] at a velocity scale vc (variants; refined once selected)
-    viscous:   Fv * qd                            [Nm s/rad]
-    Stribeck:  Fs * sign(qd) * exp(-(qd/vs)^2)    [Nm] at a fixed vs (variants; vs refined once selected)
-    direction: dFc * |sign(qd)|                   [Nm]: Coulomb levels Fc + dFc moving forwards and
-                                                  Fc - dFc backwards (gears and seals are not symmetric)
-    ripple:    sum_k a_k cos(k q) + b_k sin(k q)  [Nm], k = 1..3: a torque that depends on the joint's
-                                                  own position (gear and cogging harmonics); known only
-                                                  where the fit data went, so q is clipped to that
-                                                  range (harmonics extrapolated beyond it are guesses)
-    armature:  Ia * qdd                           [kg m^2] (reflected rotor inertia)
+Variants: Coulomb at a few velocity scales vc and Stribeck at a few velocities vs, refined once
+selected (refine.py); the ripple's positions clipped to the fit data's (Context.q_range).
 
 The Coulomb velocity scale vc is fitted because real joints do not switch sharply: in stick
 phases and reversals friction takes any value in [-Fc, Fc], which a smooth law with a wider
@@ -21,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ... import terms
 from .base import Effect
 
 # A Stribeck velocity below this many Coulomb velocity scales only reshapes the Coulomb law:
@@ -32,17 +26,15 @@ RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many p
 
 
 class _Dissipative(Effect):
-    """Friction opposes motion and a rotor inertia is positive: only positive values qualify."""
+    """Friction opposes motion and a rotor inertia is positive: only positive values qualify
+    (the term's range)."""
 
     local = True
 
-    def plausible(self, values):
-        return bool(np.all(values > 0))
-
 
 class Coulomb(_Dissipative):
-    name, parameters, units = "coulomb", ("Fc",), ("Nm",)
-    refinable = switching = True
+    term = terms.Coulomb
+    refinable = True
     simulator = ("friction", "Fc")
 
     def __init__(self, velocity: float):
@@ -68,36 +60,31 @@ class Coulomb(_Dissipative):
 
     @classmethod
     def friction_terms(cls, values, variant):
-        return {"Fc": values["Fc"], "eps": variant["vc"]}  # the fitted velocity scale (the Stribeck term shares it)
+        return {"Fc": values["Fc"], "vc": variant["vc"]}  # the fitted velocity scale
 
     def columns(self, context, signals, tau_model):
-        return np.tanh(signals.qd / self.velocity)[:, :, None]
+        return self.term.columns(signals.qd, self.velocity)
 
 
 class Direction(Effect):
-    name, parameters, units = "direction", ("dFc",), ("Nm",)
-    secondary = switching = local = True
+    term = terms.Direction
+    secondary = local = True
+
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"dFc": values["dFc"]}  # its sign's smoothing: the context's (friction_vector)
 
     def columns(self, context, signals, tau_model):
-        return np.abs(context.sign(signals.qd))[:, :, None]
+        return self.term.columns(signals.qd, context.sign_velocity)
 
 
 class Ripple(Effect):
-    HARMONICS = (1, 2, 3)
-    name = "ripple"
+    term = terms.Ripple
+    HARMONICS = terms.Ripple.HARMONICS
     ranged = True
-    parameters = tuple(f"{ab}{k}" for k in HARMONICS for ab in ("a", "b"))
-    units = ("Nm",) * (2 * len(HARMONICS))
 
     def columns(self, context, signals, tau_model):
-        q = signals.q
-        if context.q_range is not None:
-            q = np.clip(q, *context.q_range)
-        out = np.stack([f(k * q) for k in self.HARMONICS for f in (np.cos, np.sin)], axis=-1)
-        for j, joint in enumerate(context.robot.joints):
-            if not joint.revolute:  # harmonics of a position in metres mean nothing
-                out[:, j, :] = 0.0
-        return out
+        return self.term.columns(signals.q, [joint.revolute for joint in context.robot.joints], context.q_range)
 
     def derived(self, robot, values, std, torque_rms):
         if None in values.values():
@@ -120,7 +107,7 @@ class Ripple(Effect):
 
 
 class Viscous(_Dissipative):
-    name, parameters, units = "viscous", ("Fv",), ("Nm s/rad",)
+    term = terms.Viscous
     simple_term = "Fv"
     simulator = ("damping", "Fv")
 
@@ -129,12 +116,12 @@ class Viscous(_Dissipative):
         return {"Fv": values["Fv"]}
 
     def columns(self, context, signals, tau_model):
-        return signals.qd[:, :, None]
+        return self.term.columns(signals.qd)
 
 
 class Stribeck(_Dissipative):
-    name, parameters, units = "stribeck", ("Fs",), ("Nm",)
-    refinable = switching = True
+    term = terms.Stribeck
+    refinable = True
     # Static friction above the Coulomb level. Alone, it would be friction that vanishes at
     # speed, which no joint has, and the viscous law would then take the Coulomb level's place
     # (extrapolating steeply beyond the fit speeds).
@@ -184,16 +171,15 @@ class Stribeck(_Dissipative):
 
     @classmethod
     def friction_terms(cls, values, variant):
-        return {"Fs": values["Fs"], "vs": variant["vs"]}
+        return {"Fs": values["Fs"], "vs": variant["vs"]}  # its sign's smoothing: the context's (friction_vector)
 
     def columns(self, context, signals, tau_model):
-        qd = signals.qd
-        return (context.sign(qd) * np.exp(-(qd / self.velocity) ** 2))[:, :, None]
+        return self.term.columns(signals.qd, self.velocity, context.sign_velocity)
 
 
 class Armature(_Dissipative):
-    name, parameters, units = "armature", ("Ia",), ("kg m^2",)
+    term = terms.Armature
     simulator = ("armature", "Ia")
 
     def columns(self, context, signals, tau_model):
-        return signals.qdd[:, :, None]
+        return self.term.columns(signals.qdd)

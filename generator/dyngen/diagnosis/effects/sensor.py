@@ -1,8 +1,4 @@
-"""Errors of the measurement itself.
-
-    offset:      b                                  per joint [Nm]: torque-sensor zero offset
-    gain:        (k - 1) * tau_model                per joint [1]: the sensor reads k times the torque
-    time shift:  tau(t - dt) - tau(t)               whole arm [s]: torques lag positions by dt
+"""Errors of the measurement itself, as candidates of the diagnosis (the terms: terms/sensor.py).
 
 The time shift is linear in dt only to first order, -dt * d tau_model / dt, which fails
 wherever tau_model jumps (an acceleration step): the measured torque keeps the value before
@@ -19,20 +15,17 @@ dt0 <- dt (refine.py), which also reaches negative shifts (torques leading the p
 
 from __future__ import annotations
 
-import numpy as np
-
+from ... import terms
 from .base import Effect
-
-MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor's time shift
 
 
 class Offset(Effect):
-    name, parameters, units = "offset", ("b",), ("Nm",)
+    term = terms.Offset
     simple_term = "b"
     local = sensor = True
 
     def columns(self, context, signals, tau_model):
-        return np.ones(signals.q.shape + (1,))
+        return self.term.columns(signals.q.shape)
 
 
 class Gain(Effect):
@@ -40,7 +33,7 @@ class Gain(Effect):
     torque on the arm alike, friction and payload included. Its setting g0 is the gain those are
     scaled by (Context.scale), refined to the fitted value once selected (0 while selecting)."""
 
-    name, parameters, units = "gain", ("k-1",), ("1",)
+    term = terms.Gain
     refinable = sensor = scales = shapes_others = True
     tolerance = 1e-4  # of the torque: far below any gain a diagnosis reports
 
@@ -58,18 +51,15 @@ class Gain(Effect):
     def at(self, setting):
         return Gain(setting)
 
-    def plausible(self, values):
-        return bool(np.all(np.abs(values) < 0.5))  # a sensor that reads 0.5 to 1.5 times the torque
-
     def columns(self, context, signals, tau_model):
-        return tau_model[:, :, None]
+        return self.term.columns(tau_model)
 
     def derived(self, robot, values, std, torque_rms):
         return {"factor": 1.0 + values["k-1"]}
 
 
 class TimeShift(Effect):
-    name, scope, parameters, units = "time_shift", "arm", ("dt",), ("s",)
+    term = terms.TimeShift
     refinable = sensor = delays = shapes_others = True
 
     def __init__(self, shift: float):
@@ -80,9 +70,7 @@ class TimeShift(Effect):
         return {"dt0": self.shift}
 
     def columns(self, context, signals, tau_model):
-        # Before the first sample the torque is held at its first value (np.interp's ends).
-        shifted = np.column_stack([np.interp(signals.t - self.shift, signals.t, tau) for tau in tau_model.T])
-        return ((shifted - tau_model) / self.shift)[:, :, None]
+        return self.term.columns(signals.t, tau_model, self.shift)
 
     @property
     def setting(self):
@@ -90,9 +78,6 @@ class TimeShift(Effect):
 
     def implied_setting(self, values):
         return float(values[0]) or None
-
-    def plausible(self, values):
-        return bool(abs(values[0]) < MAX_SHIFT)
 
     def at(self, setting):
         return TimeShift(setting)

@@ -9,6 +9,6 @@ makes of them, which the benchmark and the tests share.
     withheld_verdict.py     does a diagnosis match a case's truth (the list of mismatches)
     withheld_run.py         one case through the diagnosis as a user runs it, and its verdict
 
-Importable as `simulation` from bench scripts (bench/ is their sys.path[0]) and from the tests
-(pyproject.toml: pytest's pythonpath).
+Test support, owned by the tests (tests/ is on their sys.path: conftest.py); the bench scripts
+import it too (bench/common.py on_path).
 """

@@ -1,5 +1,6 @@
 """The extraction step's options (dyngen.options): the command line's extraction flags, the
-YAML `extraction:` block and the problem file the driver reads all come from this class."""
+YAML `extraction:` block and the problem file the driver reads all come from this class. Part of
+the description: a robot YAML may set them, and its loader checks them (load.py)."""
 
 from __future__ import annotations
 

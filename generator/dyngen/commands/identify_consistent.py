@@ -1,13 +1,11 @@
 """`dyngen identify` (kind full): the run of the physically consistent identification (its
-options: identification.consistent.ConsistentOptions, flags by dyngen.commands.identify)."""
+options: identification.consistent.ConsistentOptions, flags by commands/identify.py)."""
 
 from __future__ import annotations
 
 import time
 from dataclasses import replace
 from pathlib import Path
-
-import numpy as np
 
 from ..options import resolve
 
@@ -16,9 +14,9 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     from ..atomic import write_file
     from ..data.parameters_file import read_link_parameters
     from ..export import write_all
-    from ..commands.recordings import conditioning_text, read_all
-    from .consistent import ConsistentOptions, identify_consistent
-    from .consistent_output import consistent_table, consistent_yaml, summary_lines
+    from ..identification.consistent import ConsistentOptions, identify_consistent
+    from ..identification.consistent_output import consistent_table, consistent_yaml, summary_lines
+    from .recordings import conditioning_text, read_all
 
     options = resolve(ConsistentOptions, args, {})
     if "none" in options.candidates:  # names were checked by the parser (options.py)
@@ -44,8 +42,3 @@ def run_consistent(args, robot, model, signals, progress) -> int:
         print(f"  {seconds:.1f} s; written: {out}, {table}, " + ", ".join(str(p) for p in exported))
     return 0
 
-
-def held_out_rms(model, result, signals) -> np.ndarray:
-    """RMS per joint of measured minus predicted torque on recordings the fit has not seen."""
-    r = np.vstack([s.tau - result.predict(model, s) for s in signals])
-    return np.sqrt(np.mean(r ** 2, axis=0))

@@ -98,7 +98,7 @@ CASES = [
 
 # Friction as real joints have it: the arm tracks its reference in a forward simulation, and
 # friction (MuJoCo's stiff friction loss, a Stribeck excess through qfrc_applied) sticks at
-# reversals and rests (bench/simulation/mujoco_tracking.py).
+# reversals and rests (tests/simulation/mujoco_tracking.py).
 TRACKED_CASES = [
     Case("sticky", Effects(coulomb={2: 0.9, 4: 0.5}, viscous={2: 0.4}), tracked=True),
     Case("stribeck_sticky", Effects(coulomb={4: 0.6}, stribeck={4: (0.6, 0.08)}), tracked=True),

@@ -1,5 +1,5 @@
 """Does a diagnosis (diagnosis.json, docs/conventions.md) match the truth of a withheld case
-(truth.json, bench/simulation/withheld_cases.py)? `problems(truth, diagnosis, noise)` lists every
+(truth.json, tests/simulation/withheld_cases.py)? `problems(truth, diagnosis, noise)` lists every
 mismatch as a sentence; an empty list is a pass.
 
 The verdict must name exactly the injected effects on exactly their joints, recover each
@@ -16,7 +16,7 @@ The truth and the diagnosis name some effects differently; the translation:
              the origin is mostly absorbed by the link's own coefficients).
   tilt       truth: the tilted base-frame gravity vector. The diagnosis: dg1, dg2, dgn along
              u1, u2, n, where n = gravity / |gravity|, u1 = the base axis least aligned with n
-             made perpendicular to it, u2 = n x u1 (effects/tilt.py). Compared: the change of the
+             made perpendicular to it, u2 = n x u1 (terms/tilt.py). Compared: the change of the
              gravity vector, within 20 % of its norm.
   coefficients  truth: the simulated links p_true. The diagnosis: errors of the base
              coefficients, named by their expressions in standard parameters. Truth per

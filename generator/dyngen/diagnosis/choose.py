@@ -1,0 +1,72 @@
+"""Stage 4, choose per joint: the effects, the simple model, both, or re-identified link
+parameters, on selection data (joints.py decides; here the cuts of the fit recordings into
+fit and selection blocks, and the consistent re-identification, reidentify.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import baseline as simple_model
+from . import joints, reidentify, roles
+from .fit import predict, ranged
+from .refine import restricted
+from .selection import solve
+
+
+def on_folds(context, segments, design, chosen, final, options) -> list[str]:
+    """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS ways of
+    cutting the fit recordings into fit and selection blocks, each model refitted per fold. One
+    cut selects on one phase of the motion only (on a periodic trajectory, the same stretch
+    every period); every sample judges once this way. Leaves the segments' masks and
+    corrections as they were."""
+    saved = [(seg.fit, seg.select, seg.correction) for seg in segments]
+    own = [seg.fit.any() or seg.select.any() for seg in segments]
+    totals = None
+    try:
+        for phase in range(roles.FOLDS):
+            for seg, mine in zip(segments, own):
+                if mine:
+                    seg.fit, seg.select = roles.blocks(seg.signals, options.block_seconds, phase)
+            # Position laws are known only over the positions this cut's fit blocks cover, as the
+            # final model's are over all the fit data (else a ripple would be judged on guesses).
+            fold = ranged(context, segments, chosen)
+            x = np.zeros(0)
+            if chosen:
+                fold_design, fold_chosen = restricted(fold, segments, design, chosen)
+                x = solve(fold_design, fold_chosen, covariance=False).x
+            for seg in segments:
+                seg.correction = predict(fold, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
+            sse = joints.errors(fold, segments, chosen, x, simple_model.fit(segments))
+            totals = sse if totals is None else [{k: a[k] + b[k] for k in a} for a, b in zip(totals, sse)]
+    finally:
+        for seg, (fit, select, correction) in zip(segments, saved):
+            seg.fit, seg.select, seg.correction = fit, select, correction
+    return joints.choose(totals, chosen, joints.FOLDS_PER_VALUE)
+
+
+def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):
+    """(Consistent result, its corrections per segment, modes) where the consistent link
+    parameters win a joint on selection data, else (None, None, modes) (reidentify.py)."""
+    remaining = [seg.residual - seg.correction for seg in segments]  # after the effects (fit-only values)
+    flagged = reidentify.gate(model, segments, remaining, min_gain)
+    if not flagged:
+        return None, None, modes
+    result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
+                                 reidentify.pieces(segments, "select"))
+    consistent = reidentify.corrections(result, model, segments)
+    new = joints.decide(context, segments, chosen, x, simple, min_gain, consistent, reidentify.JOINT_VALUES)
+    # only on joints whose residual the link parameters were shown to explain (the gate)
+    new = [m if m != joints.CONSISTENT or j in flagged else old for j, (m, old) in enumerate(zip(new, modes))]
+    if joints.CONSISTENT not in new:
+        return None, None, modes
+    return result, consistent, new
+
+
+def refit(robot, model, p, segments, reid, consistent):
+    """The consistent model refitted on every fit sample (selection blocks included), its
+    regularisation as chosen; kept only if it fits about as well as the model from the fit
+    blocks alone (reidentify.REFIT_WORSE), else that model stays."""
+    refit = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"), regularisation=reid.regularisation)
+    if np.all(refit.residual_rms <= reidentify.REFIT_WORSE * reid.residual_rms):
+        return refit, reidentify.corrections(refit, model, segments)
+    return reid, consistent

@@ -1,0 +1,78 @@
+"""Stage 6, report: each chosen effect as a finding (its gain and joints on the selection data,
+its values and deviations, what follows from them), and the split of the findings into
+those reported and those superseded on joints another model won."""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from .selection import relative_change, selection_gain, selection_mse
+
+
+def describe(robot, design, chosen, final, cand, min_gain) -> dict:
+    """What an effect does on the selection data (its gain, the joints it helps); its values
+    are filled in by _values once the final fit is made."""
+    mse_without = selection_mse(design, [c for c in chosen if c is not cand])
+    mse_with = selection_mse(design, chosen)
+    gain_per_joint = relative_change(mse_without, mse_with)
+    gain = selection_gain(cand, mse_without, mse_with)
+    joints = [cand.joint + 1] if cand.joint is not None else \
+        [j + 1 for j in range(len(gain_per_joint)) if gain_per_joint[j] >= min_gain]
+    names = list(cand.effect.parameters)
+    out = {
+        "effect": cand.effect.name, "joints": joints, "variant": cand.effect.fixed(),
+        "values": {}, "std": {}, "units": dict(zip(names, cand.effect.units)), "derived": {},
+        "selection_gain": gain,
+        "rms_before": np.sqrt(mse_without).tolist(), "rms_after": np.sqrt(mse_with).tolist(),
+    }
+    if cand.effect.suspect:
+        out["suspect"] = cand.effect.suspect
+    return out
+
+
+def fill_values(described, design, chosen, final, tau_corr, robot) -> None:
+    """The final values of every chosen effect, with deviations scaled for the residual's
+    correlation in time, and what follows from them (Effect.derived)."""
+    offset = 0
+    for cand, e in zip(chosen, described):
+        k = slice(offset, offset + cand.size)
+        offset += cand.size
+        std = np.sqrt(np.maximum(np.diag(final.covariance)[k], 0.0) * tau_corr)
+        identifiable = _identifiable(design, chosen, k)
+        names = list(cand.effect.parameters)
+        e["values"] = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], identifiable)}
+        e["std"] = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
+        e["variant"] = cand.effect.fixed()
+        e["derived"] = cand.effect.derived(robot, e["values"], e["std"], partial(_torque_rms, design, cand, final.x[k]))
+
+
+def _torque_rms(design, cand, x) -> float:
+    """RMS torque of a per-joint candidate's values x on its joint over the fit samples."""
+    G = design.fit.G[cand.joint][np.ix_(cand.slots, cand.slots)]
+    return float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
+
+
+def _identifiable(design, chosen, k) -> np.ndarray:
+    """Values the data determine: not in the null space of the weighted normal matrix."""
+    slots = np.concatenate([c.slots for c in chosen])
+    H = design.H[np.ix_(slots, slots)]
+    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
+    vals, vecs = np.linalg.eigh(H / np.outer(d, d))
+    weak = vals <= 1e-10 * max(vals.max(), 1e-300)
+    loading = (vecs[:, weak] ** 2).sum(axis=1)
+    return loading[k] < 0.5
+
+
+def reported(chosen, described, replaced) -> tuple[list, list]:
+    """(selected, superseded): the findings reported, and the per-joint ones on joints another
+    model won (replaced, 0-based); an arm-wide finding keeps only the joints not replaced."""
+    selected, superseded = [], []
+    for c, e in zip(chosen, described):
+        if c.joint is not None and c.joint in replaced:
+            superseded.append(e)
+            continue
+        e["joints"] = [j for j in e["joints"] if j - 1 not in replaced]
+        selected.append(e)
+    return selected, superseded

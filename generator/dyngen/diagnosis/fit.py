@@ -1,0 +1,99 @@
+"""Stage 1, fit: the moments of every candidate effect on every role's samples (moments.py),
+weighted per joint, and the chosen candidates' torques on a segment at fitted values."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..data.correlation import integrated_time
+from . import moments as dz
+from . import roles
+
+
+@dataclass
+class Design:
+    candidates: list
+    fit: dz.Moments
+    select: dz.Moments
+    test: dz.Moments
+    weights: np.ndarray  # per joint: 1 / RMS of the nominal fit residual
+    groups: list = field(default_factory=list)  # dz.Moments per block group (selection on blocks)
+    H: np.ndarray = None  # weighted normal matrix of every slot: sum_j w_j^2 G_j (fit samples)
+    g: np.ndarray = None  # sum_j w_j^2 b_j
+
+    def __post_init__(self):
+        w2 = self.weights ** 2
+        self.H = np.einsum("j,jkl->kl", w2, self.fit.G)
+        self.g = w2 @ self.fit.b
+
+
+def build(context, effects, segments, n) -> Design:
+    candidates, moments = None, None
+    for seg in segments:
+        columns = dz.effect_columns(effects, context, seg)
+        if candidates is None:
+            candidates = dz.candidates_of(effects, n, {k: v.shape[2] for k, v in columns.items()})
+            size = candidates[-1].start + candidates[-1].size
+            moments = [dz.empty(n, size) for _ in range(3)]
+            groups = [dz.empty(n, size) for _ in range(roles.FOLDS)]
+        roles_here = [*zip(moments, (seg.fit, seg.select, seg.test)), *zip(groups, seg.groups or [])]
+        for j in range(n):
+            A, slots = dz.joint_matrix(candidates, columns, j)
+            for m, mask in roles_here:
+                if mask.any():
+                    dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
+        for m, mask in roles_here:
+            m.count += int(mask.sum())
+    if moments[0].count == 0:
+        raise ValueError("no fit samples (recordings too short for the filter's start-up?)")
+    rms = np.sqrt(moments[0].c / max(moments[0].count, 1))
+    weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
+    return Design(candidates, *moments, weights, groups if any(m.count for m in groups) else [])
+
+
+def predict(context, chosen, x, segment) -> np.ndarray:
+    """The chosen candidates' torques (T, N) on one segment, for fitted values x (in chosen order)."""
+    effects = list({c.effect.key: c.effect for c in chosen}.values())
+    columns = dz.effect_columns(effects, dz.as_chosen(context, chosen), segment)
+    out = np.zeros_like(segment.residual)
+    offset = 0
+    for c in chosen:
+        values = x[offset: offset + c.size]
+        block = columns[c.effect.key] @ values  # (T, N)
+        if c.joint is None:
+            out += block
+        else:
+            out[:, c.joint] += block[:, c.joint]
+        offset += c.size
+    return out
+
+
+def reweighted(design, final) -> Design:
+    """The design with each joint weighted by 1 / the RMS its residual keeps after the chosen
+    effects (on the fit samples). The selection's weights come from the nominal residual, which
+    holds the very effects sought: a payload's 9 Nm on joint 2 would weigh joint 2 down as if
+    it were noise, and the arm-wide values would be set by the other joints alone."""
+    rms = np.sqrt(design.fit.mse(final.slots, final.x))
+    weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
+    return Design(design.candidates, design.fit, design.select, design.test, weights, design.groups)
+
+
+def correlation_time(segments, weights) -> float:
+    """Integrated autocorrelation time of the final weighted fit residual, median over joints."""
+    times = []
+    for j, w in enumerate(weights):
+        r = np.concatenate([(seg.residual - seg.correction)[seg.fit, j] for seg in segments])
+        times.append(integrated_time(w * r))
+    return float(np.median(times))
+
+
+def ranged(context, segments, chosen):
+    """The context with the positions the segments' fit samples cover (Context.q_range), if a
+    chosen effect depends on them (Effect.ranged); else the context itself (and its cache)."""
+    if not any(c.effect.ranged for c in chosen):
+        return context
+    q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
+    return dataclasses.replace(context, q_range=(q.min(axis=0), q.max(axis=0)), cache={})

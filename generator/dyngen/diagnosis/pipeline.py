@@ -1,0 +1,130 @@
+"""The diagnosis as a pipeline of stages, each a module with its inputs and outputs:
+
+    0. roles      the recordings cut into fit, selection and test samples (roles.py)
+    1. fit        the moments of every candidate effect (fit.py, moments.py)
+    2. select     forward selection on the selection data (selection.py)
+    3. settle     settings refined, insignificant effects pruned, implausible ones refused
+                  (settle.py, refine.py), once more with each joint weighted by what is left
+    4. choose     per joint: the effects, the simple model (baseline.py), both, or re-identified
+                  link parameters (choose.py, joints.py, reidentify.py); then the final fit on
+                  every fit sample
+    5. test       the figures on the judged data (judge.py, phases.py)
+    6. report     the findings (findings.py) and warnings (notes.py) in one record (record.py)
+
+    result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
+
+fit_signals set the values, select_signals (default: blocks of the fit data) choose the
+effects, test_signals are used for nothing but the reported held-out residual (roles.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..catalogue import STANDARD_FROM_DYNAMIC
+from . import baseline as simple_model
+from . import choose, fit, joints, reidentify, roles
+from .effects import Context, library
+from .findings import describe, fill_values, reported
+from .judge import judge, simple_mse
+from .notes import notes
+from .options import Options
+from .record import Diagnosis
+from .refine import restricted
+from .selection import forward, selection_mse, solve
+from .settle import settle
+
+
+def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options = Options(),
+             test=None) -> Diagnosis:
+    p = np.asarray(p, dtype=float)
+    s = model(STANDARD_FROM_DYNAMIC.name, p)
+    n = robot.dof
+    # 0. roles
+    segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
+    # Position- and velocity-dependent laws are known only over what the fit data cover.
+    fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
+    fit_qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
+    context = Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)),
+                      (fit_qd.min(axis=0), fit_qd.max(axis=0)))
+    # 1. fit
+    design = fit.build(context, library(context, options.effects), segments, n)
+
+    def correlation(chosen, fitted):
+        """Leaves each segment's correction at the chosen effects' values; the residual's
+        correlation time (the current context and design: the pipeline's own)."""
+        for seg in segments:
+            seg.correction = fit.predict(context, chosen, fitted.x, seg) if chosen else np.zeros_like(seg.residual)
+        return fit.correlation_time(segments, design.weights)
+
+    # 2. select
+    selection = forward(design, options.min_gain, options.alpha)
+    # 3. settle
+    design, chosen, final, dropped, refused = settle(context, segments, design, selection.chosen, correlation, options)
+    if chosen:
+        # Once more with each joint weighted by what the effects leave of its residual: an
+        # effect kept only to make up for another fitted with the nominal weights goes now.
+        design, chosen, final, dropped_now, refused_now = settle(
+            context, segments, fit.reweighted(design, final), chosen, correlation, options)
+        dropped += dropped_now
+        refused += refused_now
+    correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
+    # 4. choose, per joint: the effects, the simple model or both, all fitted on the fit samples
+    # only and compared on the selection samples (joints.py).
+    simple = simple_model.fit(segments)
+    sel_before = selection_mse(design, [])
+    sel_effects = selection_mse(design, chosen)
+    sel_simple = simple_mse(segments, simple, "select", n)
+    if not design.select.count:
+        modes = [joints.EFFECTS] * n
+    elif select_signals:
+        modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain)
+    else:
+        modes = choose.on_folds(context, segments, design, chosen, final, options)
+    reid, consistent = None, None
+    if options.reidentify and design.select.count:
+        reid, consistent, modes = choose.reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
+                                                      options.min_gain)
+    described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
+    # The choice made, every sample of the fit recordings sets the values (selection blocks
+    # included; separate selection recordings stay out of it, as test recordings do).
+    if not select_signals:
+        for seg in segments:
+            seg.fit = seg.fit | seg.select
+        simple = simple_model.fit(segments)
+        # position laws now known over every fit sample's positions
+        context = fit.ranged(context, segments, chosen)
+        if chosen:
+            design, chosen = restricted(context, segments, design, chosen)
+            final = solve(design, chosen)
+        if reid is not None:
+            reid, consistent = choose.refit(robot, model, p, segments, reid, consistent)
+    tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
+    fill_values(described, design, chosen, final, tau_corr, robot)
+    # 5. test
+    completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
+    judged = judge(design, segments, chosen, final, simple)
+    # 6. report
+    replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
+    selected, superseded = reported(chosen, described, replaced)
+    rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
+                                                    ("effects", judged.effects), ("simple", judged.simple))}
+    result = Diagnosis(
+        robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected,
+        rms_before=rms["before"], rms_after=rms["after"], rms_effects=rms["effects"], rms_simple=rms["simple"],
+        selection_before=np.sqrt(sel_before).tolist(), selection_after=np.sqrt(sel_effects).tolist(),
+        selection_simple=np.sqrt(sel_simple).tolist(),
+        simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=simple.values.tolist(),
+        peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
+        candidates=[{"candidate": k, "selection_gain": g}
+                    for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
+        steps=selection.steps, dropped=dropped, refused=refused, superseded=superseded, correlation_samples=tau_corr,
+        segments=segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
+        consistent=None if reid is None else reidentify.finding(
+            robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
+        reidentified=reid,
+        conditioning=[{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
+                      for role, group in (("fit", fit_signals), ("select", select_signals or []),
+                                          ("test", test or [])) for sig in group])
+    result.warnings = notes(result, model, s, fit_signals, select_signals or [], test or [], judged.used)
+    return result

@@ -1,0 +1,95 @@
+"""Stage 3, refine and settle: the selected effects with their nonlinear settings refined
+(refine.py), those that no longer pay for their values pruned, implausible ones refused and
+impossible ones simplified (a payload whose inertia is no body's)."""
+
+from __future__ import annotations
+
+from . import moments as dz
+from .refine import refine, restricted
+from .selection import bases, prune, selection_mse, solve, without
+
+
+def settle(context, segments, design, chosen, correlation, options):
+    """The selected effects with their settings refined, those that no longer pay for their
+    values pruned, implausible ones refused: (design, chosen, final fit, dropped, refused)."""
+    # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
+    # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
+    design, chosen = refine(context, segments, design, chosen)
+    before = chosen
+    chosen, _, dropped = prune(design, chosen, correlation, options.alpha, options.min_gain)
+    narrow = _narrow_stribeck(chosen)
+    chosen = [c for c in chosen if c not in narrow]
+    dropped += [f"{c.key} (no wider than the joint's Coulomb transition: it only reshapes it)" for c in narrow]
+    if dropped:
+        if _moved(context, chosen, before):
+            design, chosen = restricted(context, segments, design, chosen)
+        design, chosen = refine(context, segments, design, chosen)
+    before = chosen
+    chosen, final, refused = _plausible(design, chosen)
+    if _moved(context, chosen, before):
+        design, chosen = restricted(context, segments, design, chosen)
+        final = solve(design, chosen)
+    design, chosen, final = _consistent_payload(context, segments, design, chosen, final, refused)
+    return design, chosen, final, dropped, refused
+
+
+def _moved(context, chosen, before) -> bool:
+    """Whether dropping some of `before` changed what the others' columns are computed with
+    (design.world: a time shift, a gain or a payload went): then the design is rebuilt."""
+    return dz.world(context, chosen) != dz.world(context, before)
+
+
+def _plausible(design, chosen):
+    """The final fit, after refusing (one at a time, the worst first) effects whose values,
+    fitted together, are no longer physically possible (e.g. a payload of negative mass)."""
+    refused = []
+    while True:
+        final = solve(design, chosen)
+        values = dict(zip(map(id, chosen), dz.split_values(chosen, final.x)))
+        reasons = {}
+        for c in chosen:
+            if not c.effect.plausible(values[id(c)]):
+                reasons[id(c)] = ""
+            for base in bases(c, chosen):
+                why = c.effect.refusal_beside(values[id(c)], values[id(base)])
+                if why:
+                    reasons[id(c)] = f"beside {base.key} at {', '.join(f'{v:.3g}' for v in values[id(base)])}: {why}"
+        bad = [c for c in chosen if id(c) in reasons]
+        if not bad:
+            return chosen, final, refused
+        worst = bad[0]
+        refused.append({"candidate": worst.key, "values": values[id(worst)].tolist()}
+                       | ({"reason": reasons[id(worst)]} if reasons[id(worst)] else {}))
+        chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
+        refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone[1:]]
+
+
+def _consistent_payload(context, segments, design, chosen, final, refused):
+    """An effect whose fitted values are possible only in part (Effect.simplified: a payload
+    whose inertia is no body's) is replaced by the simpler form that does best on the
+    selection data (weighted as the fit), and everything refitted."""
+    offset = 0
+    for i, c in enumerate(chosen):
+        values = final.x[offset: offset + c.size]
+        offset += c.size
+        simpler = c.effect.simplified(values)
+        if simpler is None:
+            continue
+        refusal, forms = simpler
+        options = []
+        for effect in forms:
+            replaced = chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:]
+            form_design, form_chosen = restricted(context, segments, design, replaced)
+            score = float(design.weights ** 2 @ selection_mse(form_design, form_chosen))
+            options.append((score, form_design, form_chosen))
+        _, design, chosen = min(options, key=lambda o: o[0])
+        refused.append(refusal)
+        return design, chosen, solve(design, chosen)
+    return design, chosen, final
+
+
+def _narrow_stribeck(chosen) -> list:
+    """Per-joint effects that only reshape another on their joint (Effect.reshapes: a Stribeck
+    term no wider than the Coulomb transition)."""
+    return [c for c in chosen if c.joint is not None
+            and any(o.joint == c.joint and c.effect.reshapes(o.effect) for o in chosen)]

@@ -1,0 +1,162 @@
+"""A tilted base and a gravity of the wrong size, from the joint model's forward kinematics (the
+one numeric kinematics: description/joint_model.py).
+
+The gravity torque is linear in the gravity vector: g(q) = G(q) gvec, column k of G the joint
+torques of a unit gravity along base axis k. For joint i (axis z through o) and every link k it
+carries, with mass m_k and centre of mass p_k,
+    revolute:  G_i = - sum_k m_k (z x (p_k - o))      prismatic:  G_i = - sum_k m_k z
+(the potential is V = -sum m_k gvec . p_k and g = dV/dq).
+
+tilt: a rotation of the base turns gvec by d gvec = dg1 u1 + dg2 u2 across gravity (u1, u2,
+  n = gvec / |gvec| a right-handed triple: `directions`; for gravity along -z, u1 = base +x and
+  u2 = base -y), and shortens it along n by what keeps |gvec|: -(dg1^2 + dg2^2) / (2 |g|) to
+  second order. Its column k is G u_k - G n dg_k0 / (2 |g|), linearised at an estimate dg_k0 and
+  refitted there, so a tilt cannot change gravity's size. Beyond MAX_TILT_DEG it is no mounting
+  error.
+gravity_scale: G n dg: every link's gravity torque scaled alike (no tilt does this).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..description.joint_model import forward_kinematics
+from .base import Term, Value
+
+MAX_TILT_DEG = 10.0  # a larger tilt is no mounting error
+MAX_GRAVITY_SCALE = 0.1  # relative: a larger change of gravity's size is no tilt's nor a model's rounding
+
+
+def gravity_of(robot) -> np.ndarray | None:
+    """The YAML's gravity vector, or None where it has symbols or is zero (no tilt then)."""
+    try:
+        g = np.array([float(x) for x in robot.gravity])
+    except (TypeError, ValueError):
+        return None
+    return g if np.linalg.norm(g) > 0 else None
+
+
+def gravity_norm(robot) -> float:
+    return float(np.linalg.norm([float(x) for x in robot.gravity]))
+
+
+def directions(g) -> np.ndarray:
+    """(3, 3): rows u1, u2 across gravity and n along it, u2 = n x u1 (u1 the base axis least
+    along gravity, made perpendicular): for gravity along -z, base +x, base -y and -z."""
+    g = np.asarray(g, dtype=float)
+    n = g / np.linalg.norm(g)
+    seed = np.eye(3)[int(np.argmin(np.abs(n)))]
+    u1 = seed - (seed @ n) * n
+    u1 /= np.linalg.norm(u1)
+    return np.array([u1, np.cross(n, u1), n])
+
+
+def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
+    """u1, u2 of the robot's gravity (directions)."""
+    D = directions([float(x) for x in robot.gravity])
+    return D[0], D[1]
+
+
+def tilt_axes(robot) -> tuple[str, str]:
+    """Names of u1 and u2 in the base frame, e.g. ("base +x", "base -y") for gravity along -z."""
+    names = []
+    for u in tilt_directions(robot):
+        k = int(np.argmax(np.abs(u)))
+        if abs(abs(u[k]) - 1.0) < 1e-9:
+            names.append(f"base {'+' if u[k] > 0 else '-'}{'xyz'[k]}")
+        else:
+            names.append("base (" + ", ".join(f"{x:.3g}" for x in u) + ")")
+    return names[0], names[1]
+
+
+def tilt_angles_deg(robot, dg) -> tuple[float, float]:
+    """Rotation angles [deg] of gravity towards u1 and u2 for the components (dg1, dg2)."""
+    g = np.linalg.norm([float(x) for x in robot.gravity])
+    return float(np.degrees(np.arctan2(dg[0], g))), float(np.degrees(np.arctan2(dg[1], g)))
+
+
+def angle_deg(g, a) -> float:
+    """The tilt angle [deg] of the rotation that gives gravity the components a across it."""
+    return float(np.degrees(np.arcsin(min(np.hypot(*a) / np.linalg.norm(g), 1.0))))
+
+
+def change(g, a) -> np.ndarray:
+    """The change of g (coefficients along u1, u2, n) when the base turns so that gravity gains
+    the components a across it: a rotation, so the component along n shortens by
+    |g| - sqrt(|g|^2 - |a|^2)."""
+    size = float(np.linalg.norm(g))
+    a = np.asarray(a, dtype=float)
+    return np.array([a[0], a[1], np.sqrt(max(size ** 2 - float(a @ a), 0.0)) - size])
+
+
+def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
+    """G (T, N, 3) with g(q) = G(q) gvec for link parameters p (dynamic, 10N); poses: the
+    forward kinematics of q, if computed already."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    links = np.asarray(p, dtype=float).reshape(-1, 10)
+    poses = poses or forward_kinematics(robot.joint_models, q)
+    n = len(poses)
+    G = np.zeros((q.shape[0], n, 3))
+    centres = [pose.origin + np.einsum("tij,j->ti", pose.R, links[k, 1:4]) for k, pose in enumerate(poses)]
+    for i, model in enumerate(robot.joint_models):
+        z, o = poses[i].axis, poses[i].point
+        for k in range(i, n):
+            m = links[k, 0]
+            G[:, i, :] -= m * (np.cross(z, centres[k] - o) if model.revolute else z)
+    return G
+
+
+def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
+    """B (T, N, 3, 4): the G(q) of a body on the last link per unit of its standard values
+    (m, mx, my, mz; first moments in the last link's frame). Its mass times its centre is
+    m o_N + R_N (mx, my, mz), so for a revolute joint i (axis z through o):
+    B_i = -[z x (o_N - o), z x R_N e_x, z x R_N e_y, z x R_N e_z]; prismatic: [-z, 0, 0, 0]."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    poses = poses or forward_kinematics(robot.joint_models, q)
+    last = poses[-1]
+    B = np.zeros((q.shape[0], len(poses), 3, 4))
+    for i, model in enumerate(robot.joint_models):
+        z, o = poses[i].axis, poses[i].point
+        if model.revolute:
+            B[:, i, :, 0] = -np.cross(z, last.origin - o)
+            for k in range(3):
+                B[:, i, :, 1 + k] = -np.cross(z, last.R[:, :, k])
+        else:
+            B[:, i, :, 0] = -z
+    return B
+
+
+class Tilt(Term):
+    name, scope, doc = "tilt", "arm", "a tilted base: gravity turned by dg1 u1 + dg2 u2, its size kept"
+    values = (Value("dg1", "m/s^2"), Value("dg2", "m/s^2"))
+
+    @classmethod
+    def inside(cls, values, scales=None):
+        return bool(np.hypot(*values[:2]) < scales["g"] * np.sin(np.radians(MAX_TILT_DEG)))
+
+    @staticmethod
+    def columns(G, u1, u2, g: float, estimate=(0.0, 0.0)):
+        """(T, N, 2) from G (T, N, 3), linearised at the estimate (dg1, dg2)."""
+        along = G @ np.cross(u1, u2)
+        return np.stack([G @ u1 - along * estimate[0] / (2 * g), G @ u2 - along * estimate[1] / (2 * g)], axis=-1)
+
+
+class GravityScale(Term):
+    name, scope, doc = "gravity_scale", "arm", "gravity's size changed by dg: every link's gravity torque scaled alike"
+    values = (Value("dg", "m/s^2", -MAX_GRAVITY_SCALE, MAX_GRAVITY_SCALE, per="g"),)
+
+    @staticmethod
+    def columns(G, u1, u2):
+        return (G @ np.cross(u1, u2))[:, :, None]
+
+
+def rotation_columns(robot, p, q, g, a0=(0.0, 0.0)) -> np.ndarray:
+    """(T, N, 2): the tilt's columns at positions q for link parameters p and gravity g,
+    linearised at a0 (identify's rotation; the diagnosis's Tilt is the same term)."""
+    D = directions(g)
+    return Tilt.columns(gravity_matrix(robot, p, q), D[0], D[1], float(np.linalg.norm(g)), a0)
+
+
+def torque(robot, p, q, g, a) -> np.ndarray:
+    """(T, N): the exact torque change of the rotation (linear in the gravity vector)."""
+    return gravity_matrix(robot, p, q) @ (directions(g).T @ change(g, a))

@@ -1,0 +1,124 @@
+"""The torque terms (dyngen.terms): the emitted friction routine is, by construction, the law
+that was fitted. The compiled C of generated/lwr against each term's Python law at random
+states for every law alone and every combination; the diagnosis's own columns times its values
+against the C fed the friction vector its report writes (Coulomb and Stribeck both selected: the
+Stribeck sign keeps its own smoothing, not the Coulomb scale); and one combination against a
+law written out here by hand."""
+
+from __future__ import annotations
+
+import itertools
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from dyngen.description import load_robot
+from dyngen.diagnosis.effects import Context, Coulomb, Direction, Stribeck, Viscous
+from dyngen.diagnosis.model import friction_vector
+from dyngen.runtime import load
+from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, friction_torque
+
+N = 7
+
+
+@pytest.fixture(scope="module")
+def model():
+    return load(ROOT / "generated" / "lwr")
+
+
+def random_fields(rng, chosen, plain: bool):
+    """(N, fields): the chosen terms' fields random, the others zero; plain: every other joint's
+    velocity scales 0 (the plain sign; no Stribeck term)."""
+    f = np.zeros((N, len(FRICTION_FIELDS)))
+    k = 0
+    for term in IN_FRICTION:
+        for field in term.friction:
+            if term in chosen:
+                scale = rng.uniform(0.005, 0.3, N) if field.kind == "velocity" else rng.uniform(-1.0, 2.0, N)
+                if plain and field.kind == "velocity":
+                    scale[::2] = 0.0
+                f[:, k] = scale
+            k += 1
+    return f
+
+
+@pytest.mark.parametrize("plain", [False, True])
+@pytest.mark.parametrize("chosen", [c for r in range(1, len(IN_FRICTION) + 1)
+                                    for c in itertools.combinations(IN_FRICTION, r)],
+                         ids=lambda c: "+".join(t.name for t in c))
+def test_emitted_friction_is_the_terms_law(model, chosen, plain):
+    rng = np.random.default_rng(len(chosen) + 10 * plain)
+    f = random_fields(rng, chosen, plain).ravel()
+    for qd in rng.normal(0, 0.3, (20, N)):
+        qd[0] = 0.0  # the plain sign's zero
+        assert np.allclose(model("friction", qd, f), friction_torque(np, qd, f), rtol=1e-13, atol=1e-15)
+
+
+def test_friction_vector_of_a_diagnosis_is_the_fitted_law(model):
+    """Coulomb at a fitted scale vc with Stribeck, viscous and direction on one joint: the
+    friction vector effects.yaml writes, fed to the C, gives the diagnosis's columns @ values."""
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    sign_velocity = 0.002
+    context = Context(model, robot, None, None, sign_velocity)
+    chosen = [(Coulomb(0.04), {"Fc": 0.7}), (Stribeck(0.1), {"Fs": 0.3}), (Viscous(), {"Fv": 0.2}),
+              (Direction(), {"dFc": 0.05})]
+    selected = [{"effect": e.name, "joints": [3], "values": v, "variant": e.fixed()} for e, v in chosen]
+    f = friction_vector(SimpleNamespace(joints=N, selected=selected), sign_velocity)
+    rng = np.random.default_rng(3)
+    qd = rng.normal(0, 0.2, (50, N))
+    fitted = sum(e.columns(context, SimpleNamespace(qd=qd), None)[:, 2, 0] * next(iter(v.values())) for e, v in chosen)
+    emitted = np.array([model("friction", x, f)[2] for x in qd])
+    assert np.allclose(emitted, fitted, rtol=1e-12, atol=1e-14)
+    others = np.array([model("friction", x, f) for x in qd])[:, [0, 1, 3, 4, 5, 6]]
+    assert not others.any()  # nothing selected there
+
+
+def test_one_combination_against_the_law_written_out():
+    """An oracle independent of terms/: Fc tanh(v/vc) + Fv v + Fs tanh(v/es) exp(-(v/vs)^2)
+    + dFc |tanh(v/ed)|, the fields in the documented order."""
+    model = load(ROOT / "generated" / "lwr")
+    rng = np.random.default_rng(5)
+    Fc, vc, Fv, Fs, vs, es, dFc, ed = (rng.uniform(0.01, 1.0, N) for _ in range(8))
+    f = np.column_stack([Fc, vc, Fv, Fs, vs, es, dFc, ed]).ravel()
+    assert [x.name for x in FRICTION_FIELDS] == ["Fc", "vc", "Fv", "Fs", "vs", "es", "dFc", "ed"]
+    for v in rng.normal(0, 0.5, (10, N)):
+        law = Fc * np.tanh(v / vc) + Fv * v + Fs * np.tanh(v / es) * np.exp(-(v / vs) ** 2) + dFc * np.abs(np.tanh(v / ed))
+        assert np.allclose(model("friction", v, f), law, rtol=1e-13)
+
+
+def test_every_term_states_its_values_ranges_and_doc():
+    names = [t.name for t in TERMS]
+    assert len(set(names)) == len(names) == 13
+    for term in TERMS:
+        assert term.doc and term.scope in ("joint", "arm")
+        for value in term.values:
+            assert value.unit and value.low < value.high
+    from dyngen.terms import Coulomb as C, Gain, TimeShift
+    assert C.inside([0.3]) and not C.inside([-0.1])  # friction opposes motion
+    assert Gain.inside([0.2]) and not Gain.inside([0.6])  # a sensor reads 0.5 to 1.5 times the torque
+    assert not TimeShift.pointwise and C.pointwise  # a lag needs samples before a chunk
+
+
+def test_one_tilt_for_identify_and_diagnose():
+    """identify's rotation columns (terms.tilt.rotation_columns) and the diagnosis's Tilt are the
+    same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
+    gravity along -z), and the turned gravity vector keeps its size."""
+    from oracles.random_params import random_parameters
+
+    from dyngen.diagnosis.effects import Tilt
+    from dyngen.terms import tilt
+
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    p = random_parameters(7, 3, mass=(0.5, 3.0), second_moment=(0.002, 0.02))
+    q = np.random.default_rng(8).uniform(-2, 2, (30, 7))
+    g = tilt.gravity_of(robot)
+    assert np.allclose(tilt.directions(g), [[1, 0, 0], [0, -1, 0], [0, 0, -1]])
+    assert tilt.tilt_axes(robot) == ("base +x", "base -y")
+    context = Context(None, robot, p, None, 0.002)
+    estimate = (0.3, -0.5)
+    ours = Tilt.of(context).at(estimate).columns(context, SimpleNamespace(q=q), None)
+    assert np.allclose(tilt.rotation_columns(robot, p, q, g, estimate), ours, rtol=1e-12, atol=1e-12)
+    turned = g + tilt.directions(g).T @ tilt.change(g, estimate)
+    assert np.linalg.norm(turned) == pytest.approx(np.linalg.norm(g), rel=1e-12)
