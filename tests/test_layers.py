@@ -10,7 +10,8 @@ from conftest import ROOT
 
 PACKAGE = ROOT / "generator" / "dyngen"
 STAGES = (
-    {"dyngen", "errors", "untrusted", "arguments", "options", "parameters", "atomic", "cache", "progress", "blas"},
+    {"dyngen", "errors", "untrusted", "arguments", "options", "parameters", "atomic", "cache", "progress", "blas",
+     "yaml_policy", "output_paths"},
     {"description"},  # the robot, its joint model and kinematics
     {"terms"},  # the torque terms: columns, ranges and C of every term
     {"catalogue"},
