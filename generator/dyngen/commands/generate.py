@@ -44,7 +44,7 @@ def generate_step(args, robot, out_root="from args"):
 
 def summary(result, destination: Path, seconds: float) -> None:
     robot, bases = result.robot, result.bases
-    print(f"{robot.name}: {robot.dof} joints, {robot.convention} DH -> {destination}/ in {seconds:.1f} s")
+    print(f"{robot.name}: {robot.dof} joints, {robot.convention if robot.convention == 'urdf' else robot.convention + ' DH'} -> {destination}/ in {seconds:.1f} s")
     print("  base coefficients: " + ", ".join(f"{k} {b.rank}" for k, b in bases.items())
           + f" (of {10 * robot.dof} standard parameters)")
     width = max(len(f.name) for f in result.emitted.functions)

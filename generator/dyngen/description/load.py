@@ -44,8 +44,16 @@ _RESERVED = re.compile(r"(q|qd|qdd|s|c|x|a|b|p|m|mx|my|mz|XX|XY|XZ|YY|YZ|ZZ)\d+|
 
 
 def load_robot(path) -> Robot:
+    """A robot description: a YAML file, or a URDF (by its suffix; description/urdf.py)."""
     path = Path(path)
+    if path.suffix.lower() == ".urdf":
+        from .urdf import load_urdf
+
+        return load_urdf(path)
     return _Reader(path.name).robot(read_yaml(path))
+
+
+load_description = load_robot  # the one entry every command calls
 
 
 class _Reader:
