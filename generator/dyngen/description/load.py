@@ -43,13 +43,17 @@ _RESERVED = re.compile(r"(q|qd|qdd|s|c|x|a|b|p|m|mx|my|mz|XX|XY|XZ|YY|YZ|ZZ)\d+|
                        r"|pi|E|I|oo|nan|zoo|gravity|tau|[A-Z][A-Z0-9_]*_K")
 
 
-def load_robot(path) -> Robot:
-    """A robot description: a YAML file, or a URDF (by its suffix; description/urdf.py)."""
+def load_robot(path, **urdf_options) -> Robot:
+    """A robot description: a YAML file, or a URDF (by its suffix; description/urdf.py, which
+    takes urdf_options base_link, tip_link, snap)."""
     path = Path(path)
     if path.suffix.lower() == ".urdf":
         from .urdf import load_urdf
 
-        return load_urdf(path)
+        return load_urdf(path, **urdf_options)
+    if urdf_options:
+        raise InputError(path.name, "", f"{', '.join(sorted(urdf_options))}: options for a URDF; in a YAML that "
+                         "points to one, write them next to urdf:")
     return _Reader(path.name).robot(read_yaml(path))
 
 
