@@ -3,8 +3,10 @@ the inertials (docs/urdf.md).
 
 A URDF joint is a placement (origin xyz, rpy) followed by a turn about, or a slide along, its
 unit axis u. With R_u the rotation taking z to u, that is  placement * R_u * motion_z(q) * R_u^T,
-so the joint frame J_i is the placement turned by R_u and link frame i is exactly the URDF's
-child link frame (R_u = I when the axis is z, as in most URDFs). Fixed joints are folded into
+so the joint frame J_i is the placement turned by R_u. dyngen's link frame i is J_i itself
+(z along the axis, frame_i = I, as in modified DH): the URDF's child link frame is J_i turned by
+R_u^T (the same frame when the axis is z, as in most URDFs), folded into the next placement and
+into the link's inertial (docs/urdf.md). Fixed joints are folded into
 the next joint's placement and their links' inertials into the body (lumping.py); links beyond
 the tip are locked at zero and lumped into the tip.
 """
@@ -81,10 +83,12 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
             bodies.append((body_link, body))
         u = snapping.axis(joint.axis, joint.name, snaps, snap)
         align = _align(u)
-        transposed = Rigid(sp.ImmutableMatrix(align.R.T), align.p)
-        models.append(JointModel(MOVING[joint.type], fixed * origin * align, sp.Integer(0), transposed))
+        # Link frame i is the joint frame (frame_i = I, as in modified DH: the shortest code); the
+        # URDF child link sits in it turned by R_u^T, which the next placement and the inertials absorb.
+        models.append(JointModel(MOVING[joint.type], fixed * origin * align, sp.Integer(0), Rigid.identity()))
         joints.append(Joint(MOVING[joint.type], 0, 0, 0, 0, _limits(joint)))
-        fixed, body, body_link = Rigid.identity(), Body.empty(), joint.child
+        fixed = Rigid(sp.ImmutableMatrix(align.R.T), align.p)
+        body, body_link = Body.empty(), joint.child
     if not models:
         fail("tip_link", f"no revolute, continuous or prismatic joint between {shorten(base)!r} and {shorten(tip)!r}")
     body = body + _subtree(urdf, tip, children, on_path, fixed, source, notes, tip, snap)
