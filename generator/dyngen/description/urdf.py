@@ -25,6 +25,7 @@ from .angles import cos_sin
 from .joint_model import PRISMATIC, REVOLUTE, JointModel, Rigid, _floats
 from .lumping import Body
 from .robot import Joint, Limits, LinkValues, Robot
+from .sliding import slide
 from .urdf_xml import read_urdf
 
 MOVING = {"revolute": REVOLUTE, "continuous": REVOLUTE, "prismatic": PRISMATIC}
@@ -93,6 +94,7 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
         fail("tip_link", f"no revolute, continuous or prismatic joint between {shorten(base)!r} and {shorten(tip)!r}")
     body = body + _subtree(urdf, tip, children, on_path, fixed, source, notes, tip, snap)
     bodies.append((body_link, body))
+    models, bodies = slide(models, bodies)
     nominal = []
     for link, b in bodies:
         if b.mass < MIN_MASS:
