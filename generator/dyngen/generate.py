@@ -16,6 +16,7 @@ from .emission.render import Emitted, emit
 from .progress import Progress
 from .errors import InputError
 from .reduction.base import BaseSet, reduce_model
+from .reduction.exact import NotInField
 
 
 @dataclass
@@ -56,7 +57,11 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
         models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix(),
                   "unit_accelerations": derivation.unit_accelerations()}
     with progress.step("reduce to base coefficients (exact rank)"):
-        bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
+        try:
+            bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
+        except NotInField as err:  # non-exact angles whose products outgrow the largest prime
+            raise InputError(robot.source, "", f"{err}; the arm's angles are not exact multiples of pi/12 and "
+                             "their rational forms grew too large (let dyngen snap them: drop --no-snap)") from None
         if bases["gravity"].rank == 0:  # C has no zero-length arrays for pi_gravity and Y_g
             raise InputError(robot.source, "gravity", "no joint of this arm moves against gravity (the gravity "
                              "vector is identically zero, e.g. a horizontal SCARA); dyngen needs at least one "

@@ -56,7 +56,7 @@ P = MERSENNE.P  # the default field's prime, for callers that need only it
 
 # Primes P = 24 (2^bits // 24 + k) + 1 (P = 1 mod 24: 2 and 3 are squares mod P); each k found
 # once with sympy.isprime (tests/test_general_frames.py checks them).
-LADDER = ((256, 13), (640, 185), (1280, 107))
+LADDER = ((256, 13), (640, 185), (1280, 107), (2560, 210), (4096, 74))
 
 
 @functools.lru_cache(maxsize=None)
