@@ -82,6 +82,9 @@ class Robot:
     snaps: tuple = ()  # description/snapping.py Snap records (a URDF's constants made exact)
     notes: tuple = ()  # what the reader did that the user should know (links lumped beyond the tip)
     links: tuple = ()  # the URDF link name of each moving body
+    link_frames: tuple = ()  # per body: the URDF link's frame in dyngen's link frame i (a Rigid)
+    urdf_file: Optional[str] = None  # the URDF read (its full path), for export/urdf_copy.py
+    urdf_options: dict = field(default_factory=dict)  # base_link, tip_link, snap it was read with
 
     @property
     def dof(self) -> int:

@@ -18,9 +18,11 @@ from .joint_model import JointModel, Rigid
 from .lumping import Body
 
 
-def slide(models: list, bodies: list) -> tuple[list, list]:
-    """models: JointModels with frame = I; bodies: (link name, Body in link frame i)."""
+def slide(models: list, bodies: list) -> tuple[list, list, list]:
+    """models: JointModels with frame = I; bodies: (link name, Body in link frame i).
+    Returns the slid models and bodies and each lambda."""
     models, bodies = list(models), list(bodies)
+    lambdas = [sp.Integer(0)] * len(models)
     for i, model in enumerate(models):
         axis = model.placement.R[:, 2]  # z_i in frame i-1
         following = models[i + 1].placement.p if i + 1 < len(models) else None
@@ -37,10 +39,11 @@ def slide(models: list, bodies: list) -> tuple[list, list]:
         lam = max(sorted(candidates, key=lambda x: (abs(x), x)), key=zeros)  # ties: the smallest move
         if lam == 0:
             continue
+        lambdas[i] = lam
         models[i] = JointModel(model.type, model.placement * Rigid.trans(z=lam), model.offset, model.frame)
         if following is not None:
             nxt = models[i + 1]
             models[i + 1] = JointModel(nxt.type, Rigid.trans(z=-lam) * nxt.placement, nxt.offset, nxt.frame)
         link, body = bodies[i]
         bodies[i] = (link, Body(body.mass, body.com - np.array([0.0, 0.0, float(lam)]), body.inertia))
-    return models, bodies
+    return models, bodies, lambdas

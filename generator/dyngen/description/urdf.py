@@ -66,7 +66,7 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
     on_path = {j.name for j in path_joints}
 
     snaps, notes = [], []
-    models, joints, bodies = [], [], []
+    models, joints, bodies, link_frames = [], [], [], []
     fixed = Rigid.identity()  # from the current body's frame (or the base) to the joint reached
     body, body_link = None, None
     for joint in path_joints:
@@ -89,12 +89,14 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
         models.append(JointModel(MOVING[joint.type], fixed * origin * align, sp.Integer(0), Rigid.identity()))
         joints.append(Joint(MOVING[joint.type], 0, 0, 0, 0, _limits(joint)))
         fixed = Rigid(sp.ImmutableMatrix(align.R.T), align.p)
+        link_frames.append(fixed)
         body, body_link = Body.empty(), joint.child
     if not models:
         fail("tip_link", f"no revolute, continuous or prismatic joint between {shorten(base)!r} and {shorten(tip)!r}")
     body = body + _subtree(urdf, tip, children, on_path, fixed, source, notes, tip, snap)
     bodies.append((body_link, body))
-    models, bodies = slide(models, bodies)
+    models, bodies, lambdas = slide(models, bodies)
+    link_frames = [Rigid.trans(z=-lam) * frame for lam, frame in zip(lambdas, link_frames)]
     nominal = []
     for link, b in bodies:
         if b.mass < MIN_MASS:
@@ -108,7 +110,9 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
     return Robot(name=robot_name, source=source, convention="urdf", joints=tuple(joints),
                  gravity=tuple(gravity or (sp.Integer(0), sp.Integer(0), sp.Rational("-9.81"))),
                  nominal=tuple(nominal), models=tuple(models), snaps=tuple(snaps), notes=tuple(notes),
-                 links=tuple(link for link, _ in bodies))
+                 links=tuple(link for link, _ in bodies), link_frames=tuple(link_frames),
+                 urdf_file=str(Path(path).resolve()),
+                 urdf_options={"base_link": base_link, "tip_link": tip_link, "snap": snap})
 
 
 def _unique_leaf(urdf, base, children, fail):
