@@ -71,3 +71,24 @@ def test_no_snap_keeps_the_rounded_arm(files):
     exact_model, exact_data = pinocchio_chain(DATA / "kinova.urdf", robot.links)
     assert snapped["full"].rank == numerical_rank(exact_model, exact_data, "full", np.random.default_rng(2))
     assert bases["full"].rank > snapped["full"].rank  # the rounding breaks exact cancellations
+
+
+def test_snap_effect_is_the_gravity_change_pinocchio_sees(files):
+    """The reported effect of the first snap (shoulder_lift 1.5708 -> pi/2) against Pinocchio's
+    gravity torques of the file with only that angle rounded, minus those of the exact file."""
+    from dyngen.description.snap_effect import STATES, gravity_torques
+
+    robot = load_urdf(files / "rounded.urdf")
+    text = (DATA / "ur5_robot.urdf").read_text()
+    one = text.replace("1.57079632679", ROUNDED, 1).replace("1.57079632679", repr(np.pi / 2))
+    (files / "one_rounded.urdf").write_text(one)
+    rounded, rdata = pinocchio_chain(files / "one_rounded.urdf", robot.links)
+    exact, edata = pinocchio_chain(files / "exact.urdf", robot.links)
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (STATES, robot.dof))
+    change = max(np.max(np.abs(pin.computeGeneralizedGravity(rounded, rdata, configuration(rounded, x))
+                               - pin.computeGeneralizedGravity(exact, edata, configuration(exact, x)))) for x in q)
+    assert robot.snaps[0].joint == "shoulder_lift_joint"
+    assert abs(robot.snap_effects[0] - change) < 1e-9 * max(1.0, change) + 1e-12
+    assert np.allclose(gravity_torques(robot, q[:5]),
+                       [pin.computeGeneralizedGravity(exact, edata, configuration(exact, x)) for x in q[:5]],
+                       rtol=0, atol=1e-9)

@@ -50,8 +50,9 @@ def generate_step(args, robot, out_root="from args"):
 def summary(result, destination: Path, seconds: float) -> None:
     robot, bases = result.robot, result.bases
     print(f"{robot.name}: {robot.dof} joints, {robot.convention if robot.convention == 'urdf' else robot.convention + ' DH'} -> {destination}/ in {seconds:.1f} s")
-    for snap in robot.snaps:
-        print(f"  snapped {snap.joint} {snap.field}: {snap.before} -> {snap.after} (--no-snap keeps it)")
+    for snap, effect in zip(robot.snaps, robot.snap_effects or [None] * len(robot.snaps)):
+        change = f", gravity torques change by at most {effect:.1e}" if effect is not None else ""
+        print(f"  snapped {snap.joint} {snap.field}: {snap.before} -> {snap.after}{change} (--no-snap keeps it)")
     for note in robot.notes:
         print(f"  note: {note}")
     print("  base coefficients: " + ", ".join(f"{k} {b.rank}" for k, b in bases.items())

@@ -80,6 +80,7 @@ class Robot:
     extraction: dict = field(default_factory=dict)  # settings: procedure, restarts, seed, margin, identities, compare
     models: Optional[tuple] = None  # JointModels given directly (a URDF); None: built from the DH table
     snaps: tuple = ()  # description/snapping.py Snap records (a URDF's constants made exact)
+    snap_effects: tuple = ()  # per snap: the largest gravity-torque change it causes (snap_effect.py)
     notes: tuple = ()  # what the reader did that the user should know (links lumped beyond the tip)
     links: tuple = ()  # the URDF link name of each moving body
     link_frames: tuple = ()  # per body: the URDF link's frame in dyngen's link frame i (a Rigid)

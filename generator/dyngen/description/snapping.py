@@ -28,6 +28,11 @@ class Snap:
     after: str  # the exact value used
 
 
+def allowed(snap, joint: str, field: str) -> bool:
+    """snap: True, False, or a frozenset of (joint, field) to keep as written (snap_effect.py)."""
+    return snap is True or (isinstance(snap, frozenset) and (joint, field) not in snap)
+
+
 def length(text: str) -> sp.Rational:
     return sp.Rational(text)
 
@@ -38,7 +43,7 @@ def angle(text: str, joint: str, field: str, snaps: list, snap: bool = True) -> 
     exact = k * STEP
     if abs(value - float(exact)) <= 1e-15 * max(1.0, abs(value)) or value == 0:
         return exact if value != 0 else sp.Integer(0)
-    if snap and abs(value - float(exact)) <= ANGLE_TOLERANCE:
+    if allowed(snap, joint, field) and abs(value - float(exact)) <= ANGLE_TOLERANCE:
         snaps.append(Snap(joint, field, text, str(exact)))
         return exact
     return sp.Rational(text)
@@ -53,7 +58,7 @@ def axis(texts, joint: str, snaps: list, snap: bool = True) -> tuple:
                -1 if abs(u + 1) <= AXIS_TOLERANCE else None) for u in unit]
     if None not in snapped and sum(abs(s) for s in snapped) == 1:
         if snapped != values:
-            if snap:
+            if allowed(snap, joint, "axis"):
                 snaps.append(Snap(joint, "axis", " ".join(texts), " ".join(str(s) for s in snapped)))
             else:
                 return tuple(unit)

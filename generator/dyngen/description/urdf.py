@@ -14,6 +14,7 @@ the tip are locked at zero and lumped into the tip.
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +27,7 @@ from .joint_model import PRISMATIC, REVOLUTE, JointModel, Rigid, _floats
 from .lumping import Body
 from .robot import Joint, Limits, LinkValues, Robot
 from .sliding import slide
+from .snap_effect import snap_effects
 from .urdf_xml import read_urdf
 
 MOVING = {"revolute": REVOLUTE, "continuous": REVOLUTE, "prismatic": PRISMATIC}
@@ -107,12 +109,16 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
         nominal.append(LinkValues(float(b.mass), tuple(float(x) for x in b.com),
                                   (I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2])))
     robot_name = name or _c_name(urdf.name)
-    return Robot(name=robot_name, source=source, convention="urdf", joints=tuple(joints),
+    robot = Robot(name=robot_name, source=source, convention="urdf", joints=tuple(joints),
                  gravity=tuple(gravity or (sp.Integer(0), sp.Integer(0), sp.Rational("-9.81"))),
                  nominal=tuple(nominal), models=tuple(models), snaps=tuple(snaps), notes=tuple(notes),
                  links=tuple(link for link, _ in bodies), link_frames=tuple(link_frames),
                  urdf_file=str(Path(path).resolve()),
                  urdf_options={"base_link": base_link, "tip_link": tip_link, "snap": snap})
+    if robot.snaps and snap is True:  # each snap's effect, from the file read with that one kept
+        effects = snap_effects(robot, lambda keep: load_urdf(path, base_link, tip_link, keep, name, gravity, source))
+        robot = replace(robot, snap_effects=effects)
+    return robot
 
 
 def _unique_leaf(urdf, base, children, fail):
