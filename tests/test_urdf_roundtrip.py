@@ -86,3 +86,15 @@ def _chain_joint_names(path, robot):
     joints = {j.get("name"): j for j in ET.fromstring(path.read_text()).findall("joint")}
     by_child = {j.find("child").get("link"): name for name, j in joints.items()}
     return [by_child[link] for link in robot.links]
+
+
+def test_fresh_export_of_an_arm_read_from_urdf(arm):
+    """dyngen's own URDF export (joint frames as links) of an arm read from a URDF, in Pinocchio."""
+    from dyngen.export import to_urdf
+
+    robot, c, p, _, _ = arm
+    model = pin.buildModelFromXML(to_urdf(robot, p))
+    data = model.createData()
+    s = c("standard_from_dynamic", p)
+    for q, qd, qdd in states(robot.dof):
+        assert rel_err(c("rnea", q, qd, qdd, s), pin.rnea(model, data, q, qd, qdd)) < 1e-9
