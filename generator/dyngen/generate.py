@@ -15,7 +15,7 @@ from .emission.render import Emitted, emit
 from .progress import Progress
 from .errors import InputError
 from .reduction.base import BaseSet, reduce_model
-from .reduction.exact import Reconstruction
+from .reduction.exact import NotInField
 
 
 @dataclass
@@ -58,8 +58,9 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
     with progress.step("reduce to base coefficients (exact rank)"):
         try:
             bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
-        except Reconstruction as err:
-            raise InputError(robot.source, "joints", f"the exact regrouping failed ({err})") from None
+        except NotInField as err:  # non-exact angles whose products outgrow the largest prime
+            raise InputError(robot.source, "", f"the exact regrouping failed ({err}); a URDF's angles "
+                             "that are not multiples of pi/12 make it grow: let dyngen snap them (drop --no-snap)") from None
         if bases["gravity"].rank == 0:  # C has no zero-length arrays for pi_gravity and Y_g
             raise InputError(robot.source, "gravity", "no joint of this arm moves against gravity (the gravity "
                              "vector is identically zero, e.g. a horizontal SCARA); dyngen needs at least one "

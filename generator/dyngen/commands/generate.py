@@ -17,7 +17,12 @@ def parser(prog: str) -> argparse.ArgumentParser:
         prog=prog, description="Derive the regressors and Newton-Euler of an arm symbolically, reduce them to "
         "a minimal set of base coefficients and emit standalone C99 (header, sources, CMakeLists.txt, "
         "manifest.json, coefficients.md) into DIR/<robot name>/.")
-    result.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
+    result.add_argument("robot", metavar="ROBOT.yaml", help="robot description: a YAML (docs/conventions.md) "
+                        "or a URDF (docs/urdf.md)")
+    result.add_argument("--base-link", metavar="NAME", help="URDF: the chain's first link (default: the root)")
+    result.add_argument("--tip-link", metavar="NAME", help="URDF: the chain's last link (default: the unique leaf)")
+    result.add_argument("--no-snap", action="store_true",
+                        help="URDF: keep angles and axes as written (default: snap them to exact values)")
     result.add_argument("-o", "--output", default="generated", metavar="DIR",
                         help="parent folder of the robot's output folder (default: generated)")
     result.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
@@ -58,7 +63,12 @@ def generate_step(args, robot, out_root="from args"):
 
 def summary(result, destination: Path, seconds: float) -> None:
     robot, bases = result.robot, result.bases
-    print(f"{robot.name}: {robot.dof} joints, {robot.convention} DH -> {destination}/ in {seconds:.1f} s")
+    print(f"{robot.name}: {robot.dof} joints, {robot.convention if robot.convention == 'urdf' else robot.convention + ' DH'} -> {destination}/ in {seconds:.1f} s")
+    for snap, effect in zip(robot.snaps, robot.snap_effects or [None] * len(robot.snaps)):
+        change = f", gravity torques change by at most {effect:.1e}" if effect is not None else ""
+        print(f"  snapped {snap.joint} {snap.field}: {snap.before} -> {snap.after}{change} (--no-snap keeps it)")
+    for note in robot.notes:
+        print(f"  note: {note}")
     print("  base coefficients: " + ", ".join(f"{k} {b.rank}" for k, b in bases.items())
           + f" (of {10 * robot.dof} standard parameters)")
     width = max(len(f.name) for f in result.emitted.functions)
@@ -70,6 +80,9 @@ def summary(result, destination: Path, seconds: float) -> None:
 
 
 def load(args):
-    from ..description import load_robot
+    from ..description import load_description
 
-    return load_robot(args.robot)
+    urdf = {k: getattr(args, k) for k in ("base_link", "tip_link") if getattr(args, k, None)}
+    if getattr(args, "no_snap", False):
+        urdf["snap"] = False
+    return load_description(args.robot, **urdf)

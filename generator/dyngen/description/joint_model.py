@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
+from .angles import cos_sin
+
 REVOLUTE, PRISMATIC = "revolute", "prismatic"
 
 
@@ -38,11 +40,11 @@ class Rigid:
 
     @staticmethod
     def rot_x(angle) -> "Rigid":
-        return Rigid(sp.ImmutableMatrix(rot_x(sp.cos(angle), sp.sin(angle))), sp.ImmutableMatrix(sp.zeros(3, 1)))
+        return Rigid(sp.ImmutableMatrix(rot_x(*cos_sin(angle))), sp.ImmutableMatrix(sp.zeros(3, 1)))
 
     @staticmethod
     def rot_z(angle) -> "Rigid":
-        return Rigid(sp.ImmutableMatrix(rot_z(sp.cos(angle), sp.sin(angle))), sp.ImmutableMatrix(sp.zeros(3, 1)))
+        return Rigid(sp.ImmutableMatrix(rot_z(*cos_sin(angle))), sp.ImmutableMatrix(sp.zeros(3, 1)))
 
     @staticmethod
     def trans(x=0, y=0, z=0) -> "Rigid":

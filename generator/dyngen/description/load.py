@@ -21,6 +21,8 @@ from .expressions import ExpressionError, exact_number, parse_expression, shorte
 from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
 
 _TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
+_URDF_KEYS = {"urdf", "base_link", "tip_link", "snap", "name", "description", "gravity", "parameters", "identified",
+              "extraction", "limits"}
 _EXTRACTION_KEYS = yaml_keys(ExtractionOptions) | {"compare"}  # every extraction option, and the compared file
 _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
@@ -43,9 +45,24 @@ _RESERVED = re.compile(r"(q|qd|qdd|s|c|x|a|b|p|m|mx|my|mz|XX|XY|XZ|YY|YZ|ZZ)\d+|
                        r"|pi|E|I|oo|nan|zoo|gravity|tau|[A-Z][A-Z0-9_]*_K")
 
 
-def load_robot(path) -> Robot:
+def load_robot(path, **urdf_options) -> Robot:
+    """A robot description: a YAML file, or a URDF (by its suffix; description/urdf.py, which
+    takes urdf_options base_link, tip_link, snap)."""
     path = Path(path)
-    return _Reader(printable(path.name)).robot(read_yaml(path))  # the name reaches comments and the terminal
+    if path.suffix.lower() == ".urdf":
+        from .urdf import load_urdf
+
+        return load_urdf(path, **urdf_options)
+    if urdf_options:
+        raise InputError(path.name, "", f"{', '.join(sorted(urdf_options))}: options for a URDF; in a YAML that "
+                         "points to one, write them next to urdf:")
+    doc = read_yaml(path)
+    if isinstance(doc, dict) and "urdf" in doc:
+        return _Reader(printable(path.name)).urdf_robot(doc, path.parent)
+    return _Reader(printable(path.name)).robot(doc)  # the name reaches comments and the terminal
+
+
+load_description = load_robot  # the one entry every command calls
 
 
 class _Reader:
@@ -141,6 +158,67 @@ class _Reader:
         return Robot(name=name, source=self.source, convention=convention, joints=joints, gravity=gravity,
                      nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified,
                      extraction=extraction)
+
+    def urdf_robot(self, doc, folder: Path) -> Robot:
+        """A YAML that points to a URDF (urdf:, base_link, tip_link, snap) and adds what a URDF lacks:
+        gravity, parameter bounds, identified coefficients, extraction settings."""
+        from dataclasses import replace
+
+        from .urdf import load_urdf
+
+        doc = self.mapping(doc, "", _URDF_KEYS)
+        target = doc["urdf"]
+        if (not isinstance(target, str) or not target or len(target) > 255 or Path(target).is_absolute()
+                or ".." in Path(target).parts or "\0" in target):
+            self.fail("urdf", f"expected the name of a URDF in the description's folder, got {_describe(target)}")
+        options = {}
+        for key in ("base_link", "tip_link"):
+            if key in doc:
+                if not isinstance(doc[key], str) or not doc[key]:
+                    self.fail(key, f"expected a link name, got {_describe(doc[key])}")
+                options[key] = doc[key]
+        if "snap" in doc:
+            if not isinstance(doc["snap"], bool):
+                self.fail("snap", f"expected true or false, got {_describe(doc['snap'])}")
+            options["snap"] = doc["snap"]
+        robot = load_urdf(folder / target, **options)
+        changes = {"source": self.source}
+        if "name" in doc:
+            if not isinstance(doc["name"], str) or not _C_NAME.fullmatch(doc["name"]):
+                self.fail("name", f"expected a lowercase C identifier, got {_describe(doc['name'])}")
+            changes["name"] = doc["name"]
+        if "gravity" in doc:
+            changes["gravity"] = tuple(
+                self.exact(g, f"gravity[{k}]", "a number or a symbol name", allow_symbols=True,
+                           limit=MAX_GRAVITY, smallest=1e-9)
+                for k, g in enumerate(self.sequence(doc["gravity"], "gravity", 3)))
+        n = robot.dof
+        params = self.mapping(doc.get("parameters") or {}, "parameters", _PARAMETER_KEYS)
+        if "nominal" in params:
+            changes["nominal"] = tuple(self.link_values(v, f"parameters.nominal[{i}]")
+                                       for i, v in enumerate(self.sequence(params["nominal"], "parameters.nominal", n)))
+        if "bounds" in params:
+            pairs = [self.link_bounds(v, f"parameters.bounds[{i}]")
+                     for i, v in enumerate(self.sequence(params["bounds"], "parameters.bounds", n))]
+            changes["lower"], changes["upper"] = tuple(lo for lo, _ in pairs), tuple(hi for _, hi in pairs)
+        if "total_mass" in params:
+            changes["total_mass"] = self.interval(params["total_mass"], "parameters.total_mass", MAX_MASS)
+        names = {sym.name: sym for sym in standard_symbols(n) + dynamic_symbols(n)}
+        ident = self.mapping(doc.get("identified") or {}, "identified", set(_IDENTIFIED_KINDS))
+        changes["identified"] = {kind: tuple(self.coefficient(c, f"identified.{kind}[{k}]", names)
+                                             for k, c in enumerate(self.sequence(ident[kind], f"identified.{kind}")))
+                                 for kind in _IDENTIFIED_KINDS if kind in ident}
+        changes["extraction"] = self.extraction(doc.get("extraction") or {}, names)
+        if "limits" in doc:  # per joint, in chain order: what excite needs beyond the URDF's
+            raw = self.sequence(doc["limits"], "limits", n)
+            joints = []
+            for i, (joint, value) in enumerate(zip(robot.joints, raw)):
+                limits = self.joint({"type": joint.type, "limits": value}, f"limits[{i}]").limits
+                merged = {k: getattr(limits, k) if getattr(limits, k) is not None else getattr(joint.limits, k)
+                          for k in ("lower", "upper", "velocity", "acceleration", "effort")}
+                joints.append(replace(joint, limits=Limits(**merged)))
+            changes["joints"] = tuple(joints)
+        return replace(robot, **changes)
 
     def extraction(self, value, names) -> dict:
         value = dict(self.mapping(value, "extraction", _EXTRACTION_KEYS))

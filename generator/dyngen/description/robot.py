@@ -78,6 +78,14 @@ class Robot:
     total_mass: Optional[tuple[float, float]] = None
     identified: dict = field(default_factory=dict)  # kind -> tuple[IdentifiedCoefficient]
     extraction: dict = field(default_factory=dict)  # settings: procedure, restarts, seed, margin, identities, compare
+    models: Optional[tuple] = None  # JointModels given directly (a URDF); None: built from the DH table
+    snaps: tuple = ()  # description/snapping.py Snap records (a URDF's constants made exact)
+    snap_effects: tuple = ()  # per snap: the largest gravity-torque change it causes (snap_effect.py)
+    notes: tuple = ()  # what the reader did that the user should know (links lumped beyond the tip)
+    links: tuple = ()  # the URDF link name of each moving body
+    link_frames: tuple = ()  # per body: the URDF link's frame in dyngen's link frame i (a Rigid)
+    urdf_file: Optional[str] = None  # the URDF read (its full path), for export/urdf_copy.py
+    urdf_options: dict = field(default_factory=dict)  # base_link, tip_link, snap it was read with
 
     @property
     def dof(self) -> int:
@@ -86,7 +94,7 @@ class Robot:
     @cached_property
     def joint_models(self) -> tuple:
         """One JointModel per joint (description/joint_model.py), built once from the DH table."""
-        return joint_models(self.convention, self.joints)
+        return self.models if self.models is not None else joint_models(self.convention, self.joints)
 
     @property
     def gravity_symbols(self) -> tuple[sp.Symbol, ...]:

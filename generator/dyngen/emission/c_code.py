@@ -45,12 +45,22 @@ class Printer(C99CodePrinter):
 
     def _print_Mul(self, expr):
         coeff, rest = expr.as_coeff_Mul()
+        constant, rest = _constant_part(expr)
+        if not constant.is_Rational:  # sqrt(2)/2*x: one constant, as opcount.py counts it
+            sign = "-" if constant < 0 else ""
+            return f"{sign}{self._print_irrational(abs(constant))}*{self.parenthesize(rest, 50)}"
         if coeff.is_Rational and not coeff.is_Integer:
             sign = "-" if coeff < 0 else ""
             return f"{sign}{self._print_Rational(abs(coeff))}*{self.parenthesize(rest, 50)}"
         return super()._print_Mul(expr)
 
+    def _print_irrational(self, expr):
+        """An exact constant like sqrt(2)/2 (a twist of pi/4), as the double nearest to it."""
+        return f"{self.macro}_K({float(expr)!r})"
+
     def _print_Pow(self, expr):
+        if expr.is_number:
+            return self._print_irrational(expr)
         if expr.exp.is_Integer and 1 < expr.exp <= 4:
             base = self.parenthesize(expr.base, 100)
             return "*".join([base] * int(expr.exp))
@@ -63,6 +73,12 @@ class Printer(C99CodePrinter):
 
     def _print_cos(self, expr):
         return f"{self.macro}_COS({self._print(expr.args[0])})"
+
+
+def _constant_part(expr):
+    """(numeric factor, the rest) of a product: sqrt(2)/2*x -> (sqrt(2)/2, x)."""
+    numbers = [f for f in expr.args if f.is_number]
+    return sp.Mul(*numbers), sp.Mul(*(f for f in expr.args if not f.is_number))
 
 
 def decimal_text(r: sp.Rational) -> str:

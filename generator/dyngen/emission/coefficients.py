@@ -20,7 +20,8 @@ def grouped_text(row, names) -> str:
             terms += [(k, name) for name in group]
         else:
             body = group[0] if len(group) == 1 else "(" + " + ".join(group) + ")"
-            terms.append((k, f"{decimal_text(abs(k))}*{body}"))
+            size = decimal_text(abs(k)) if k.is_Rational else f"({abs(k)})"  # e.g. (sqrt(2)/2)
+            terms.append((k, f"{size}*{body}"))
     text = ""
     for k, term in terms:
         if not text:

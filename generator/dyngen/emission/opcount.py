@@ -46,6 +46,9 @@ def _count(e, c):
         c["add"] += len(e.args) - 1
     elif e.is_Mul:
         coeff, factors = e.as_coeff_mul()
+        constants = [f for f in factors if f.is_number]  # sqrt(2)/2*x: one constant factor (as printed)
+        if constants:
+            coeff, factors = sp.Mul(coeff, *constants), tuple(f for f in factors if not f.is_number)
         denominators = [f for f in factors if f.is_Pow and f.exp.is_negative]
         numerators = len(factors) - len(denominators) + (0 if abs(coeff) == 1 else 1)
         c["mul"] += max(numerators - 1, 0) + max(len(denominators) - 1, 0)

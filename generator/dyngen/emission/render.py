@@ -99,6 +99,11 @@ def emit(robot, derivation, regressors: dict, bases: dict, models: dict) -> Emit
                          "selftest": f"{P}_selftest.c", "cmake": "CMakeLists.txt",
                          "extractor_kinds": f"{P}_kinds.h"}
     manifest["selftest"] = check.as_dict() | {"tolerance": TOLERANCE}
+    if robot.convention == "urdf":  # what the URDF reader changed: every snapped constant, every lumped link
+        manifest["urdf"] = {"links": list(robot.links), "notes": list(robot.notes),
+                            "snaps": [{"joint": x.joint, "field": x.field, "from": x.before, "to": x.after,
+                                       "gravity_torque_change_max": effect}
+                                      for x, effect in zip(robot.snaps, robot.snap_effects or [None] * len(robot.snaps))]}
     files["manifest.json"] = json.dumps(manifest, indent=1) + "\n"
     return Emitted(files, functions, manifest)
 

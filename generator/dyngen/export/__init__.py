@@ -18,6 +18,10 @@ def write_all(robot, p, folder, joint_dynamics=None) -> list[Path]:
     joint_dynamics: optional per-joint friction and rotor inertia (see to_mjcf)."""
     texts = {f"{robot.name}.urdf": to_urdf(robot, p, joint_dynamics=joint_dynamics),
              f"{robot.name}.xml": to_mjcf(robot, p, joint_dynamics=joint_dynamics)}
+    if robot.urdf_file is not None:  # read from a URDF: the parameters also go into a copy of it
+        from .urdf_copy import urdf_copy
+
+        texts[f"{Path(robot.urdf_file).stem}_with_parameters.urdf"] = urdf_copy(robot, p)
     paths = []
     for name, text in texts.items():
         path = Path(folder) / name

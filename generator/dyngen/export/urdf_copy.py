@@ -1,0 +1,84 @@
+"""Parameters written back into a copy of the user's URDF: link names, joints, limits, meshes and
+comments kept; only the inertial of each moving chain link changes.
+
+dyngen's body i is the chain link plus everything lumped into it (links behind fixed joints,
+links beyond the tip). Those other links keep their inertials as the user wrote them, and the
+chain link gets the rest: s_link = s_body(new) - (s_body(file) - s_link(file)), exact because the
+standard parameters s (mass, first moment, inertia about the frame origin) add. It is written in
+the URDF link's own frame (the robot's link_frames), with its centre-of-mass inertia.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import defusedxml.ElementTree as SafeET
+import numpy as np
+
+from ..description.joint_model import _floats
+from ..description.urdf import load_urdf
+from ..description.urdf_xml import MAX_URDF_BYTES, read_urdf
+from ..errors import InputError
+from ..untrusted import read_text
+
+
+def _s(m, c, I):
+    """Standard parameters about the frame origin: (m, m c, J) with J = I + m (c.c E - c c^T)."""
+    c = np.asarray(c, dtype=float)
+    return m, m * c, I + m * (c @ c * np.eye(3) - np.outer(c, c))
+
+
+def _link_values(values):
+    m, c, (xx, xy, xz, yy, yz, zz) = values.m, values.c, values.I
+    return _s(m, c, np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+
+
+def urdf_copy(robot, p) -> str:
+    if robot.urdf_file is None:
+        raise ValueError("the robot was not read from a URDF")
+    original = load_urdf(robot.urdf_file, **robot.urdf_options)
+    file = read_urdf(robot.urdf_file)
+    text = read_text(robot.urdf_file, MAX_URDF_BYTES)
+    SafeET.fromstring(text, forbid_dtd=True, forbid_entities=True, forbid_external=True)  # read_urdf's check again
+    # No DTD (checked above), so the standard parser cannot expand anything; it keeps the comments.
+    root = ET.fromstring(text, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
+    p = np.asarray(p, dtype=float).reshape(robot.dof, 10)
+    for i, link in enumerate(robot.links):
+        frame = original.link_frames[i]
+        R, t = _floats(frame.R), _floats(frame.p)[:, 0]
+        own = file.links[link].inertial
+        m_own, h_own, J_own = 0.0, np.zeros(3), np.zeros((3, 3))
+        if own is not None:
+            from ..description.urdf import _inertial
+
+            body = _inertial(file.links[link]).moved(R, t)
+            m_own, h_own, J_own = _s(body.mass, body.com, body.inertia)
+        m_file, h_file, J_file = _link_values(original.nominal[i])
+        xx, xy, xz, yy, yz, zz = p[i, 4:]
+        m_new, h_new, J_new = _s(p[i, 0], p[i, 1:4], np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+        m = m_new - (m_file - m_own)
+        h = h_new - (h_file - h_own)
+        J = J_new - (J_file - J_own)
+        if m <= 0:
+            raise InputError(robot.source, f'link "{link}"', "the new mass is smaller than that of the links "
+                             "lumped into it; the copy cannot keep their inertials")
+        c = h / m
+        I_com = J - m * (c @ c * np.eye(3) - np.outer(c, c))
+        c_link, I_link = R.T @ (c - t), R.T @ I_com @ R  # into the URDF link's frame
+        _set_inertial(root, link, m, c_link, I_link)
+    prefix = text[:text.index("<robot")] if "<robot" in text else ""
+    prefix = "\n".join(line for line in prefix.splitlines() if not line.startswith("<?xml"))
+    return '<?xml version="1.0" encoding="utf-8"?>\n' + prefix + "\n" + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _set_inertial(root, link, m, c, I):
+    element = next(e for e in root.findall("link") if e.get("name") == link)
+    old = element.find("inertial")
+    if old is not None:
+        element.remove(old)
+    inertial = ET.SubElement(element, "inertial")
+    ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(x)) for x in c), rpy="0 0 0")
+    ET.SubElement(inertial, "mass", value=repr(float(m)))
+    ET.SubElement(inertial, "inertia", **{k: repr(float(I[a, b])) for k, (a, b) in
+                                            zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"),
+                                                ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)))})
