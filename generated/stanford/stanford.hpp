@@ -27,6 +27,11 @@
  *   RegressorInertia         21 x 31   Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)
  *   Regressor                 6 x 33   Y(q, qd, qdd): tau = Y pi_full
  *   Friction                 30 x 1    friction values, 5 per joint: Fc, Fv, Fs, vs, eps
+ *   LinkPoses                24 x 4    the 4x4 pose of every link frame stacked, link 1 first
+ *   Pose                      4 x 4    4x4 homogeneous pose [R p; 0 0 0 1] in the base frame
+ *   Jacobian                  6 x 6    geometric Jacobian, rows [v; w] in the base frame
+ *   LinkJacobians            36 x 6    the Jacobian of every link frame's origin stacked, link 1 first
+ *   Twist                     6 x 1    [linear; angular] in the base frame
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -55,6 +60,11 @@ using RegressorGravity = Eigen::Matrix<Real, 6, 9, Eigen::RowMajor>;
 using RegressorInertia = Eigen::Matrix<Real, 21, 31, Eigen::RowMajor>;
 using Regressor = Eigen::Matrix<Real, 6, 33, Eigen::RowMajor>;
 using Friction = Eigen::Matrix<Real, 30, 1, Eigen::ColMajor>;
+using LinkPoses = Eigen::Matrix<Real, 24, 4, Eigen::RowMajor>;
+using Pose = Eigen::Matrix<Real, 4, 4, Eigen::RowMajor>;
+using Jacobian = Eigen::Matrix<Real, 6, 6, Eigen::RowMajor>;
+using LinkJacobians = Eigen::Matrix<Real, 36, 6, Eigen::RowMajor>;
+using Twist = Eigen::Matrix<Real, 6, 1, Eigen::ColMajor>;
 
 namespace detail {
 
@@ -314,6 +324,86 @@ inline Joints friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<
     Joints tau;
     friction(qd, f, tau);
     return tau;
+}
+
+/* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.
+ * stanford_link_poses(q: Joints, T: LinkPoses written) */
+template <typename A0, typename Out>
+inline void link_poses(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &T)
+{
+    stanford_link_poses(detail::in<Joints>(q), detail::out<LinkPoses>(T));
+}
+
+template <typename A0>
+inline LinkPoses link_poses(const Eigen::MatrixBase<A0> &q)
+{
+    LinkPoses T;
+    link_poses(q, T);
+    return T;
+}
+
+/* Pose of the flange frame (last link frame times the description's tool offset) in the base frame.
+ * stanford_flange_pose(q: Joints, T: Pose written) */
+template <typename A0, typename Out>
+inline void flange_pose(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &T)
+{
+    stanford_flange_pose(detail::in<Joints>(q), detail::out<Pose>(T));
+}
+
+template <typename A0>
+inline Pose flange_pose(const Eigen::MatrixBase<A0> &q)
+{
+    Pose T;
+    flange_pose(q, T);
+    return T;
+}
+
+/* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).
+ * stanford_jacobian(q: Joints, J: Jacobian written) */
+template <typename A0, typename Out>
+inline void jacobian(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &J)
+{
+    stanford_jacobian(detail::in<Joints>(q), detail::out<Jacobian>(J));
+}
+
+template <typename A0>
+inline Jacobian jacobian(const Eigen::MatrixBase<A0> &q)
+{
+    Jacobian J;
+    jacobian(q, J);
+    return J;
+}
+
+/* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero).
+ * stanford_link_jacobians(q: Joints, J: LinkJacobians written) */
+template <typename A0, typename Out>
+inline void link_jacobians(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &J)
+{
+    stanford_link_jacobians(detail::in<Joints>(q), detail::out<LinkJacobians>(J));
+}
+
+template <typename A0>
+inline LinkJacobians link_jacobians(const Eigen::MatrixBase<A0> &q)
+{
+    LinkJacobians J;
+    link_jacobians(q, J);
+    return J;
+}
+
+/* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).
+ * stanford_jacobian_dot_qd(q: Joints, qd: Joints, a: Twist written) */
+template <typename A0, typename A1, typename Out>
+inline void jacobian_dot_qd(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<Out> &a)
+{
+    stanford_jacobian_dot_qd(detail::in<Joints>(q), detail::in<Joints>(qd), detail::out<Twist>(a));
+}
+
+template <typename A0, typename A1>
+inline Twist jacobian_dot_qd(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd)
+{
+    Twist a;
+    jacobian_dot_qd(q, qd, a);
+    return a;
 }
 
 }  // namespace stanford

@@ -19,8 +19,9 @@ from ..parameters import dynamic_symbols, standard_symbols
 from ..untrusted import read_yaml
 from .expressions import ExpressionError, exact_number, parse_expression, shorten
 from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
+from .tool import tool_frame
 
-_TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
+_TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction", "tool"}
 _EXTRACTION_KEYS = yaml_keys(ExtractionOptions) | {"compare"}  # every extraction option, and the compared file
 _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
@@ -140,7 +141,18 @@ class _Reader:
         extraction = self.extraction(doc.get("extraction") or {}, names)
         return Robot(name=name, source=self.source, convention=convention, joints=joints, gravity=gravity,
                      nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified,
-                     extraction=extraction)
+                     extraction=extraction, tool=self.tool(doc.get("tool")))
+
+    def tool(self, value):
+        """The optional flange offset (description/tool.py), in the last link frame."""
+        if value is None:
+            return None
+        value = self.mapping(value, "tool", {"xyz", "rpy"})
+        xyz = [self.exact(x, f"tool.xyz[{k}]", limit=MAX_LENGTH, smallest=MIN_LENGTH)
+               for k, x in enumerate(self.sequence(value.get("xyz", [0, 0, 0]), "tool.xyz", 3))]
+        rpy = [self.exact(x, f"tool.rpy[{k}]", "a number or an expression of pi", limit=MAX_ANGLE)
+               for k, x in enumerate(self.sequence(value.get("rpy", [0, 0, 0]), "tool.rpy", 3))]
+        return tool_frame(xyz, rpy)
 
     def extraction(self, value, names) -> dict:
         value = dict(self.mapping(value, "extraction", _EXTRACTION_KEYS))

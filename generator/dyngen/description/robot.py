@@ -14,6 +14,7 @@ import sympy as sp
 
 from ..parameters import DYNAMIC_NAMES_PER_LINK
 from .dh import joint_models
+from .joint_model import Rigid
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,7 @@ class Robot:
     total_mass: Optional[tuple[float, float]] = None
     identified: dict = field(default_factory=dict)  # kind -> tuple[IdentifiedCoefficient]
     extraction: dict = field(default_factory=dict)  # settings: procedure, restarts, seed, margin, identities, compare
+    tool: Optional[Rigid] = None  # the flange frame in the last link frame (description/tool.py); None: the same
 
     @property
     def dof(self) -> int:

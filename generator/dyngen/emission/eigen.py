@@ -20,6 +20,11 @@ TYPE_DOCS = {
     "RegressorInertia": "Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)",
     "Regressor": "Y(q, qd, qdd): tau = Y pi_full",
     "Friction": "friction values, 5 per joint: Fc, Fv, Fs, vs, eps",
+    "Pose": "4x4 homogeneous pose [R p; 0 0 0 1] in the base frame",
+    "LinkPoses": "the 4x4 pose of every link frame stacked, link 1 first",
+    "Jacobian": "geometric Jacobian, rows [v; w] in the base frame",
+    "LinkJacobians": "the Jacobian of every link frame's origin stacked, link 1 first",
+    "Twist": "[linear; angular] in the base frame",
 }
 
 
