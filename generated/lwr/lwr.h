@@ -37,6 +37,8 @@
  *   lwr_jacobian                 72 mul, 44 add, 0 div, 12 sin/cos
  *   lwr_link_jacobians           82 mul, 48 add, 0 div, 12 sin/cos
  *   lwr_jacobian_dot_qd          164 mul, 93 add, 0 div, 12 sin/cos
+ *   lwr_control                  1242 mul, 998 add, 0 div, 12 sin/cos
+ *   lwr_control_with_jacobian    1416 mul, 1108 add, 0 div, 14 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -201,10 +203,34 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J);
 /* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).
  *   q        [7]  joint positions [rad or m]
  *   qd       [7]  joint velocities
- *   a        [6]  [linear; angular] acceleration at qdd = 0 (written)
+ *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
  * 164 mul, 93 add, 0 div, 12 sin/cos
  */
-void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *a);
+void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_qd);
+
+/* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [7]  gravity torques (written)
+ *   M        [7 x 7]  inertia matrix, row-major, symmetric (written)
+ *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ * 1242 mul, 998 add, 0 div, 12 sin/cos
+ */
+void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c);
+
+/* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [7]  gravity torques (written)
+ *   M        [7 x 7]  inertia matrix, row-major, symmetric (written)
+ *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ *   J        [6 x 7]  flange Jacobian, row-major, rows [v; w] (written)
+ *   jdot_qd  [6]  Jdot qd of the flange (written)
+ * 1416 mul, 1108 add, 0 div, 14 sin/cos
+ */
+void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c, lwr_real *J, lwr_real *jdot_qd);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [35] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

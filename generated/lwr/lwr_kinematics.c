@@ -542,7 +542,7 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J)
 }
 
 /* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control). */
-void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *a)
+void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_qd)
 {
     /* joint angles */
     const lwr_real c1 = LWR_COS(q[0]);
@@ -645,11 +645,11 @@ void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *a)
     const lwr_real x74 = -qd[6]*x29*x73 + qd[6]*x30*x72 + x68;
     const lwr_real x75 = qd[6]*x28*x73 - qd[6]*x30*x71 + x69;
     const lwr_real x76 = -qd[6]*x28*x72 + qd[6]*x29*x71 + x70;
-    /* a */
-    a[0] = x65;
-    a[1] = x66;
-    a[2] = x67;
-    a[3] = x74;
-    a[4] = x75;
-    a[5] = x76;
+    /* jdot_qd */
+    jdot_qd[0] = x65;
+    jdot_qd[1] = x66;
+    jdot_qd[2] = x67;
+    jdot_qd[3] = x74;
+    jdot_qd[4] = x75;
+    jdot_qd[5] = x76;
 }

@@ -37,6 +37,8 @@
  *   stanford_jacobian            50 mul, 43 add, 0 div, 8 sin/cos
  *   stanford_link_jacobians      56 mul, 47 add, 0 div, 8 sin/cos
  *   stanford_jacobian_dot_qd     143 mul, 85 add, 0 div, 8 sin/cos
+ *   stanford_control             815 mul, 670 add, 0 div, 8 sin/cos
+ *   stanford_control_with_jacobian 976 mul, 784 add, 0 div, 10 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -201,10 +203,34 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J);
 /* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).
  *   q        [6]  joint positions [rad or m]
  *   qd       [6]  joint velocities
- *   a        [6]  [linear; angular] acceleration at qdd = 0 (written)
+ *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
  * 143 mul, 85 add, 0 div, 8 sin/cos
  */
-void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *a);
+void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *jdot_qd);
+
+/* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [6]  gravity torques (written)
+ *   M        [6 x 6]  inertia matrix, row-major, symmetric (written)
+ *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ * 815 mul, 670 add, 0 div, 8 sin/cos
+ */
+void stanford_control(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c);
+
+/* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [6]  gravity torques (written)
+ *   M        [6 x 6]  inertia matrix, row-major, symmetric (written)
+ *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ *   J        [6 x 6]  flange Jacobian, row-major, rows [v; w] (written)
+ *   jdot_qd  [6]  Jdot qd of the flange (written)
+ * 976 mul, 784 add, 0 div, 10 sin/cos
+ */
+void stanford_control_with_jacobian(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c, stanford_real *J, stanford_real *jdot_qd);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [30] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

@@ -432,7 +432,7 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J)
 }
 
 /* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control). */
-void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *a)
+void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *jdot_qd)
 {
     /* joint angles */
     const stanford_real c1 = STANFORD_COS(q[0]);
@@ -523,11 +523,11 @@ void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, s
     const stanford_real x67 = x40 - x56*x60 + x57*x59 + x62*x66 - x63*x65;
     const stanford_real x68 = x41 + x55*x60 - x57*x58 - x61*x66 + x63*x64;
     const stanford_real x69 = x42 - x55*x59 + x56*x58 + x61*x65 - x62*x64;
-    /* a */
-    a[0] = x67;
-    a[1] = x68;
-    a[2] = x69;
-    a[3] = x58;
-    a[4] = x59;
-    a[5] = x60;
+    /* jdot_qd */
+    jdot_qd[0] = x67;
+    jdot_qd[1] = x68;
+    jdot_qd[2] = x69;
+    jdot_qd[3] = x58;
+    jdot_qd[4] = x59;
+    jdot_qd[5] = x60;
 }

@@ -73,6 +73,11 @@ class Function:
     check: Check
     kind: str = ""  # gravity | inertia | full, for coefficient and regressor functions
     state: bool = True  # whether it reads a joint state (checked at every self-test state)
+    more: tuple = ()  # further Outputs, written by the same call after `output`
+
+    @property
+    def outputs(self) -> tuple:
+        return (self.output, *self.more)
 
     def arguments(self, gravity_symbols: bool) -> tuple:
         return tuple(a for a in self.inputs if a != "gravity" or gravity_symbols)
@@ -149,13 +154,29 @@ LINK_JACOBIANS = Function(
     "(columns of the joints after link i are zero).", Check())
 JACOBIAN_DOT_QD = Function(
     "jacobian_dot_qd", "kinematics", "jacobian_dot_qd", ("q", "qd"),
-    Output("a", ("twist",), "[linear; angular] acceleration at qdd = 0", "Twist"),
+    Output("jdot_qd", ("twist",), "[linear; angular] acceleration at qdd = 0", "Twist"),
     "Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular "
     "acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).", Check())
 
+# ---- one call per control cycle (derivation/control.py): one program, several outputs ------
+_CONTROL_OUTPUTS = (Output("M", ("dof", "dof"), "inertia matrix, row-major, symmetric", "MassMatrix"),
+                    Output("c", ("dof",), "velocity torques c(q, qd) = rnea(q, qd, 0) - g(q)", "Joints"))
+CONTROL = Function(
+    "control", "control", "control", ("q", "qd", "s", "gravity"),
+    Output("g", ("dof",), "gravity torques", "Joints"),
+    "g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions "
+    "once.", Check(), more=_CONTROL_OUTPUTS)
+CONTROL_WITH_JACOBIAN = Function(
+    "control_with_jacobian", "control", "control_with_jacobian", ("q", "qd", "s", "gravity"),
+    Output("g", ("dof",), "gravity torques", "Joints"),
+    "control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.", Check(),
+    more=_CONTROL_OUTPUTS + (Output("J", ("twist", "dof"), "flange Jacobian, row-major, rows [v; w]", "Jacobian"),
+                             Output("jdot_qd", ("twist",), "Jdot qd of the flange", "Twist")))
+
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
-             FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD)
+             FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD,
+             CONTROL, CONTROL_WITH_JACOBIAN)
 KINEMATICS = (LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
@@ -163,7 +184,8 @@ JACOBIANS = {"gravity": PI_GRAVITY_JACOBIAN, "inertia": PI_INERTIA_JACOBIAN, "fu
 REGRESSORS = {"gravity": REGRESSOR_GRAVITY, "inertia": REGRESSOR_INERTIA, "full": REGRESSOR}
 SOURCES = {"parameters": "parameters and base coefficients", "regressors": "base regressors",
            "dynamics": "inverse dynamics, gravity and inertia matrix",
-           "kinematics": "forward kinematics and Jacobians"}  # straight-line C files, in order
+           "kinematics": "forward kinematics and Jacobians",
+           "control": "one call per control cycle"}  # straight-line C files, in order
 
 
 def dimensions(dof: int, ranks: dict, gravity_symbols: int) -> dict:

@@ -55,6 +55,11 @@ class Wrapper:
     doc: str
     inputs: list  # (argument name, EigenType name)
     output: tuple  # (argument name, EigenType name)
+    more: list  # further outputs (argument name, EigenType name): then only the form that writes into arguments
+
+    @property
+    def outputs(self) -> list:
+        return [self.output, *self.more]
 
 
 def eigen_interface(prefix: str, dims: dict, docs: dict) -> dict:
@@ -74,8 +79,8 @@ def eigen_interface(prefix: str, dims: dict, docs: dict) -> dict:
     for f in FUNCTIONS:
         c_name = f"{prefix}_{f.name}"
         inputs = [(arg, use(ARGUMENTS[arg].eigen, ARGUMENTS[arg].shape)) for arg in f.arguments(has_gravity)]
-        output = (f.output.name, use(f.output.eigen, f.output.shape))
-        wrappers.append(Wrapper(f.name, c_name, docs.get(c_name, f.doc), inputs, output))
+        output, *more = [(o.name, use(o.eigen, o.shape)) for o in f.outputs]
+        wrappers.append(Wrapper(f.name, c_name, docs.get(c_name, f.doc), inputs, output, more))
     first = ["Joints", "Parameters", "GravitySymbols", "MassMatrix"]
     ordered = sorted(types.values(), key=lambda t: first.index(t.name) if t.name in first else len(first))
     largest = max(ordered, key=lambda t: t.rows * t.cols)
