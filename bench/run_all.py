@@ -42,7 +42,7 @@ ROOT = BENCH.parent
 sys.path.insert(0, str(BENCH))
 from common import cpu_model, log  # noqa: E402
 RESULTS = BENCH / "results"
-PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory")
+PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory", "kinematics", "firmware")
 TITLES = {
     "opcounts": "Operation counts of the generated functions",
     "dynamics": "Generated C vs Pinocchio (time per call, instructions per call)",
@@ -50,6 +50,8 @@ TITLES = {
     "extraction": "Extraction: dyngen's driver vs SciPy",
     "diagnosis": "Diagnosis: 30 s of 1 kHz data",
     "memory": "Peak memory of each step",
+    "kinematics": "Kinematics and control() vs Pinocchio (time per call, instructions per call)",
+    "firmware": "Firmware build: size and stack of every function (Cortex-M4F, Cortex-M7)",
 }
 DIAGNOSIS_SCRIPT = BENCH / "bench_diagnosis.py"
 # Reading notes for a part's table, where the script's own output can mislead.
@@ -95,6 +97,12 @@ def part_command(part: str, args) -> list | None:
         return [*py, DIAGNOSIS_SCRIPT] if DIAGNOSIS_SCRIPT.is_file() else None
     if part == "memory":
         return [*py, BENCH / "bench_memory.py"]
+    if part == "kinematics":
+        quick = ["--batches", "30"] if args.quick or not shutil.which("valgrind") else ["--callgrind"]
+        return [*py, BENCH / "bench_kinematics.py", *(arms or (["--arms", "lwr", "stanford"] if args.quick else [])),
+                *quick, "--output", RESULTS / "kinematics.md"]
+    if part == "firmware":
+        return [*py, BENCH / "bench_firmware.py"] if shutil.which("arm-none-eabi-gcc") else None
     raise ValueError(part)
 
 
@@ -102,7 +110,9 @@ def run_part(part: str, args) -> Outcome:
     cmd = part_command(part, args)
     out = Outcome(part)
     if cmd is None:
-        out.note = (f"Not available: {DIAGNOSIS_SCRIPT.relative_to(ROOT)} does not exist on this branch "
+        out.note = ("Not available: arm-none-eabi-gcc is not installed (scripts/setup.sh installs it)"
+                    if part == "firmware" else
+                    f"Not available: {DIAGNOSIS_SCRIPT.relative_to(ROOT)} does not exist on this branch "
                     "(`dyngen diagnose` is being written on another branch)")
         log(f"== {part}: {out.note}")
         return out
