@@ -63,14 +63,23 @@ def test_kinematics_match_pinocchio_and_numpy(built):
 
 
 TOOL = '\ntool: {xyz: [0.01, -0.02, 0.126], rpy: [0.3, "pi/2", -0.7]}\n'
+# joint offsets on top: a revolute joint's theta, and the prismatic joint's d on the Stanford arm
+OFFSETS = {"stanford": ("d: 0,     theta: \"-pi/2\"", "d: 0.1,   theta: \"-pi/2\""),
+           "puma560": ("theta: 0", "theta: 0.3"), "panda": ("theta: 0", "theta: -1.1")}
 
 
-@pytest.mark.parametrize("name", ["stanford", "puma560"])
-def test_a_rotated_offset_tool(name, tmp_path):
-    """A tool with all three angles (one exact) and an offset in every direction; the Stanford
-    arm has a prismatic joint."""
+@pytest.mark.parametrize("name", sorted(OFFSETS))
+def test_a_rotated_offset_tool_and_joint_offsets(name, tmp_path):
+    """A tool with all three angles (one exact) and an offset in every direction, and joint
+    offsets (standard and modified DH; the Stanford arm's prismatic joint)."""
+    text = (ROOT / "examples" / f"{name}.yaml").read_text()
+    old, new = OFFSETS[name]
+    assert old in text
+    text = text.replace(old, new, 1)
+    if "\ntool:" in text:  # panda has its flange already: replace it
+        text = "\n".join(line for line in text.splitlines() if not line.startswith("tool:")) + "\n"
     yaml = tmp_path / f"{name}.yaml"
-    yaml.write_text((ROOT / "examples" / f"{name}.yaml").read_text() + TOOL)
+    yaml.write_text(text + TOOL)
     check_kinematics(build_arm(yaml, tmp_path), states=10, seed=5)
 
 

@@ -49,7 +49,7 @@ def _lets_matrix(program: Program, M) -> sp.Matrix:
 def base_frames(robot, program: Program, sym) -> Frames:
     """The pose of every link frame, joint axis and the flange (last link frame times the
     description's tool offset), in the base frame."""
-    chain = Chain(robot, program, sym)  # creates the trig symbols s_i, c_i of the dynamics
+    Chain(robot, program, sym)  # names the joint angles' sines and cosines (s_i, c_i) as the dynamics does
     trig = {v: k for k, v in sym.trig.items()}
     R, o = sp.eye(3), list(ZERO)
     frames = Frames([], [], [], [], [], None, None)
@@ -69,7 +69,6 @@ def base_frames(robot, program: Program, sym) -> Frames:
         o = program.let_vector(add(o_joint, mat_vec(R_joint, list(frame.p))))
         frames.R.append(R), frames.o.append(o), frames.axis.append(axis)
         frames.point.append(point), frames.revolute.append(model.revolute)
-    del chain
     tool = robot.tool or Rigid.identity()
     program.section = "flange"
     frames.flange_R = _lets_matrix(program, R * tool.R)
