@@ -208,6 +208,17 @@ def summary() -> list:
         lines += ["", f"Arms: {', '.join(doc['arms'])}. Above 1: the generated C is faster. yg_pig = Y_g(q) pi_g, "
                   "ym_pim = Y_m(q) pi_m (regressor then product); regressor = dyngen's base regressor vs "
                   "Pinocchio's n x 10n joint-torque regressor.", ""]
+    kinematics = RESULTS / "kinematics.json"
+    if kinematics.is_file():
+        arms = json.loads(kinematics.read_text())
+        lines += ["| kinematics and control() vs Pinocchio | time ratio, min - max over arms | instruction ratio |",
+                  "|---|---:|---:|"]
+        for fn in next(iter(arms.values())):
+            t = [a[fn]["pinocchio_ns"] / a[fn]["dyngen_ns"] for a in arms.values()]
+            ir = [a[fn]["pinocchio_ir"] / a[fn]["dyngen_ir"] for a in arms.values() if "dyngen_ir" in a[fn]]
+            lines.append(f"| {fn} | {min(t):.2f}x - {max(t):.2f}x | "
+                         + (f"{min(ir):.2f}x - {max(ir):.2f}x |" if ir else "not measured |"))
+        lines += ["", "Pairs and the reading of the control rows: section " + str(PARTS.index("kinematics") + 1) + ".", ""]
     scaling = RESULTS / "scaling.json"
     if scaling.is_file():
         doc = json.loads(scaling.read_text())
