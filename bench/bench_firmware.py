@@ -45,7 +45,7 @@ def build(folder: Path, target: str, precision: str, level: str, work: Path) -> 
     if precision == "float":
         flags += [f"-D{robot.upper()}_USE_FLOAT", "-Wdouble-promotion"]
     work.mkdir(parents=True, exist_ok=True)
-    text, data, stack, undefined = {}, 0, {}, set()
+    text, data, stack, undefined, sizes = {}, 0, {}, set(), {}
     for source in library_sources(folder):
         obj = work / (source.stem + ".o")
         subprocess.run([CC, *flags, "-I", str(folder), "-c", str(source), "-o", str(obj)], check=True,
@@ -60,7 +60,14 @@ def build(folder: Path, target: str, precision: str, level: str, work: Path) -> 
             stack[where.rsplit(":", 1)[-1]] = (int(size), kind)
         nm = subprocess.run(["arm-none-eabi-nm", "-u", str(obj)], check=True, capture_output=True, text=True).stdout
         undefined |= {line.split()[-1] for line in nm.splitlines() if line.strip()}
-    return {"text": text, "data_bss": data, "stack": stack, "undefined": sorted(undefined)}
+        # code size of each function: nm -S prints "address size type name" for defined symbols
+        nm = subprocess.run(["arm-none-eabi-nm", "-S", "--defined-only", str(obj)], check=True, capture_output=True,
+                            text=True).stdout
+        for line in nm.splitlines():
+            fields = line.split()
+            if len(fields) == 4 and fields[2] in "tT":
+                sizes[fields[3]] = int(fields[1], 16)
+    return {"text": text, "data_bss": data, "stack": stack, "undefined": sorted(undefined), "sizes": sizes}
 
 
 def report(folder: Path, results: dict, compiler: str) -> str:
@@ -84,6 +91,11 @@ def report(folder: Path, results: dict, compiler: str) -> str:
         lines.append(f"| {target} | {precision} | {level} | " + " | ".join(str(r["text"][s]) for s in sources)
                      + f" | {sum(r['text'].values())} | {r['data_bss']} | {described} |")
     functions = list(next(iter(results.values()))["stack"])
+    lines += ["", "## Code size per function (.text bytes, `nm -S`)", "",
+              "| function | " + " | ".join(f"{t} {p} {lv}" for t, p, lv in configs) + " |",
+              "|---|" + "---:|" * len(configs)]
+    for fn in functions:
+        lines.append(f"| `{fn}` | " + " | ".join(str(results[c]["sizes"].get(fn, "-")) for c in configs) + " |")
     lines += ["", "## Stack use per function (bytes, `-fstack-usage`)", "",
               "Every function's own frame; all are `static` (known at compile time). Add the stack of",
               "`sin`/`cos` (libm) for the functions that call them.", "",

@@ -41,7 +41,7 @@ BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
 from common import arguments, cpu_model, log  # noqa: E402  (bench/ is sys.path[0])
 RESULTS = BENCH / "results"
-PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory")
+PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory", "kinematics", "firmware")
 TITLES = {
     "opcounts": "Operation counts of the generated functions",
     "dynamics": "Generated C vs Pinocchio (time per call, instructions per call)",
@@ -49,6 +49,8 @@ TITLES = {
     "extraction": "Extraction: dyngen's driver vs SciPy",
     "diagnosis": "Diagnosis: 30 s of 1 kHz data",
     "memory": "Peak memory of each step",
+    "kinematics": "Kinematics and control() vs Pinocchio (time per call, instructions per call)",
+    "firmware": "Firmware build: size and stack of every function (Cortex-M4F, Cortex-M7)",
 }
 DIAGNOSIS_SCRIPT = BENCH / "bench_diagnosis.py"
 # Reading notes for a part's table, where the script's own output can mislead.
@@ -94,6 +96,12 @@ def part_command(part: str, args) -> list | None:
         return [*py, DIAGNOSIS_SCRIPT] if DIAGNOSIS_SCRIPT.is_file() else None
     if part == "memory":
         return [*py, BENCH / "bench_memory.py"]
+    if part == "kinematics":
+        quick = ["--batches", "30"] if args.quick or not shutil.which("valgrind") else ["--callgrind"]
+        return [*py, BENCH / "bench_kinematics.py", *(arms or (["--arms", "lwr", "stanford"] if args.quick else [])),
+                *quick, "--output", RESULTS / "kinematics.md"]
+    if part == "firmware":
+        return [*py, BENCH / "bench_firmware.py"] if shutil.which("arm-none-eabi-gcc") else None
     raise ValueError(part)
 
 
@@ -101,7 +109,9 @@ def run_part(part: str, args) -> Outcome:
     cmd = part_command(part, args)
     out = Outcome(part)
     if cmd is None:
-        out.note = (f"Not available: {DIAGNOSIS_SCRIPT.relative_to(ROOT)} does not exist on this branch "
+        out.note = ("Not available: arm-none-eabi-gcc is not installed (scripts/setup.sh installs it)"
+                    if part == "firmware" else
+                    f"Not available: {DIAGNOSIS_SCRIPT.relative_to(ROOT)} does not exist on this branch "
                     "(`dyngen diagnose` is being written on another branch)")
         log(f"== {part}: {out.note}")
         return out
@@ -197,6 +207,17 @@ def summary() -> list:
         lines += ["", f"Arms: {', '.join(doc['arms'])}. Above 1: the generated C is faster. yg_pig = Y_g(q) pi_g, "
                   "ym_pim = Y_m(q) pi_m (regressor then product); regressor = dyngen's base regressor vs "
                   "Pinocchio's n x 10n joint-torque regressor.", ""]
+    kinematics = RESULTS / "kinematics.json"
+    if kinematics.is_file():
+        arms = json.loads(kinematics.read_text())
+        lines += ["| kinematics and control() vs Pinocchio | time ratio, min - max over arms | instruction ratio |",
+                  "|---|---:|---:|"]
+        for fn in next(iter(arms.values())):
+            t = [a[fn]["pinocchio_ns"] / a[fn]["dyngen_ns"] for a in arms.values()]
+            ir = [a[fn]["pinocchio_ir"] / a[fn]["dyngen_ir"] for a in arms.values() if "dyngen_ir" in a[fn]]
+            lines.append(f"| {fn} | {min(t):.2f}x - {max(t):.2f}x | "
+                         + (f"{min(ir):.2f}x - {max(ir):.2f}x |" if ir else "not measured |"))
+        lines += ["", "Pairs and the reading of the control rows: section " + str(PARTS.index("kinematics") + 1) + ".", ""]
     scaling = RESULTS / "scaling.json"
     if scaling.is_file():
         doc = json.loads(scaling.read_text())

@@ -41,7 +41,7 @@ def test_every_catalogue_function_is_declared_and_documented_in_the_header():
     sizes = dims()
     for f in catalogue.FUNCTIONS:
         args = ", ".join([f"const {P}_real *{a}" for a in f.arguments(sizes["gravity_symbols"] > 0)] +
-                         [f"{P}_real *{f.output.name}"])
+                         [f"{P}_real *{o.name}" for o in f.outputs])
         declaration = f"void {P}_{f.name}({args});"
         assert declaration in header, declaration
         comment = header[:header.index(declaration)].rsplit("/*", 1)[1]
@@ -61,13 +61,15 @@ def test_every_catalogue_function_is_in_the_manifest_with_its_shapes():
             assert i["length"] == sizes[shape[0]] * (sizes[shape[1]] if len(shape) > 1 else 1)
         assert entry["output"]["name"] == f.output.name
         assert entry["output"]["shape"] == [sizes[d] for d in f.output.shape]
+        assert [(o["name"], o["shape"]) for o in entry["outputs"]] == [(o.name, [sizes[d] for d in o.shape])
+                                                                       for o in f.outputs]
 
 
 def test_every_catalogue_function_has_an_eigen_wrapper():
     hpp = (FOLDER / f"{P}.hpp").read_text()
     for f in catalogue.FUNCTIONS:
         assert f"inline void {f.name}(" in hpp and f"{P}_{f.name}(detail::in<" in hpp, f.name
-        assert f"using {f.output.eigen} = " in hpp
+        assert all(f"using {o.eigen} = " in hpp for o in f.outputs)
 
 
 def test_every_catalogue_function_is_checked_by_the_selftest():
@@ -76,7 +78,8 @@ def test_every_catalogue_function_is_checked_by_the_selftest():
         call = re.search(rf"^\s+{P}_{f.name}\((.*)\);$", selftest, re.M)
         assert call, f.name
         label = f.name if not f.check.times else f"{f.name} * {f.check.times}"
-        assert f'check("{label}"' in selftest or f'compare("{label}"' in selftest, f.name
+        labels = [f"{f.name}.{o.name}" for o in f.outputs] if f.more else [label]
+        assert all(f'check("{x}"' in selftest or f'compare("{x}"' in selftest for x in labels), f.name
         assert f"{f.expected}_expected" in selftest
     expected = manifest()["selftest"]
     assert sorted(expected["expected"]) == sorted(f.name for f in catalogue.FUNCTIONS

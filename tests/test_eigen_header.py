@@ -72,6 +72,16 @@ def test_wrappers_equal_the_c_functions_and_the_lagrangian(check_program, tmp_pa
         assert normwise(outputs["Y_gravity"][k], c("regressor_gravity", q).ravel()) < same
         assert normwise(outputs["Y_inertia"][k], c("regressor_inertia", q).ravel()) < same
         assert normwise(outputs["Y"][k], c("regressor", q, qd, qdd).ravel()) < same
+        for name in ("flange_pose", "link_poses", "jacobian", "link_jacobians"):
+            assert normwise(outputs[name][k], c(name, q).ravel()) < same, name
+        assert normwise(outputs["jacobian_dot_qd"][k], c("jacobian_dot_qd", q, qd)) < same
+        g, M, cv = (x.ravel() for x in c("control", q, qd, s))
+        for name, want in (("control_g", g), ("control_M", M), ("control_c", cv)):
+            assert normwise(outputs[name][k], want) < same, name
+        assert normwise(outputs["control_g"][k], lag.gravity(arm, q, p)) < 1e-9
+        assert normwise(outputs["control_c"][k], lag.coriolis(arm, q, qd, p)) < 1e-9
+        assert normwise(outputs["control_J"][k], c("jacobian", q).ravel()) < same
+        assert normwise(outputs["control_jdot_qd"][k], c("jacobian_dot_qd", q, qd)) < same
 
 
 REFUSED = {

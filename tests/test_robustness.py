@@ -24,6 +24,7 @@ import os
 import subprocess
 from pathlib import Path
 
+import pytest
 
 from dyngen.runtime import library_sources
 from dyngen.terms import FRICTION_FIELDS
@@ -170,16 +171,19 @@ def driver_source(manifest: dict, robot) -> str:
                        lim.upper if lim and lim.upper is not None else default[1]))
     outputs, calls, frees = [], [], []
     for f in manifest["functions"]:
-        out = f"out_{f['name']}"
-        size = math.prod(f["output"]["shape"])
-        outputs.append(f"    real *{out} = block({size});")
-        frees.append(f"    free({out});")
-        args = [i["name"] for i in f["inputs"]] + [out]
+        written = f.get("outputs") or [f["output"]]  # several outputs (control): each in its own block
+        outs = [f"out_{f['name']}_{o['name']}" for o in written]
+        sizes = [math.prod(o["shape"]) for o in written]
+        for out, size in zip(outs, sizes):
+            outputs.append(f"    real *{out} = block({size});")
+            frees.append(f"    free({out});")
         if f["name"] == f"{prefix}_standard_from_dynamic":  # its output s feeds the dynamics functions
-            args[-1] = "s"
+            outs = ["s"]
+        args = [i["name"] for i in f["inputs"]] + outs
         call = f"{f['name']}({', '.join(args)})"
+        finite = " && ".join(f"finite_all({out}, {size})" for out, size in zip(outs, sizes))
         calls.append(f"        {call}; ++calls;\n"
-                     f"        if (!finite_all({args[-1]}, {size})) {{\n"
+                     f"        if (!({finite})) {{\n"
                      f"            printf(\"{f['name']}: non-finite output at state %ld\\n\", k);\n"
                      f"            failed = 1;\n            continue;\n        }}")
     # standard_from_dynamic first: the others read s
@@ -239,10 +243,12 @@ def test_every_function_finite_and_sanitizer_clean(built, tmp_path):
     assert injected.returncode == 1 and "non-finite output at state 3" in injected.stdout, injected.stdout
 
 
-def test_an_out_of_bounds_write_is_reported(lwr, tmp_path):
-    """The sanitizer set-up can fail: a driver whose output block is one entry short aborts."""
-    driver = driver_source(lwr.emitted.manifest, lwr.robot).replace("real *out_lwr_rnea = block(7);",
-                                                                    "real *out_lwr_rnea = block(6);")
-    assert "block(6)" in driver
+@pytest.mark.parametrize("block", ["out_lwr_rnea_tau", "out_lwr_control_c"])
+def test_an_out_of_bounds_write_is_reported(block, lwr, tmp_path):
+    """The sanitizer set-up can fail: a driver whose output block is one entry short aborts
+    (for control(), its last output: each output has a block of its own)."""
+    driver = driver_source(lwr.emitted.manifest, lwr.robot).replace(f"real *{block} = block(7);",
+                                                                    f"real *{block} = block(6);")
+    assert f"{block} = block(6)" in driver
     result = run(build_sanitized(lwr.c.folder, driver, tmp_path), 1)
     assert result.returncode != 0 and "heap-buffer-overflow" in result.stderr

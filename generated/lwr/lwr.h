@@ -32,6 +32,13 @@
  *   lwr_rnea                     375 mul, 368 add, 0 div, 12 sin/cos
  *   lwr_gravity                  108 mul, 72 add, 0 div, 12 sin/cos
  *   lwr_mass_matrix              781 mul, 584 add, 0 div, 12 sin/cos
+ *   lwr_link_poses               68 mul, 31 add, 0 div, 14 sin/cos
+ *   lwr_flange_pose              68 mul, 31 add, 0 div, 14 sin/cos
+ *   lwr_jacobian                 72 mul, 44 add, 0 div, 12 sin/cos
+ *   lwr_link_jacobians           82 mul, 48 add, 0 div, 12 sin/cos
+ *   lwr_jacobian_dot_qd          164 mul, 93 add, 0 div, 12 sin/cos
+ *   lwr_control                  1242 mul, 998 add, 0 div, 12 sin/cos
+ *   lwr_control_with_jacobian    1416 mul, 1108 add, 0 div, 14 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -164,6 +171,66 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
  * 781 mul, 584 add, 0 div, 12 sin/cos
  */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
+
+/* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.
+ *   q        [7]  joint positions [rad or m]
+ *   T        [28 x 4]  row-major 4x4 pose of link frame i in rows 4(i-1)..4i-1 (written)
+ * 68 mul, 31 add, 0 div, 14 sin/cos
+ */
+void lwr_link_poses(const lwr_real *q, lwr_real *T);
+
+/* Pose of the flange frame (last link frame times the description's tool offset) in the base frame.
+ *   q        [7]  joint positions [rad or m]
+ *   T        [4 x 4]  row-major 4x4 [R p; 0 0 0 1] (written)
+ * 68 mul, 31 add, 0 div, 14 sin/cos
+ */
+void lwr_flange_pose(const lwr_real *q, lwr_real *T);
+
+/* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).
+ *   q        [7]  joint positions [rad or m]
+ *   J        [6 x 7]  row-major, rows [v; w] (written)
+ * 72 mul, 44 add, 0 div, 12 sin/cos
+ */
+void lwr_jacobian(const lwr_real *q, lwr_real *J);
+
+/* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero).
+ *   q        [7]  joint positions [rad or m]
+ *   J        [42 x 7]  row-major, rows 6(i-1)..6i-1: link i's [v; w] (written)
+ * 82 mul, 48 add, 0 div, 12 sin/cos
+ */
+void lwr_link_jacobians(const lwr_real *q, lwr_real *J);
+
+/* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
+ * 164 mul, 93 add, 0 div, 12 sin/cos
+ */
+void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_qd);
+
+/* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [7]  gravity torques (written)
+ *   M        [7 x 7]  inertia matrix, row-major, symmetric (written)
+ *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ * 1242 mul, 998 add, 0 div, 12 sin/cos
+ */
+void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c);
+
+/* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [7]  gravity torques (written)
+ *   M        [7 x 7]  inertia matrix, row-major, symmetric (written)
+ *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ *   J        [6 x 7]  flange Jacobian, row-major, rows [v; w] (written)
+ *   jdot_qd  [6]  Jdot qd of the flange (written)
+ * 1416 mul, 1108 add, 0 div, 14 sin/cos
+ */
+void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c, lwr_real *J, lwr_real *jdot_qd);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [56] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

@@ -27,6 +27,11 @@
  *   RegressorInertia         28 x 39   Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)
  *   Regressor                 7 x 43   Y(q, qd, qdd): tau = Y pi_full
  *   Friction                 56 x 1    friction values, 8 per joint: Fc, vc, Fv, Fs, vs, es, dFc, ed
+ *   LinkPoses                28 x 4    the 4x4 pose of every link frame stacked, link 1 first
+ *   Pose                      4 x 4    4x4 homogeneous pose [R p; 0 0 0 1] in the base frame
+ *   Jacobian                  6 x 7    geometric Jacobian, rows [v; w] in the base frame
+ *   LinkJacobians            42 x 7    the Jacobian of every link frame's origin stacked, link 1 first
+ *   Twist                     6 x 1    [linear; angular] in the base frame
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -55,6 +60,11 @@ using RegressorGravity = Eigen::Matrix<Real, 7, 12, Eigen::RowMajor>;
 using RegressorInertia = Eigen::Matrix<Real, 28, 39, Eigen::RowMajor>;
 using Regressor = Eigen::Matrix<Real, 7, 43, Eigen::RowMajor>;
 using Friction = Eigen::Matrix<Real, 56, 1, Eigen::ColMajor>;
+using LinkPoses = Eigen::Matrix<Real, 28, 4, Eigen::RowMajor>;
+using Pose = Eigen::Matrix<Real, 4, 4, Eigen::RowMajor>;
+using Jacobian = Eigen::Matrix<Real, 6, 7, Eigen::RowMajor>;
+using LinkJacobians = Eigen::Matrix<Real, 42, 7, Eigen::RowMajor>;
+using Twist = Eigen::Matrix<Real, 6, 1, Eigen::ColMajor>;
 
 namespace detail {
 
@@ -94,8 +104,8 @@ inline Real *out(const Eigen::MatrixBase<Arg> &x)
 
 /* Standard parameters s from dynamic parameters p.
  * lwr_standard_from_dynamic(p: Parameters, s: Parameters written) */
-template <typename A0, typename Out>
-inline void standard_from_dynamic(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &s)
+template <typename A0, typename Out0>
+inline void standard_from_dynamic(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &s)
 {
     lwr_standard_from_dynamic(detail::in<Parameters>(p), detail::out<Parameters>(s));
 }
@@ -110,8 +120,8 @@ inline Parameters standard_from_dynamic(const Eigen::MatrixBase<A0> &p)
 
 /* Base coefficients pi_gravity(p) of the gravity vector g(q) = Y_g(q) pi_gravity.
  * lwr_pi_gravity(p: Parameters, pi: PiGravity written) */
-template <typename A0, typename Out>
-inline void pi_gravity(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &pi)
+template <typename A0, typename Out0>
+inline void pi_gravity(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &pi)
 {
     lwr_pi_gravity(detail::in<Parameters>(p), detail::out<PiGravity>(pi));
 }
@@ -126,8 +136,8 @@ inline PiGravity pi_gravity(const Eigen::MatrixBase<A0> &p)
 
 /* Jacobian d pi_gravity / d p (for gradient-based extraction).
  * lwr_pi_gravity_jacobian(p: Parameters, J: PiGravityJacobian written) */
-template <typename A0, typename Out>
-inline void pi_gravity_jacobian(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &J)
+template <typename A0, typename Out0>
+inline void pi_gravity_jacobian(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &J)
 {
     lwr_pi_gravity_jacobian(detail::in<Parameters>(p), detail::out<PiGravityJacobian>(J));
 }
@@ -142,8 +152,8 @@ inline PiGravityJacobian pi_gravity_jacobian(const Eigen::MatrixBase<A0> &p)
 
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  * lwr_pi_inertia(p: Parameters, pi: PiInertia written) */
-template <typename A0, typename Out>
-inline void pi_inertia(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &pi)
+template <typename A0, typename Out0>
+inline void pi_inertia(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &pi)
 {
     lwr_pi_inertia(detail::in<Parameters>(p), detail::out<PiInertia>(pi));
 }
@@ -158,8 +168,8 @@ inline PiInertia pi_inertia(const Eigen::MatrixBase<A0> &p)
 
 /* Jacobian d pi_inertia / d p (for gradient-based extraction).
  * lwr_pi_inertia_jacobian(p: Parameters, J: PiInertiaJacobian written) */
-template <typename A0, typename Out>
-inline void pi_inertia_jacobian(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &J)
+template <typename A0, typename Out0>
+inline void pi_inertia_jacobian(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &J)
 {
     lwr_pi_inertia_jacobian(detail::in<Parameters>(p), detail::out<PiInertiaJacobian>(J));
 }
@@ -174,8 +184,8 @@ inline PiInertiaJacobian pi_inertia_jacobian(const Eigen::MatrixBase<A0> &p)
 
 /* Base coefficients pi_full(p) of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  * lwr_pi_full(p: Parameters, pi: PiFull written) */
-template <typename A0, typename Out>
-inline void pi_full(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &pi)
+template <typename A0, typename Out0>
+inline void pi_full(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &pi)
 {
     lwr_pi_full(detail::in<Parameters>(p), detail::out<PiFull>(pi));
 }
@@ -190,8 +200,8 @@ inline PiFull pi_full(const Eigen::MatrixBase<A0> &p)
 
 /* Jacobian d pi_full / d p (for gradient-based extraction).
  * lwr_pi_full_jacobian(p: Parameters, J: PiFullJacobian written) */
-template <typename A0, typename Out>
-inline void pi_full_jacobian(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out> &J)
+template <typename A0, typename Out0>
+inline void pi_full_jacobian(const Eigen::MatrixBase<A0> &p, const Eigen::MatrixBase<Out0> &J)
 {
     lwr_pi_full_jacobian(detail::in<Parameters>(p), detail::out<PiFullJacobian>(J));
 }
@@ -206,8 +216,8 @@ inline PiFullJacobian pi_full_jacobian(const Eigen::MatrixBase<A0> &p)
 
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity.
  * lwr_regressor_gravity(q: Joints, Y: RegressorGravity written) */
-template <typename A0, typename Out>
-inline void regressor_gravity(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &Y)
+template <typename A0, typename Out0>
+inline void regressor_gravity(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out0> &Y)
 {
     lwr_regressor_gravity(detail::in<Joints>(q), detail::out<RegressorGravity>(Y));
 }
@@ -222,8 +232,8 @@ inline RegressorGravity regressor_gravity(const Eigen::MatrixBase<A0> &q)
 
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body).
  * lwr_regressor_inertia(q: Joints, Y: RegressorInertia written) */
-template <typename A0, typename Out>
-inline void regressor_inertia(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out> &Y)
+template <typename A0, typename Out0>
+inline void regressor_inertia(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out0> &Y)
 {
     lwr_regressor_inertia(detail::in<Joints>(q), detail::out<RegressorInertia>(Y));
 }
@@ -238,8 +248,8 @@ inline RegressorInertia regressor_inertia(const Eigen::MatrixBase<A0> &q)
 
 /* Base regressor of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  * lwr_regressor(q: Joints, qd: Joints, qdd: Joints, Y: Regressor written) */
-template <typename A0, typename A1, typename A2, typename Out>
-inline void regressor(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<Out> &Y)
+template <typename A0, typename A1, typename A2, typename Out0>
+inline void regressor(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<Out0> &Y)
 {
     lwr_regressor(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qdd), detail::out<Regressor>(Y));
 }
@@ -254,8 +264,8 @@ inline Regressor regressor(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBa
 
 /* Inverse dynamics tau = M(q) qdd + c(q, qd) + g(q), recursive Newton-Euler.
  * lwr_rnea(q: Joints, qd: Joints, qdd: Joints, s: Parameters, tau: Joints written) */
-template <typename A0, typename A1, typename A2, typename A3, typename Out>
-inline void rnea(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out> &tau)
+template <typename A0, typename A1, typename A2, typename A3, typename Out0>
+inline void rnea(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out0> &tau)
 {
     lwr_rnea(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qdd), detail::in<Parameters>(s), detail::out<Joints>(tau));
 }
@@ -270,8 +280,8 @@ inline Joints rnea(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &
 
 /* Gravity vector g(q).
  * lwr_gravity(q: Joints, s: Parameters, g: Joints written) */
-template <typename A0, typename A1, typename Out>
-inline void gravity(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &s, const Eigen::MatrixBase<Out> &g)
+template <typename A0, typename A1, typename Out0>
+inline void gravity(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &s, const Eigen::MatrixBase<Out0> &g)
 {
     lwr_gravity(detail::in<Joints>(q), detail::in<Parameters>(s), detail::out<Joints>(g));
 }
@@ -286,8 +296,8 @@ inline Joints gravity(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1
 
 /* Inertia matrix M(q).
  * lwr_mass_matrix(q: Joints, s: Parameters, M: MassMatrix written) */
-template <typename A0, typename A1, typename Out>
-inline void mass_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &s, const Eigen::MatrixBase<Out> &M)
+template <typename A0, typename A1, typename Out0>
+inline void mass_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &s, const Eigen::MatrixBase<Out0> &M)
 {
     lwr_mass_matrix(detail::in<Joints>(q), detail::in<Parameters>(s), detail::out<MassMatrix>(M));
 }
@@ -302,8 +312,8 @@ inline MassMatrix mass_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::Matri
 
 /* Joint friction (Coulomb, viscous, Stribeck, direction), the terms of terms/friction.py.
  * lwr_friction(qd: Joints, f: Friction, tau: Joints written) */
-template <typename A0, typename A1, typename Out>
-inline void friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<A1> &f, const Eigen::MatrixBase<Out> &tau)
+template <typename A0, typename A1, typename Out0>
+inline void friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<A1> &f, const Eigen::MatrixBase<Out0> &tau)
 {
     lwr_friction(detail::in<Joints>(qd), detail::in<Friction>(f), detail::out<Joints>(tau));
 }
@@ -314,6 +324,102 @@ inline Joints friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<
     Joints tau;
     friction(qd, f, tau);
     return tau;
+}
+
+/* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.
+ * lwr_link_poses(q: Joints, T: LinkPoses written) */
+template <typename A0, typename Out0>
+inline void link_poses(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out0> &T)
+{
+    lwr_link_poses(detail::in<Joints>(q), detail::out<LinkPoses>(T));
+}
+
+template <typename A0>
+inline LinkPoses link_poses(const Eigen::MatrixBase<A0> &q)
+{
+    LinkPoses T;
+    link_poses(q, T);
+    return T;
+}
+
+/* Pose of the flange frame (last link frame times the description's tool offset) in the base frame.
+ * lwr_flange_pose(q: Joints, T: Pose written) */
+template <typename A0, typename Out0>
+inline void flange_pose(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out0> &T)
+{
+    lwr_flange_pose(detail::in<Joints>(q), detail::out<Pose>(T));
+}
+
+template <typename A0>
+inline Pose flange_pose(const Eigen::MatrixBase<A0> &q)
+{
+    Pose T;
+    flange_pose(q, T);
+    return T;
+}
+
+/* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).
+ * lwr_jacobian(q: Joints, J: Jacobian written) */
+template <typename A0, typename Out0>
+inline void jacobian(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out0> &J)
+{
+    lwr_jacobian(detail::in<Joints>(q), detail::out<Jacobian>(J));
+}
+
+template <typename A0>
+inline Jacobian jacobian(const Eigen::MatrixBase<A0> &q)
+{
+    Jacobian J;
+    jacobian(q, J);
+    return J;
+}
+
+/* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero).
+ * lwr_link_jacobians(q: Joints, J: LinkJacobians written) */
+template <typename A0, typename Out0>
+inline void link_jacobians(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<Out0> &J)
+{
+    lwr_link_jacobians(detail::in<Joints>(q), detail::out<LinkJacobians>(J));
+}
+
+template <typename A0>
+inline LinkJacobians link_jacobians(const Eigen::MatrixBase<A0> &q)
+{
+    LinkJacobians J;
+    link_jacobians(q, J);
+    return J;
+}
+
+/* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).
+ * lwr_jacobian_dot_qd(q: Joints, qd: Joints, jdot_qd: Twist written) */
+template <typename A0, typename A1, typename Out0>
+inline void jacobian_dot_qd(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<Out0> &jdot_qd)
+{
+    lwr_jacobian_dot_qd(detail::in<Joints>(q), detail::in<Joints>(qd), detail::out<Twist>(jdot_qd));
+}
+
+template <typename A0, typename A1>
+inline Twist jacobian_dot_qd(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd)
+{
+    Twist jdot_qd;
+    jacobian_dot_qd(q, qd, jdot_qd);
+    return jdot_qd;
+}
+
+/* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once.
+ * lwr_control(q: Joints, qd: Joints, s: Parameters, g: Joints, M: MassMatrix, c: Joints written) */
+template <typename A0, typename A1, typename A2, typename Out0, typename Out1, typename Out2>
+inline void control(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out0> &g, const Eigen::MatrixBase<Out1> &M, const Eigen::MatrixBase<Out2> &c)
+{
+    lwr_control(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<Joints>(g), detail::out<MassMatrix>(M), detail::out<Joints>(c));
+}
+
+/* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.
+ * lwr_control_with_jacobian(q: Joints, qd: Joints, s: Parameters, g: Joints, M: MassMatrix, c: Joints, J: Jacobian, jdot_qd: Twist written) */
+template <typename A0, typename A1, typename A2, typename Out0, typename Out1, typename Out2, typename Out3, typename Out4>
+inline void control_with_jacobian(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out0> &g, const Eigen::MatrixBase<Out1> &M, const Eigen::MatrixBase<Out2> &c, const Eigen::MatrixBase<Out3> &J, const Eigen::MatrixBase<Out4> &jdot_qd)
+{
+    lwr_control_with_jacobian(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<Joints>(g), detail::out<MassMatrix>(M), detail::out<Joints>(c), detail::out<Jacobian>(J), detail::out<Twist>(jdot_qd));
 }
 
 }  // namespace lwr

@@ -32,6 +32,13 @@
  *   stanford_rnea                311 mul, 314 add, 0 div, 8 sin/cos
  *   stanford_gravity             83 mul, 56 add, 0 div, 8 sin/cos
  *   stanford_mass_matrix         454 mul, 347 add, 0 div, 8 sin/cos
+ *   stanford_link_poses          46 mul, 22 add, 0 div, 10 sin/cos
+ *   stanford_flange_pose         46 mul, 22 add, 0 div, 10 sin/cos
+ *   stanford_jacobian            50 mul, 43 add, 0 div, 8 sin/cos
+ *   stanford_link_jacobians      56 mul, 47 add, 0 div, 8 sin/cos
+ *   stanford_jacobian_dot_qd     143 mul, 85 add, 0 div, 8 sin/cos
+ *   stanford_control             815 mul, 670 add, 0 div, 8 sin/cos
+ *   stanford_control_with_jacobian 976 mul, 784 add, 0 div, 10 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -164,6 +171,66 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
  * 454 mul, 347 add, 0 div, 8 sin/cos
  */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
+
+/* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.
+ *   q        [6]  joint positions [rad or m]
+ *   T        [24 x 4]  row-major 4x4 pose of link frame i in rows 4(i-1)..4i-1 (written)
+ * 46 mul, 22 add, 0 div, 10 sin/cos
+ */
+void stanford_link_poses(const stanford_real *q, stanford_real *T);
+
+/* Pose of the flange frame (last link frame times the description's tool offset) in the base frame.
+ *   q        [6]  joint positions [rad or m]
+ *   T        [4 x 4]  row-major 4x4 [R p; 0 0 0 1] (written)
+ * 46 mul, 22 add, 0 div, 10 sin/cos
+ */
+void stanford_flange_pose(const stanford_real *q, stanford_real *T);
+
+/* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).
+ *   q        [6]  joint positions [rad or m]
+ *   J        [6 x 6]  row-major, rows [v; w] (written)
+ * 50 mul, 43 add, 0 div, 8 sin/cos
+ */
+void stanford_jacobian(const stanford_real *q, stanford_real *J);
+
+/* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero).
+ *   q        [6]  joint positions [rad or m]
+ *   J        [36 x 6]  row-major, rows 6(i-1)..6i-1: link i's [v; w] (written)
+ * 56 mul, 47 add, 0 div, 8 sin/cos
+ */
+void stanford_link_jacobians(const stanford_real *q, stanford_real *J);
+
+/* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
+ * 143 mul, 85 add, 0 div, 8 sin/cos
+ */
+void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *jdot_qd);
+
+/* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [6]  gravity torques (written)
+ *   M        [6 x 6]  inertia matrix, row-major, symmetric (written)
+ *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ * 815 mul, 670 add, 0 div, 8 sin/cos
+ */
+void stanford_control(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c);
+
+/* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   g        [6]  gravity torques (written)
+ *   M        [6 x 6]  inertia matrix, row-major, symmetric (written)
+ *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
+ *   J        [6 x 6]  flange Jacobian, row-major, rows [v; w] (written)
+ *   jdot_qd  [6]  Jdot qd of the flange (written)
+ * 976 mul, 784 add, 0 div, 10 sin/cos
+ */
+void stanford_control_with_jacobian(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c, stanford_real *J, stanford_real *jdot_qd);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [48] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

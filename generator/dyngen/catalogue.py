@@ -7,8 +7,9 @@ manifest derive from it; code that calls the generated functions (identification
 validation, diagnosis) takes their names from here. The C name is <robot>_<name>.
 
 Shapes are tuples of dimension names, resolved per robot by `dimensions`:
-dof (N), parameters (10 N), stacked (N(N+1)/2), gravity_symbols, friction (5 N) and
-pi_<kind> (the number of base coefficients of a kind).
+dof (N), parameters (10 N), stacked (N(N+1)/2), gravity_symbols, friction (5 N),
+pi_<kind> (the number of base coefficients of a kind), homogeneous (4), twist (6),
+link_pose_rows (4 N) and link_twist_rows (6 N).
 """
 
 from __future__ import annotations
@@ -73,6 +74,11 @@ class Function:
     check: Check
     kind: str = ""  # gravity | inertia | full, for coefficient and regressor functions
     state: bool = True  # whether it reads a joint state (checked at every self-test state)
+    more: tuple = ()  # further Outputs, written by the same call after `output`
+
+    @property
+    def outputs(self) -> tuple:
+        return (self.output, *self.more)
 
     def arguments(self, gravity_symbols: bool) -> tuple:
         return tuple(a for a in self.inputs if a != "gravity" or gravity_symbols)
@@ -127,19 +133,65 @@ FRICTION = Function(
     Output("tau", ("dof",), "friction torques", "Joints"),
     "Joint friction (Coulomb, viscous, Stribeck, direction), the terms of terms/friction.py.", Check())
 
+# ---- kinematics (derivation/kinematics_functions.py): base frame, rows [v; w] ---------------
+LINK_POSES = Function(
+    "link_poses", "kinematics", "link_poses", ("q",),
+    Output("T", ("link_pose_rows", "homogeneous"), "row-major 4x4 pose of link frame i in rows 4(i-1)..4i-1",
+           "LinkPoses"),
+    "Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.", Check())
+FLANGE_POSE = Function(
+    "flange_pose", "kinematics", "flange_pose", ("q",),
+    Output("T", ("homogeneous", "homogeneous"), "row-major 4x4 [R p; 0 0 0 1]", "Pose"),
+    "Pose of the flange frame (last link frame times the description's tool offset) in the base frame.", Check())
+JACOBIAN = Function(
+    "jacobian", "kinematics", "jacobian", ("q",),
+    Output("J", ("twist", "dof"), "row-major, rows [v; w]", "Jacobian"),
+    "Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, "
+    "w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).", Check())
+LINK_JACOBIANS = Function(
+    "link_jacobians", "kinematics", "link_jacobians", ("q",),
+    Output("J", ("link_twist_rows", "dof"), "row-major, rows 6(i-1)..6i-1: link i's [v; w]", "LinkJacobians"),
+    "Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first "
+    "(columns of the joints after link i are zero).", Check())
+JACOBIAN_DOT_QD = Function(
+    "jacobian_dot_qd", "kinematics", "jacobian_dot_qd", ("q", "qd"),
+    Output("jdot_qd", ("twist",), "[linear; angular] acceleration at qdd = 0", "Twist"),
+    "Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular "
+    "acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control).", Check())
+
+# ---- one call per control cycle (derivation/control.py): one program, several outputs ------
+_CONTROL_OUTPUTS = (Output("M", ("dof", "dof"), "inertia matrix, row-major, symmetric", "MassMatrix"),
+                    Output("c", ("dof",), "velocity torques c(q, qd) = rnea(q, qd, 0) - g(q)", "Joints"))
+CONTROL = Function(
+    "control", "control", "control", ("q", "qd", "s", "gravity"),
+    Output("g", ("dof",), "gravity torques", "Joints"),
+    "g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions "
+    "once.", Check(), more=_CONTROL_OUTPUTS)
+CONTROL_WITH_JACOBIAN = Function(
+    "control_with_jacobian", "control", "control_with_jacobian", ("q", "qd", "s", "gravity"),
+    Output("g", ("dof",), "gravity torques", "Joints"),
+    "control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call.", Check(),
+    more=_CONTROL_OUTPUTS + (Output("J", ("twist", "dof"), "flange Jacobian, row-major, rows [v; w]", "Jacobian"),
+                             Output("jdot_qd", ("twist",), "Jdot qd of the flange", "Twist")))
+
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
-             FRICTION)
+             FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD,
+             CONTROL, CONTROL_WITH_JACOBIAN)
+KINEMATICS = (LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
 JACOBIANS = {"gravity": PI_GRAVITY_JACOBIAN, "inertia": PI_INERTIA_JACOBIAN, "full": PI_FULL_JACOBIAN}
 REGRESSORS = {"gravity": REGRESSOR_GRAVITY, "inertia": REGRESSOR_INERTIA, "full": REGRESSOR}
 SOURCES = {"parameters": "parameters and base coefficients", "regressors": "base regressors",
-           "dynamics": "inverse dynamics, gravity and inertia matrix"}  # straight-line C files, in order
+           "dynamics": "inverse dynamics, gravity and inertia matrix",
+           "kinematics": "forward kinematics and Jacobians",
+           "control": "one call per control cycle"}  # straight-line C files, in order
 
 
 def dimensions(dof: int, ranks: dict, gravity_symbols: int) -> dict:
     """Dimension name -> size for one robot; ranks: kind -> number of base coefficients."""
     return {"dof": dof, "parameters": PER_LINK * dof, "stacked": dof * (dof + 1) // 2,
             "gravity_symbols": gravity_symbols, "friction": FRICTION_PER_JOINT * dof,
+            "homogeneous": 4, "twist": 6, "link_pose_rows": 4 * dof, "link_twist_rows": 6 * dof,
             **{f"pi_{kind}": rank for kind, rank in ranks.items()}}

@@ -9,6 +9,8 @@ from pathlib import Path
 
 from .atomic import write_folder
 from .catalogue import KINDS
+from .derivation.control import control_model
+from .derivation.kinematics_functions import KinematicsModels
 from .derivation.models import Derivation
 from .description import Robot, load_robot
 from .emission.render import Emitted, emit
@@ -54,7 +56,8 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
         regressors = {kind: derivation.regressor(kind) for kind in ("gravity", "full")}
         reduced = {**regressors, "inertia": derivation.regressor("full_without_gravity")}
         models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix(),
-                  "unit_accelerations": derivation.unit_accelerations()}
+                  "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),
+                  "control": control_model(robot), "control_with_jacobian": control_model(robot, with_jacobian=True)}
     with progress.step("reduce to base coefficients (exact rank)"):
         try:
             bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}

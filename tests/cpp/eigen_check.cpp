@@ -58,6 +58,23 @@ int main()
         print("Y", Y);
         const lwr::Joints Y_pi = Y * pi;
         print("Y_pi", Y_pi);
+
+        print("flange_pose", lwr::flange_pose(q));
+        print("link_poses", lwr::link_poses(q));
+        print("jacobian", lwr::jacobian(q));
+        print("link_jacobians", lwr::link_jacobians(q));
+        print("jacobian_dot_qd", lwr::jacobian_dot_qd(q, qd));
+        lwr::Joints g_control, c_control;  // several outputs: the form that writes into arguments
+        lwr::MassMatrix M_control;
+        lwr::control(q, qd, s, g_control, M_control, c_control);
+        print("control_g", g_control);
+        print("control_M", M_control);
+        print("control_c", c_control);
+        lwr::Jacobian J;
+        lwr::Twist jdot_qd;
+        lwr::control_with_jacobian(q, qd, s, g_control, M_control, c_control, J, jdot_qd);
+        print("control_J", J);
+        print("control_jdot_qd", jdot_qd);
     }
     return 0;
 }

@@ -19,10 +19,11 @@ from ..parameters import dynamic_symbols, standard_symbols
 from ..untrusted import read_yaml
 from .expressions import ExpressionError, exact_number, parse_expression, shorten
 from .robot import IdentifiedCoefficient, Joint, Limits, LinkValues, Robot
+from .tool import tool_frame
 
-_TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction"}
+_TOP_KEYS = {"name", "description", "dh", "gravity", "joints", "parameters", "identified", "extraction", "tool"}
 _URDF_KEYS = {"urdf", "base_link", "tip_link", "snap", "name", "description", "gravity", "parameters", "identified",
-              "extraction", "limits"}
+              "extraction", "limits", "tool"}
 _EXTRACTION_KEYS = yaml_keys(ExtractionOptions) | {"compare"}  # every extraction option, and the compared file
 _JOINT_KEYS = {"type", "a", "alpha", "d", "theta", "limits", "name"}
 _LIMIT_KEYS = {"lower", "upper", "velocity", "acceleration", "effort"}
@@ -157,7 +158,18 @@ class _Reader:
         extraction = self.extraction(doc.get("extraction") or {}, names)
         return Robot(name=name, source=self.source, convention=convention, joints=joints, gravity=gravity,
                      nominal=nominal, lower=lower, upper=upper, total_mass=total_mass, identified=identified,
-                     extraction=extraction)
+                     extraction=extraction, tool=self.tool(doc.get("tool")))
+
+    def tool(self, value):
+        """The optional flange offset (description/tool.py), in the last link frame."""
+        if value is None:
+            return None
+        value = self.mapping(value, "tool", {"xyz", "rpy"})
+        xyz = [self.exact(x, f"tool.xyz[{k}]", limit=MAX_LENGTH, smallest=MIN_LENGTH)
+               for k, x in enumerate(self.sequence(value.get("xyz", [0, 0, 0]), "tool.xyz", 3))]
+        rpy = [self.exact(x, f"tool.rpy[{k}]", "a number or an expression of pi", limit=MAX_ANGLE)
+               for k, x in enumerate(self.sequence(value.get("rpy", [0, 0, 0]), "tool.rpy", 3))]
+        return tool_frame(xyz, rpy)
 
     def urdf_robot(self, doc, folder: Path) -> Robot:
         """A YAML that points to a URDF (urdf:, base_link, tip_link, snap) and adds what a URDF lacks:
@@ -209,6 +221,9 @@ class _Reader:
                                              for k, c in enumerate(self.sequence(ident[kind], f"identified.{kind}")))
                                  for kind in _IDENTIFIED_KINDS if kind in ident}
         changes["extraction"] = self.extraction(doc.get("extraction") or {}, names)
+        if "tool" in doc:  # given in the URDF tip link's frame: moved into dyngen's last link frame
+            tool = self.tool(doc["tool"])
+            changes["tool"] = robot.link_frames[-1] * tool if robot.link_frames else tool
         if "limits" in doc:  # per joint, in chain order: what excite needs beyond the URDF's
             raw = self.sequence(doc["limits"], "limits", n)
             joints = []

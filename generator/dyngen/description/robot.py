@@ -14,6 +14,7 @@ import sympy as sp
 
 from ..parameters import DYNAMIC_NAMES_PER_LINK
 from .dh import joint_models
+from .joint_model import Rigid
 
 
 @dataclass(frozen=True)
@@ -86,6 +87,7 @@ class Robot:
     link_frames: tuple = ()  # per body: the URDF link's frame in dyngen's link frame i (a Rigid)
     urdf_file: Optional[str] = None  # the URDF read (its full path), for export/urdf_copy.py
     urdf_options: dict = field(default_factory=dict)  # base_link, tip_link, snap it was read with
+    tool: Optional[Rigid] = None  # the flange frame in the last link frame (description/tool.py); None: the same
 
     @property
     def dof(self) -> int:

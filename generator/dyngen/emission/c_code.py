@@ -6,7 +6,7 @@ Inputs are flat arrays (q[0] is joint 1), constants go through the robot's cast 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -23,6 +23,11 @@ class CFunction:
     body: list[str]
     ops: OpCount
     used: set  # input arguments the body reads (the others are cast to void)
+    more: list = field(default_factory=list)  # further outputs (argument name, shape, meaning), after output
+
+    @property
+    def outputs(self) -> list:
+        return [self.output, *self.more]
 
 
 class Printer(C99CodePrinter):

@@ -21,6 +21,11 @@ TYPE_DOCS = {
     "RegressorInertia": "Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)",
     "Regressor": "Y(q, qd, qdd): tau = Y pi_full",
     "Friction": f"friction values, {FRICTION_PER_JOINT} per joint: " + ", ".join(FRICTION_NAMES),
+    "Pose": "4x4 homogeneous pose [R p; 0 0 0 1] in the base frame",
+    "LinkPoses": "the 4x4 pose of every link frame stacked, link 1 first",
+    "Jacobian": "geometric Jacobian, rows [v; w] in the base frame",
+    "LinkJacobians": "the Jacobian of every link frame's origin stacked, link 1 first",
+    "Twist": "[linear; angular] in the base frame",
 }
 
 
@@ -51,6 +56,11 @@ class Wrapper:
     doc: str
     inputs: list  # (argument name, EigenType name)
     output: tuple  # (argument name, EigenType name)
+    more: list  # further outputs (argument name, EigenType name): then only the form that writes into arguments
+
+    @property
+    def outputs(self) -> list:
+        return [self.output, *self.more]
 
 
 def eigen_interface(prefix: str, dims: dict, docs: dict) -> dict:
@@ -70,8 +80,8 @@ def eigen_interface(prefix: str, dims: dict, docs: dict) -> dict:
     for f in FUNCTIONS:
         c_name = f"{prefix}_{f.name}"
         inputs = [(arg, use(ARGUMENTS[arg].eigen, ARGUMENTS[arg].shape)) for arg in f.arguments(has_gravity)]
-        output = (f.output.name, use(f.output.eigen, f.output.shape))
-        wrappers.append(Wrapper(f.name, c_name, docs.get(c_name, f.doc), inputs, output))
+        output, *more = [(o.name, use(o.eigen, o.shape)) for o in f.outputs]
+        wrappers.append(Wrapper(f.name, c_name, docs.get(c_name, f.doc), inputs, output, more))
     first = ["Joints", "Parameters", "GravitySymbols", "MassMatrix"]
     ordered = sorted(types.values(), key=lambda t: first.index(t.name) if t.name in first else len(first))
     largest = max(ordered, key=lambda t: t.rows * t.cols)

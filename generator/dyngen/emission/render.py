@@ -19,6 +19,7 @@ from .c_code import CFunction, render_function
 from .coefficients import dynamic_names_text, grouped_text
 from .eigen import eigen_interface
 from .inertia_regressor import render_inertia_regressor
+from .outputs import render_outputs
 from .selftest import N_STATES, TOLERANCE, c_numbers, selftest_checks, selftest_data
 
 TEMPLATES = Path(__file__).resolve().parents[1] / "templates"  # package data, shipped in the wheel
@@ -138,13 +139,18 @@ def _c_function(robot, f, programs: dict, models: dict, bases: dict, dims: dict)
     P = robot.name
     if f.model == "unit_accelerations":  # factored: O(n^2) code for its O(n^3) entries
         c = render_inertia_regressor(P, robot.joint_models, models["unit_accelerations"], bases[f.kind], f.doc)
+    elif f.more:  # one program, several output arrays
+        model, _ = programs[f.name]
+        outs = [(o.name, tuple(dims[d] for d in o.shape), o.meaning) for o in f.outputs]
+        c = render_outputs(P, robot.joint_models, f.name, model, outs, f.doc)
     else:
         model, outputs = programs[f.name]
         output = (f.output.name, tuple(dims[d] for d in f.output.shape), f.output.meaning)
         c = render_function(P, robot.joint_models, f.name, model, outputs, output, f.doc)
     expected = f.arguments(bool(robot.gravity_symbols))
     assert c.name == f"{P}_{f.name}" and tuple(name for name, _, _ in c.inputs) == expected, (c.name, c.inputs)
-    assert c.output[0] == f.output.name and tuple(c.output[1]) == tuple(dims[d] for d in f.output.shape), c.output
+    for written, o in zip(c.outputs, f.outputs, strict=True):
+        assert written[0] == o.name and tuple(written[1]) == tuple(dims[d] for d in o.shape), written
     return c
 
 
@@ -154,6 +160,7 @@ def _template_function_manifest(P: str, f, dims: dict) -> dict:
             "inputs": [{"name": a, "length": math.prod(dims[d] for d in catalogue.ARGUMENTS[a].shape),
                         "meaning": catalogue.ARGUMENTS[a].meaning} for a in f.inputs],
             "output": {"name": f.output.name, "shape": [dims[d] for d in f.output.shape], "meaning": f.output.meaning},
+            "outputs": [{"name": f.output.name, "shape": [dims[d] for d in f.output.shape], "meaning": f.output.meaning}],
             "ops": None}
 
 
@@ -181,6 +188,7 @@ def _manifest(robot, functions, kinds, std_names, n_stacked) -> dict:
             "name": f.name, "doc": f.doc,
             "inputs": [{"name": a, "length": length, "meaning": m} for a, length, m in f.inputs],
             "output": {"name": f.output[0], "shape": list(f.output[1]), "meaning": f.output[2]},
+            "outputs": [{"name": name, "shape": list(shape), "meaning": meaning} for name, shape, meaning in f.outputs],
             "ops": {"mul": f.ops.mul, "add": f.ops.add, "div": f.ops.div, "sin_cos": f.ops.trig},
         } for f in functions],
         "coefficients": {k["name"]: {

@@ -121,8 +121,15 @@ def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
 
     checks = []
     for fn in sorted(FUNCTIONS, key=lambda fn: fn.state):
-        args = [arrays.get(a, a) for a in fn.arguments(has_gravity)] + [f"{fn.name}_out"]
-        check = {"name": fn.name, "state": fn.state, "out": f"{fn.name}_out", "length": size(fn.output.shape),
+        parts, offset = [], 0  # a function with several outputs: each checked against its slice
+        for o in fn.outputs if fn.more else ():
+            parts.append({"out": f"{fn.name}_{o.name}_out", "offset": offset, "length": size(o.shape),
+                          "label": f"{fn.name}.{o.name}"})
+            offset += size(o.shape)
+        outs = [part["out"] for part in parts] or [f"{fn.name}_out"]
+        args = [arrays.get(a, a) for a in fn.arguments(has_gravity)] + outs
+        check = {"name": fn.name, "state": fn.state, "out": f"{fn.name}_out",
+                 "length": offset or size(fn.output.shape), "parts": parts,
                  "call": f"{prefix}_{fn.name}({', '.join(args)})", "expected": f"{BY_NAME[fn.expected].name}_expected",
                  "label": fn.name, "times": None, "stacked": fn.check.stacked}
         if fn.check.times:
