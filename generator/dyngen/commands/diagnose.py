@@ -89,11 +89,24 @@ def main(argv, prog="dyngen diagnose") -> int:
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = compiled_model(args, robot, progress)
-    with progress.step("residual, effects, selection, test"):
-        result = diagnose(robot, model, p, fit, select or None, options, test=test)
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
     sources = {"params": Path(args.params).name, "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
+    from ..diagnosis.trust import EXIT_UNUSABLE, Unusable
+
+    try:
+        with progress.step("residual, effects, selection, test"):
+            result = diagnose(robot, model, p, fit, select or None, options, test=test)
+    except Unusable as err:  # nothing claimed: the line, report.md and the figure that shows why
+        from ..diagnosis.unusable_output import write_unusable
+
+        import sys
+
+        paths = write_unusable(err, out, sources)
+        print(f"dyngen diagnose: {err.line}", file=sys.stderr)
+        if not args.quiet:
+            print(f"  written: {', '.join(str(v) for v in paths.values())}")
+        return EXIT_UNUSABLE
     with progress.step("report, JSON, figures, updated model"):
         paths = write_outputs(result, robot, p, out, sources, options.sign_velocity)
     if not args.quiet:

@@ -18,7 +18,7 @@ import numpy as np
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from . import baseline as simple_model
 from . import design as dz
-from . import joints, phases, reidentify, roles
+from . import joints, phases, reidentify, roles, trust
 from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
@@ -130,6 +130,10 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     p = np.asarray(p, dtype=float)
     s = model(STANDARD_FROM_DYNAMIC.name, p)
     n = robot.dof
+    # --- hook (trust.py): a recording whose nominal residual exceeds its torques is conditioned
+    # again, or raises trust.Unusable (nothing claimed)
+    fit_signals, select_signals, test = trust.checked_roles(model, s, fit_signals, select_signals, test)
+    # ---
     segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
     # Position- and velocity-dependent laws are known only over what the fit data cover.
     fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
