@@ -10,7 +10,8 @@ torque itself; every effect fitted to it is then a description of the noise.
     signals, notes = checked(model, s, signals)    # raises Unusable when nothing helps
 
 For each recording the nominal residual RMS is compared with the measured torque's RMS on the
-joints that carry torque (above TORQUE_FLOOR of the largest). Where the residual is larger,
+joints that carry torque (above TORQUE_FLOOR of the largest). Where the residual is ABOVE times
+larger,
 the recording is conditioned again, when its cutoff was the automatic one: positions
 differentiated through the automatic cutoff (if recorded velocities were used), then cutoffs
 halved down to MIN_CUTOFF; the highest cutoff whose residual is within KEEP of the best tried
@@ -30,6 +31,8 @@ import numpy as np
 from ..catalogue import RNEA
 
 TORQUE_FLOOR = 0.05  # joints carrying less torque RMS than this share of the largest are not judged
+ABOVE = 1.5  # a residual this many times the torque's RMS is not the model's error (a joint whose torque is
+# all friction, which the nominal model lacks, has a residual as large as its torque)
 KEEP = 1.1  # the highest cutoff whose mean squared residual share is within this factor of the best
 MIN_CUTOFF = 0.5  # Hz
 EXIT_UNUSABLE = 3  # `dyngen diagnose` exit status when a recording's conditioning cannot be trusted
@@ -49,7 +52,7 @@ class Trial:
     @property
     def above(self) -> list[int]:
         """0-based joints whose nominal residual exceeds their torque."""
-        return [int(j) for j in np.flatnonzero(self.judged & (self.residual > self.torque))]
+        return [int(j) for j in np.flatnonzero(self.judged & (self.residual > ABOVE * self.torque))]
 
     @property
     def share(self) -> float:
