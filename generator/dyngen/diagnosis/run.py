@@ -18,7 +18,7 @@ import numpy as np
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from . import baseline as simple_model
 from . import design as dz
-from . import joints, phases, reidentify, roles, trust
+from . import findings_check, joints, phases, reidentify, roles, trust
 from ..data.correlation import integrated_time
 from .effects import Context, effect_class, library
 from .options import Options
@@ -236,7 +236,10 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     result.conditioning = [{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
                            for role, group in (("fit", fit_signals), ("select", select_signals or []),
                                                ("test", test or [])) for sig in group]
-    result.warnings = _warnings(result, model, s, fit_signals, select_signals or [], test or [], used)
+    # --- hook (findings_check.py): findings outside their physical range are marked suspect
+    apart = findings_check.check(result, model, s, fit_signals)
+    # ---
+    result.warnings = _warnings(result, model, s, fit_signals, select_signals or [], test or [], used) + apart
     return result
 
 
