@@ -49,15 +49,14 @@ def main() -> int:
              "`python bench/bench_lwr_real.py`: paper's parameters (examples/lwr_paper_solution.yaml), default "
              "options; fit on the named measurement(s) with selection on blocks of them, test on another that "
              "plays no other part. Test RMS per joint [Nm]; 'simple' is b + Fc tanh(qd/0.02) + Fv qd per joint "
-             "fitted on the same fit data. The default tries the consistent re-identification of the link parameters "
-             "as a per-joint alternative (diagnosis/reidentify.py); the last row: the same without it "
-             "(`--no-reidentify`).", ""]
+             "fitted on the same fit data. The last row: the same with the consistent re-identification of the link "
+             "parameters as a per-joint alternative (`--reidentify`, diagnosis/reidentify.py).", ""]
     for fit, test in RUNS:
         start = time.perf_counter()
         d = diagnose(robot, model, p, [recording(k) for k in fit], None, test=[recording(k) for k in test])
         seconds = time.perf_counter() - start
         start = time.perf_counter()
-        r = diagnose(robot, model, p, [recording(k) for k in fit], None, Options(reidentify=False),
+        r = diagnose(robot, model, p, [recording(k) for k in fit], None, Options(reidentify=True),
                      test=[recording(k) for k in test])
         r_seconds = time.perf_counter() - start
         r_after = np.array(r.rms_after)
@@ -72,19 +71,19 @@ def main() -> int:
                   "| selected effects alone | " + " | ".join(f"{x:.3f}" for x in d.rms_effects)
                   + f" | {np.mean(d.rms_effects):.3f} |",
                   "| simple model | " + " | ".join(f"{x:.3f}" for x in simple) + f" | {simple.mean():.3f} |",
-                  f"| final model with `--no-reidentify` ({r_seconds:.1f} s) | " + " | ".join(f"{x:.3f}" for x in r_after)
+                  f"| final model with `--reidentify` ({r_seconds:.1f} s) | " + " | ".join(f"{x:.3f}" for x in r_after)
                   + f" | {r_after.mean():.3f} |", "",
-                  f"With `--no-reidentify`: worse than the simple model on {r_worse or 'none'}. Link parameters off (default): "
-                  f"{d.consistent['joints'] if d.consistent else 'not claimed'}"
-                  + (f" (regularisation {d.consistent['regularisation']:g})" if d.consistent else "") + ".", "",
+                  f"With `--reidentify`: worse than the simple model on {r_worse or 'none'}; link parameters off: "
+                  f"{r.consistent['joints'] if r.consistent else 'not claimed'}"
+                  + (f" (regularisation {r.consistent['regularisation']:g})" if r.consistent else "") + ".", "",
                   within_fit_speeds(d),
                   f"Joints where the final model is worse than the simple model: {worse or 'none'}. Per joint "
                   f"model: {', '.join(f'J{j + 1} {m}' for j, m in enumerate(d.joint_models))}.", "",
                   "Selected: " + "; ".join(f"{e['effect']} {e['joints']}" for e in d.selected) + ".", ""]
         lines += [f"- warning: {w}" for w in d.warnings] + [""]
         print(f"{name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple {np.round(simple, 3)}; "
-              f"worse on {worse}; --no-reidentify {np.round(r_after, 3)} mean {r_after.mean():.3f} worse on {r_worse}, "
-              f"link parameters off {d.consistent['joints'] if d.consistent else None}", flush=True)
+              f"worse on {worse}; --reidentify {np.round(r_after, 3)} mean {r_after.mean():.3f} worse on {r_worse}, "
+              f"link parameters off {r.consistent['joints'] if r.consistent else None}", flush=True)
     lines += positions_only(robot, model, p)
     lines += block_lengths(robot, model, p, recording)
     write_file(ROOT / "bench" / "results" / "lwr_real.md", "\n".join(lines))

@@ -17,7 +17,7 @@ from conftest import ROOT
 from dyngen.data import condition, read_recording
 from dyngen.data.parameters_file import read_link_parameters
 from dyngen.description import load_robot
-from dyngen.diagnosis import diagnose
+from dyngen.diagnosis import Options, diagnose
 from dyngen.runtime import load
 
 LWR = ROOT / "examples" / "lwr.yaml"
@@ -58,9 +58,10 @@ def test_injected_offsets_are_not_flagged():
 def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
     """The LWR in MuJoCo with link 3's mass, first moments and inertia 10 % above the model's
     (bench/simulation/withheld_cases.py, 200 Hz, 20-bit encoder positions, 0.05 Nm torque noise),
-    once without and once with the 1.5 kg payload; default options (the re-identification is
-    tried). The payload is found only where it is (within 5 %), and both runs say that the link
-    parameters are off instead of naming friction or ripple for them."""
+    once without and once with the 1.5 kg payload. With default options both runs warn that the
+    link parameters may be off (the re-identification's gate); with --reidentify the payload is
+    found only where it is (within 5 %), and both runs say that the link parameters are off
+    instead of naming friction or ripple for them."""
     import sys
 
     sys.path.insert(0, str(ROOT / "bench"))
@@ -77,7 +78,9 @@ def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
         for name, text in case_files(case, k, robot, p_true, trajs, 0.05, 0, Encoder()).items():
             (tmp_path / name).write_text(text)
         fit, test = (condition(read_recording(tmp_path / f"{case.name}.{r}.csv", 7)) for r in ("fit", "holdout"))
-        d = diagnose(robot, model, p_model, [fit], None, test=[test])
+        plain = diagnose(robot, model, p_model, [fit], None, test=[test])
+        assert any(w.startswith("the link parameters may be off") for w in plain.warnings), case.name
+        d = diagnose(robot, model, p_model, [fit], None, Options(reidentify=True), test=[test])
         found[case.name] = d
         assert d.consistent and {2, 3} <= set(d.consistent["joints"]), case.name
         assert any(w.startswith("link parameters off") for w in d.warnings)

@@ -183,3 +183,38 @@ def test_identify_reports_its_sanity_and_the_simple_model_beside(tmp_path):
     assert np.all(np.array([float(v) for v in row.split("|")[2:-1]]) < simple)
     assert "use the simple model there" not in r.stdout
     assert "last of its search grid" in r.stdout
+
+
+@pytest.fixture(scope="module")
+def exact(tmp_path_factory):
+    out = tmp_path_factory.mktemp("exact1k") / "clean"
+    return out, write_cases(out, rate_hz=1000.0, cases=[CASE])
+
+
+def test_a_franka_like_log_with_recorded_velocities(arm, exact, tmp_path):
+    """As franka_ros logs: q from a 20-bit encoder (1e-5 rad noise), the controller's qd (1e-3
+    rad/s noise), no qdd, 0.05 Nm torque noise, written by a polling logger (repeated rows,
+    dropped samples, late stamps). qdd is differentiated from the recorded qd through a cutoff
+    chosen from qd's noise (it used to be differentiated unfiltered)."""
+    folder, doc = exact
+    out = tmp_path / "franka"
+    out.mkdir()
+    step = 2 * np.pi / 2 ** 20
+    for f in folder.iterdir():
+        if f.suffix != ".csv":
+            shutil.copy(f, out / f.name)
+            continue
+        header, data = logger.parse(f.read_text())
+        names = header.split(",")
+        rng = np.random.default_rng(len(f.name))
+        keep = [k for k, n in enumerate(names) if not n.startswith("qdd")]
+        data[:, 1:8] = np.round((data[:, 1:8] + 1e-5 * rng.standard_normal((data.shape[0], 7))) / step) * step
+        data[:, 8:15] += 1e-3 * rng.standard_normal((data.shape[0], 7))
+        tau = [k for k, n in enumerate(names) if n.startswith("tau")]
+        data[:, tau] += 0.05 * rng.standard_normal((data.shape[0], 7))
+        text = logger.unparse(",".join(names[k] for k in keep), data[:, keep])
+        (out / f.name).write_text(logger.polled(text, len(f.name)))
+    r = run(*arm, out, doc, CASE.name, "forward")
+    assert r["problems"] == [], "\n".join(r["problems"])
+    assert all(c is not None and c < 20 for c in r["cutoff"])
+    assert _below_the_torques(r, out, doc["cases"][0], arm)

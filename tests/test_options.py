@@ -113,7 +113,7 @@ TYPED = {"kind": ("gravity", "gravity"), "ols": (None, True), "consistent": (Non
          "friction": ("coulomb, ripple", ("coulomb", "ripple")), "candidates": ("tilt", ("tilt",)), "smoothing": ("0.01", 0.01),
          "regularisation": ("3", 3.0), "tilt": (None, True), "cutoff": ("none", None), "order": ("2", 2),
          "differentiate": (None, True), "effects": ("offset,gain", ("offset", "gain")), "min_gain": ("0.1", 0.1),
-         "sign_velocity": ("0.01", 0.01), "reidentify": (None, False), "seed": ("7", 7), "period": ("5", 5.0),
+         "sign_velocity": ("0.01", 0.01), "reidentify": (None, True), "seed": ("7", 7), "period": ("5", 5.0),
          "harmonics": ("3", 3), "margin": ("0.5", 0.5), "max_iterations": ("9", 9), "criterion": ("logdet", "logdet"),
          "rate": ("200", 200.0), "periods": ("2", 2)}
 

@@ -22,9 +22,7 @@ class Options:
                                   "V in rad/s (Coulomb's own scale is fitted)", metavar="V", bounds=(0.0, 1e3),
                                   above=True)
     block_seconds: float = 2.0  # without selection recordings: blocks of this length, each third selects in turn
-    reidentify: bool = option(True, "do not try the explanation 'the link parameters are off'. By default, where "
-                              "the rigid body's columns explain what the effects leave on selection data (a cheap "
-                              "gate), physically consistent link parameters (with friction and a tilted base) are "
-                              "re-identified from the fit data and used on the joints where they beat every effect "
-                              "and the simple model on selection data; the report then says 'link parameters off' and "
-                              "they are written to consistent/", flag="--no-reidentify")
+    reidentify: bool = option(False, "also re-identify physically consistent link parameters (with friction and a "
+                              "tilted base) from the fit data, and use them on the joints where they beat every "
+                              "effect and the simple model on selection data; says 'link parameters off' and writes "
+                              "them to consistent/ (experimental: see README)")

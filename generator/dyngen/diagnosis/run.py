@@ -172,6 +172,13 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     else:
         modes = _decide_on_folds(context, segments, design, chosen, final, options)
     reid, consistent = None, None
+    # --- hook (issue 25): without the re-identification its cheap gate still says where the rigid
+    # body's columns explain what the effects leave: the link parameters may be off there
+    links_hint = []
+    if not options.reidentify and design.select.count and all(seg.correction is not None for seg in segments):
+        links_hint = reidentify.gate(model, segments, [seg.residual - seg.correction for seg in segments],
+                                     options.min_gain)
+    # ---
     if options.reidentify and design.select.count:
         reid, consistent, modes = _reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
                                                 options.min_gain)
@@ -239,6 +246,11 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # --- hook (findings_check.py): findings outside their physical range are marked suspect
     apart = findings_check.check(result, model, s, fit_signals)
     # ---
+    if links_hint:
+        apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in links_hint)
+                     + " the rigid body's own columns explain what the effects leave on selection data, so the "
+                     "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
+                     "parameters as an alternative (or identify them first: dyngen identify)")
     result.warnings = _warnings(result, model, s, fit_signals, select_signals or [], test or [], used) + apart
     return result
 
