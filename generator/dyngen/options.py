@@ -28,7 +28,7 @@ def option(default, help: str, *, flag: str = "", metavar: str = "", choices: tu
     list); listed: a tuple of names given as one comma-separated argument (with choices: each
     one of them); parse: the
     argparse type of an option that is none of these (e.g. a number or a word). A bool
-    default makes an on/off flag; const, a flag without argument that sets this value (for a
+    default makes an on/off flag (a True default: give it flag="--no-..." to turn it off); const, a flag without argument that sets this value (for a
     default None meaning "decided from the data", e.g. --tilt)."""
     metadata = {"help": help, "flag": flag, "metavar": metavar, "choices": tuple(choices), "bounds": bounds,
                 "above": above, "repeat": repeat, "listed": listed, "parse": parse, "const": const}
@@ -59,8 +59,8 @@ def add_arguments(group, cls) -> None:
             kwargs["metavar"] = m["metavar"]
         if m["const"] is not None:
             kwargs["action"], kwargs["const"] = "store_const", m["const"]
-        elif isinstance(default, bool):
-            kwargs["action"] = "store_true"
+        elif isinstance(default, bool):  # a flag turns the default over (--x on, or --no-x off)
+            kwargs["action"] = "store_false" if default else "store_true"
         elif m["repeat"]:
             kwargs["action"] = "append"
         elif m["choices"] and not m["listed"]:

@@ -4,6 +4,7 @@ unmodelled effects explain it, and how far it shrinks on data used for nothing e
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -99,10 +100,22 @@ def main(argv, prog="dyngen diagnose") -> int:
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = compiled_model(args, robot, progress)
-    with progress.step("residual, effects, selection, test"):
-        result = diagnose(robot, model, p, fit, select or None, options, test=test)
     sources = {"params": printable(Path(args.params).name), "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
+    from ..diagnosis.trust import EXIT_UNUSABLE, Unusable  # the diagnosis loads only once it runs
+    from ..diagnosis.unusable_output import write_unusable
+
+    try:
+        with progress.step("residual, effects, selection, test"):
+            result = diagnose(robot, model, p, fit, select or None, options, test=test)
+    except Unusable as err:  # nothing claimed: the line, report.md and the figure that shows why
+        with results_folder(out) as staging:  # written as one unit, as the full results are
+            paths = write_unusable(err, staging, sources)
+        paths = {k: shown(v, staging, out) for k, v in paths.items()}
+        print(f"dyngen diagnose: {err.line}", file=sys.stderr)
+        if not args.quiet:
+            print(f"  written: {', '.join(str(v) for v in paths.values())}")
+        return EXIT_UNUSABLE
     with progress.step("report, JSON, figures, updated model"):
         with results_folder(out) as staging:  # the folder is written as one unit
             paths = write_outputs(result, robot, p, staging, sources, options.sign_velocity)

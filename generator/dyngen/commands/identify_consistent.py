@@ -28,17 +28,30 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     with progress.step("consistent identification (weighted least squares, barrier solver)"):
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
+    # --- hook (sanity.py): values in their physical ranges, grid edges, the simple model on --select
+    from .sanity import check, table_lines
+
+    prior = options.prior if options.prior is not None else (
+        np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
+    sanity, sanity_table = check(robot, model, result, signals, select, prior)
+    # ---
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
     sources = [s.name for s in signals]  # printable: recording.read_recording
     write_file(out, consistent_yaml(robot, result, sources, conditioning_text(signals)))
     table = out.with_suffix(".md")
     write_file(table, f"# {robot.name}: consistent identification from {', '.join(sources)}\n\n"
-               + "\n".join(summary_lines(robot, result)) + "\n\n" + consistent_table(result) + "\n")
+               + "\n".join(summary_lines(robot, result)) + "\n\n" + consistent_table(result) + "\n\n"
+               + "\n".join(["## Sanity", ""] + [f"- warning: {w}" for w in sanity] + [""] + table_lines(sanity_table))
+               + "\n")
     exported = write_all(robot, result.p, out.parent, result.joint_dynamics())
     if not args.quiet:
         print("\n".join(summary_lines(robot, result)))
-        for w in (w for s in signals for w in getattr(s, "warnings", [])):
+        for w in [*(w for s in signals for w in getattr(s, "warnings", [])), *sanity]:
             print(f"  warning: {w}")
         print(f"  {seconds:.1f} s; written: {out}, {table}, " + ", ".join(str(p) for p in exported))
+    elif sanity:
+        import sys
+
+        print("\n".join(f"warning: {w}" for w in sanity), file=sys.stderr)
     return 0
 

@@ -28,9 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .noise_floor import spectral_noise
+
 NOISE_SHARE = 0.003  # acceleration noise allowed, relative to the motion's acceleration RMS
 MAX_FRACTION = 0.2  # the cutoff stays below this fraction of the sampling rate
 MIN_CUTOFF = 0.5  # Hz
+HEAVY_TAILS = 1.5  # the spectrum's noise is used when it exceeds the robust estimate by this factor
 NO_FILTER_NOISE = 1e-12  # rad: positions this clean are differentiated without a filter
 
 
@@ -44,16 +47,21 @@ class Decision:
 
 
 def position_noise(q: np.ndarray) -> np.ndarray:
-    """Per joint sigma of white noise on q, from robust third differences."""
+    """Per joint sigma of white noise on q, from robust third differences; where the spectrum
+    shows clearly more broadband error than that (a logger's late or repeated samples, a coarse
+    encoder's steps: noise_floor.py), the spectrum's."""
     if q.shape[0] < 8:
         return np.zeros(q.shape[1])
     d3 = np.diff(q, n=3, axis=0)
     mad = np.median(np.abs(d3 - np.median(d3, axis=0)), axis=0)
-    return 1.4826 * mad / np.sqrt(20.0)
+    robust = 1.4826 * mad / np.sqrt(20.0)
+    broadband = spectral_noise(q)
+    return np.where(broadband > HEAVY_TAILS * robust, broadband, robust)
 
 
-def acceleration_noise(sigma_q, cutoff: float, rate: float) -> np.ndarray:
-    return np.asarray(sigma_q) * (2 * np.pi) ** 2 * np.sqrt(cutoff ** 5 / (5 * rate / 2))
+def acceleration_noise(sigma_q, cutoff: float, rate: float, order: int = 2) -> np.ndarray:
+    """After `order` differentiations (2 from positions, 1 from recorded velocities)."""
+    return np.asarray(sigma_q) * (2 * np.pi) ** order * np.sqrt(cutoff ** (2 * order + 1) / ((2 * order + 1) * rate / 2))
 
 
 def motion_band(qd: np.ndarray, rate: float) -> float:
@@ -67,34 +75,36 @@ def motion_band(qd: np.ndarray, rate: float) -> float:
     return float(f[min(np.searchsorted(cumulative, 0.99 * cumulative[-1]), f.size - 1)])
 
 
-def decide(t: np.ndarray, q: np.ndarray, lowpass_of) -> Decision:
-    """lowpass_of(cutoff) -> a function filtering (T, ...) arrays along time."""
+def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision:
+    """lowpass_of(cutoff) -> a function filtering (T, ...) arrays along time. order 1: q are
+    recorded velocities, differentiated once (their noise measured the same way)."""
     rate = 1.0 / float(np.median(np.diff(t)))
     sigma = position_noise(q)
+
+    def derivatives(x):
+        qd = np.gradient(x, t, axis=0) if order == 2 else x
+        return qd, np.gradient(qd, t, axis=0)
+
     if q.shape[0] < 32 or float(sigma.max()) <= NO_FILTER_NOISE:
-        qd = np.gradient(q, t, axis=0)
-        qdd = np.gradient(qd, t, axis=0)
+        qd, qdd = derivatives(q)
         return Decision(None, sigma, np.zeros_like(sigma), motion_band(qd, rate) if q.shape[0] >= 32 else 0.0,
                         float(np.sqrt(np.mean(qdd ** 2))))
     noise = float(np.sqrt(np.mean(sigma ** 2)))
     top = MAX_FRACTION * rate
     cutoff = rate / 20
     for _ in range(6):  # converges in two or three steps: the RMS changes slowly with the cutoff
-        qf = lowpass_of(cutoff)(q)
-        qd = np.gradient(qf, t, axis=0)
-        qdd = np.gradient(qd, t, axis=0)
+        qd, qdd = derivatives(lowpass_of(cutoff)(q))
         measured = float(np.mean(qdd ** 2))
-        signal = np.sqrt(max(measured - float(np.mean(acceleration_noise(sigma, cutoff, rate) ** 2)), 0.0))
+        signal = np.sqrt(max(measured - float(np.mean(acceleration_noise(sigma, cutoff, rate, order) ** 2)), 0.0))
         # the largest fc with noise(fc) <= NOISE_SHARE * signal
         target = NOISE_SHARE * max(signal, 1e-12)
-        new = (target / (noise * (2 * np.pi) ** 2)) ** 0.4 * (5 * rate / 2) ** 0.2
+        k = 2 * order + 1
+        new = (target / (noise * (2 * np.pi) ** order)) ** (2 / k) * (k * rate / 2) ** (1 / k)
         new = float(np.clip(new, MIN_CUTOFF, top))
         if abs(new - cutoff) <= 0.01 * cutoff:
             cutoff = new
             break
         cutoff = new
-    qf = lowpass_of(cutoff)(q)
-    qd = np.gradient(qf, t, axis=0)
-    qdd = np.gradient(qd, t, axis=0)
-    return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate), motion_band(qd, rate),
+    qd, qdd = derivatives(lowpass_of(cutoff)(q))
+    return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate, order), motion_band(qd, rate),
                     float(np.sqrt(np.mean(qdd ** 2))))

@@ -11,8 +11,9 @@ torques so that no signal is shifted or smoothed against another; it is kept on 
 (`lowpass`) so that whatever is compared with the filtered torque (a model torque, an effect's
 columns) can be passed through the very same filter. The filter's start-up at both ends is
 not data: `trim` samples at each end are to be left out of every fit and every figure.
-Stamps that jitter around a regular clock are replaced by the clock (timeline.py); the sampling
-rate is the median rate.
+Rows as a logger wrote them are made samples of one regular clock first (log_quality.py: repeated
+rows left out, held columns interpolated, jittered stamps replaced by the clock (timeline.py),
+uneven ones interpolated onto a regular grid); the sampling rate is the median rate.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from scipy import signal
 from ..arguments import real
 from ..errors import InputError
 from ..options import option
-from . import automatic, timeline
+from . import automatic, log_quality
 from .recording import Recording
 
 AUTO = "auto"
@@ -74,6 +75,9 @@ class Signals:
     qdd_noise: np.ndarray | None = None  # per joint acceleration noise left after the filter [rad/s^2]
     band: float | None = None  # Hz: the motion's band (99 % of velocity power)
     warnings: list = field(default_factory=list)
+    log: object = None  # log_quality.LogReport: what was done to the rows and stamps as written
+    source: object = None  # the Recording as read and the Conditioning used (to condition it again)
+    options: object = None
 
     @property
     def rate(self) -> float:
@@ -101,10 +105,12 @@ class Signals:
 
 
 def condition(recording: Recording, options: Conditioning = Conditioning()) -> Signals:
-    t, timing = timeline.regular(recording.t, recording.q)
-    r = dataclasses.replace(recording, t=t)
+    differentiate = recording.qd is None or options.differentiate
+    filtering = options.cutoff is not None and (options.cutoff != AUTO or differentiate or recording.qdd is None)
+    # repeats, held columns, jittered stamps; uneven ones made a regular grid where a filter follows
+    r, log = log_quality.regular_samples(recording, regrid=filtering)
+    timing = log.clock
     rate = 1.0 / float(np.median(np.diff(r.t)))
-    differentiate = r.qd is None or options.differentiate
     decision = None
     cutoff = options.cutoff
     if isinstance(cutoff, str):
@@ -112,6 +118,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
             raise InputError(r.name, "cutoff", f"{cutoff!r}: expected a frequency in Hz or {AUTO!r}")
         if differentiate:
             decision = automatic.decide(r.t, r.q, lambda fc: _lowpass(r.name, rate, fc, options.order))
+            cutoff = decision.cutoff
+        elif r.qdd is None:  # recorded qd, differentiated once: through a cutoff chosen from qd's noise
+            decision = automatic.decide(r.t, r.qd, lambda fc: _lowpass(r.name, rate, fc, options.order), order=1)
             cutoff = decision.cutoff
         else:
             cutoff = None  # the recording's own velocities: nothing to differentiate, nothing to filter
@@ -137,10 +146,15 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     if timing:
         out.note = f"{timing}; {out.note}"
         out.warnings.append(f"{r.name}: {timing}")
+    if log.notes:
+        out.note = "; ".join(log.notes) + f"; {out.note}"
+        out.warnings.extend(log.warnings)
+    out.log, out.source, out.options = log, recording, options
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
         if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
-            out.warnings.append(f"{r.name}: position noise ({_sigma(decision.q_noise)}) allows a cutoff of only "
+            what = "position" if differentiate else "velocity"
+            out.warnings.append(f"{r.name}: {what} noise ({_sigma(decision.q_noise)}) allows a cutoff of only "
                                 f"{cutoff:.3g} Hz, below twice the motion's band ({decision.band:.3g} Hz): "
                                 "accelerations are smoothed")
     elif differentiate and cutoff is not None:
@@ -164,8 +178,9 @@ def _note(differentiate, cutoff, options, decision, no_qdd) -> str:
         return how + ", no filter"
     text = f"{how}; zero-phase Butterworth order {options.order}, {cutoff:.3g} Hz on q and tau"
     if decision is not None:
-        text += (f" (chosen from the data: position noise {_sigma(decision.q_noise)}, motion band "
-                 f"{decision.band:.3g} Hz)")
+        noise = f"position noise {_sigma(decision.q_noise)}" if differentiate else \
+            f"velocity noise {_sigma(decision.q_noise)}/s"
+        text += f" (chosen from the data: {noise}, motion band {decision.band:.3g} Hz)"
     return text
 
 

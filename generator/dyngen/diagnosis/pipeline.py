@@ -23,7 +23,7 @@ import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from . import baseline as simple_model
-from . import choose, fit, joints, reidentify, roles
+from . import choose, findings_check, fit, joints, reidentify, roles, trust
 from .effects import Context, library
 from .findings import describe, fill_values, reported
 from .judge import judge, simple_mse
@@ -40,7 +40,9 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     p = np.asarray(p, dtype=float)
     s = model(STANDARD_FROM_DYNAMIC.name, p)
     n = robot.dof
-    # 0. roles
+    # 0. roles; a recording whose nominal residual exceeds its torques is conditioned again, or
+    # trust.Unusable is raised (nothing claimed)
+    fit_signals, select_signals, test = trust.checked_roles(model, s, fit_signals, select_signals, test)
     segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
     # Position- and velocity-dependent laws are known only over what the fit data cover.
     fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
@@ -82,6 +84,12 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     else:
         modes = choose.on_folds(context, segments, design, chosen, final, options)
     reid, consistent = None, None
+    # Without the re-identification its cheap gate still says where the rigid body's columns
+    # explain what the effects leave: the link parameters may be off there.
+    links_hint = []
+    if not options.reidentify and design.select.count and all(seg.correction is not None for seg in segments):
+        links_hint = reidentify.gate(model, segments, [seg.residual - seg.correction for seg in segments],
+                                     options.min_gain)
     if options.reidentify and design.select.count:
         reid, consistent, modes = choose.reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
                                                       options.min_gain)
@@ -126,5 +134,11 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         conditioning=[{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
                       for role, group in (("fit", fit_signals), ("select", select_signals or []),
                                           ("test", test or [])) for sig in group])
-    result.warnings = notes(result, model, s, fit_signals, select_signals or [], test or [], judged.used)
+    apart = findings_check.check(result, model, s, fit_signals)  # findings outside their range: suspect
+    if links_hint:
+        apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in links_hint)
+                     + " the rigid body's own columns explain what the effects leave on selection data, so the "
+                     "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
+                     "parameters as an alternative (or identify them first: dyngen identify)")
+    result.warnings = notes(result, model, s, fit_signals, select_signals or [], test or [], judged.used) + apart
     return result

@@ -1,0 +1,171 @@
+"""A recording as a logger wrote it, made into samples of one regular clock.
+
+Controllers sample on a regular clock; loggers write rows at their own, irregular times, each
+row the latest sample they have, stamped when written. What that does to a log, and what is
+done about it here (before filtering and differentiation, data/conditioning.py):
+
+  repeated rows   the same sample written twice: every value equal to the row before while the
+                  arm moves (torque-sensor noise alone makes an exact repeat of all torques
+                  impossible otherwise). The copy is left out (the first write is the nearer to
+                  when the sample was taken). Rows equal while the positions stand still (a
+                  noise-free recording at rest) are kept.
+  held columns    a block (positions, velocities or torques) updated only every k-th row (mixed
+                  rates): between its updates it is interpolated over the update times instead
+                  of held (a held torque lags the motion by up to k rows, in steps).
+  dropped samples, irregular stamps
+                  the stamps are replaced by a regular clock when they jitter around one
+                  (timeline.py); whatever is then not on one regular grid (gaps left by dropped or
+                  repeated samples, stamps that are not jitter) is interpolated onto the grid of
+                  the median step by cubic splines, so that the zero-phase filter, which assumes
+                  equal steps, sees equal steps.
+
+    recording, report = regular_samples(recording)
+
+`report.notes` say in words what was done (for report.md); `report.warnings` what a user must
+know (a long gap filled by interpolation, many repeated rows).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from . import timeline
+from .recording import Recording
+
+UNEVEN = 0.01  # steps differing from the median by more than this share are not one grid
+HELD_MEDIAN = 2  # a block whose updates are this many rows apart (median) is at a lower rate
+LONG_GAP = 10  # warn when interpolation fills a gap of more than this many steps
+REPEATS_WORTH_SAYING = 0.001  # share of rows
+
+
+@dataclass
+class LogReport:
+    repeated: int = 0  # rows left out as repeats of the row before
+    held: dict = field(default_factory=dict)  # block -> median rows between its updates
+    filled: int = 0  # samples interpolated onto the grid where the log had none
+    longest_gap: float = 0.0  # s
+    clock: str | None = None  # timeline.regular's note, when the stamps were replaced by a clock
+    regridded: bool = False  # the samples were interpolated onto a regular grid
+    step_range: tuple = (0.0, 0.0)  # smallest and largest step between stamps as written [s]
+    notes: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+
+
+def _blocks(r: Recording) -> dict:
+    out = {"q": r.q}
+    for name in ("qd", "qdd", "tau"):
+        if getattr(r, name) is not None:
+            out[name] = getattr(r, name)
+    return out
+
+
+def _all_columns(r: Recording) -> np.ndarray:
+    parts = list(_blocks(r).values()) + [np.asarray(v, dtype=float)[:, None] for v in r.extra.values()]
+    return np.hstack(parts)
+
+
+def _select(r: Recording, keep: np.ndarray) -> Recording:
+    return dataclasses.replace(r, t=r.t[keep], q=r.q[keep], tau=None if r.tau is None else r.tau[keep],
+                               qd=None if r.qd is None else r.qd[keep], qdd=None if r.qdd is None else r.qdd[keep],
+                               extra={k: np.asarray(v)[keep] for k, v in r.extra.items()})
+
+
+def repeated_rows(r: Recording) -> np.ndarray:
+    """Boolean (T,): rows that repeat the row before in every column while the positions move
+    (the row after the repeats has other positions than the repeated sample)."""
+    data = _all_columns(r)
+    same = np.zeros(r.t.size, dtype=bool)
+    same[1:] = np.all(data[1:] == data[:-1], axis=1)
+    if not same.any():
+        return same
+    # a run of repeats counts when the row after it has other positions (walking back, each run
+    # inherits that from its successor); a run at the very end is kept
+    moving = np.zeros(r.t.size, dtype=bool)
+    next_moves = False
+    for i in range(r.t.size - 1, 0, -1):
+        if same[i]:
+            moving[i] = next_moves
+        else:
+            next_moves = bool(np.any(r.q[i] != r.q[i - 1]))
+    return same & moving
+
+
+def held_blocks(r: Recording) -> dict:
+    """{block: median rows between its updates} for blocks updated at a lower rate than the rows."""
+    out = {}
+    for name, x in _blocks(r).items():
+        changed = np.flatnonzero(np.any(x[1:] != x[:-1], axis=1)) + 1
+        if changed.size < 8:
+            continue
+        every = float(np.median(np.diff(changed)))
+        if every >= HELD_MEDIAN:
+            out[name] = every
+    return out
+
+
+def _unheld(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """x interpolated linearly between the rows where it changes (its update times)."""
+    changed = np.concatenate([[0], np.flatnonzero(np.any(x[1:] != x[:-1], axis=1)) + 1])
+    return np.column_stack([np.interp(t, t[changed], x[changed, j]) for j in range(x.shape[1])])
+
+
+def _on_grid(r: Recording, grid: np.ndarray) -> Recording:
+    def spline(x):
+        return CubicSpline(r.t, x, axis=0)(grid)
+
+    return dataclasses.replace(r, t=grid, q=spline(r.q), tau=None if r.tau is None else spline(r.tau),
+                               qd=None if r.qd is None else spline(r.qd), qdd=None if r.qdd is None else spline(r.qdd),
+                               extra={k: spline(np.asarray(v, dtype=float)) for k, v in r.extra.items()})
+
+
+def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogReport]:
+    """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are
+    exact, a filter over them is not)."""
+    report = LogReport()
+    if r.t.size < 16:
+        return r, report
+    steps = np.diff(r.t)
+    report.step_range = (float(steps.min()), float(steps.max()))
+    repeats = repeated_rows(r)
+    if repeats.any():
+        report.repeated = int(repeats.sum())
+        r = _select(r, ~repeats)
+        share = report.repeated / (report.repeated + r.t.size)
+        report.notes.append(f"{report.repeated} repeated rows ({100 * share:.2g} %: the same sample written twice) "
+                            "left out")
+        if share > REPEATS_WORTH_SAYING:
+            report.warnings.append(f"{r.name}: {report.repeated} rows ({100 * share:.2g} %) repeat the row before "
+                                   "while the arm moves (a logger writing one sample twice): left out")
+    held = held_blocks(r)
+    for name, every in held.items():
+        setattr(r, name, _unheld(r.t, getattr(r, name)))
+        rate = 1.0 / float(np.median(np.diff(r.t)))
+        report.notes.append(f"{name} updated every {every:g} rows (about {rate / every:.3g} Hz in a {rate:.3g} Hz log): "
+                            "interpolated between its updates")
+        report.warnings.append(f"{r.name}: mixed rates: {name} is updated only every {every:g} rows; interpolated "
+                               "between its updates")
+    report.held = held
+    t, note = timeline.regular(r.t, r.q)
+    if note:
+        report.clock = note
+        r = dataclasses.replace(r, t=t)
+    steps = np.diff(r.t)
+    period = float(np.median(steps))
+    if regrid and np.max(np.abs(steps - period)) > UNEVEN * period:
+        count = int(round((r.t[-1] - r.t[0]) / period))
+        grid = r.t[0] + period * np.arange(count + 1)
+        grid = grid[grid <= r.t[-1] + 1e-9 * period]
+        report.filled = max(grid.size - r.t.size, 0)
+        report.longest_gap = float(steps.max())
+        report.regridded = True
+        r = _on_grid(r, grid)
+        report.notes.append(f"stamps uneven (steps {1e3 * float(steps.min()):.3g}-{1e3 * float(steps.max()):.3g} ms): "
+                            f"interpolated onto a regular {1e3 * period:.4g} ms grid ({report.filled} samples filled)")
+        if report.longest_gap > LONG_GAP * period:
+            report.warnings.append(f"{r.name}: a gap of {1e3 * report.longest_gap:.3g} ms in the stamps "
+                                   f"({report.longest_gap / period:.0f} steps) was filled by interpolation")
+    return r, report

@@ -1,0 +1,175 @@
+"""Whether a recording's conditioning can be trusted, before anything is claimed from it.
+
+The nominal model, however wrong its details, predicts most of an arm's torque: its residual
+is a fraction of the measured torque on every joint that carries torque. Where conditioning
+failed (a logger's repeated rows or late stamps differentiated as if they were motion,
+recorded accelerations that are noise, a cutoff far above what the positions allow), the
+model torque carries tens of Nm of differentiation noise and the residual exceeds the
+torque itself; every effect fitted to it is then a description of the noise.
+
+    signals, notes = checked(model, s, signals)    # raises Unusable when nothing helps
+
+For each recording the nominal residual RMS is compared with the measured torque's RMS on the
+joints that carry torque (above TORQUE_FLOOR of the largest). Where the residual is ABOVE times
+larger,
+the recording is conditioned again, when its cutoff was the automatic one: positions
+differentiated through the automatic cutoff (if recorded velocities were used), then cutoffs
+halved down to MIN_CUTOFF; the highest cutoff whose residual is within KEEP of the best tried
+and below the torque on every judged joint is used, and the recording's warnings say so. When
+none is, the conditioning cannot be trusted: Unusable carries one line for the terminal and
+report.md and every trial for the figure (commands/diagnose.py: exit status EXIT_UNUSABLE, no
+effect claimed).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..catalogue import RNEA
+
+TORQUE_FLOOR = 0.05  # joints carrying less torque RMS than this share of the largest are not judged
+ABOVE = 1.5  # a residual this many times the torque's RMS is not the model's error (a joint whose torque is
+# all friction, which the nominal model lacks, has a residual as large as its torque)
+KEEP = 1.1  # the highest cutoff whose mean squared residual share is within this factor of the best
+MIN_CUTOFF = 0.5  # Hz
+EXIT_UNUSABLE = 3  # `dyngen diagnose` exit status when a recording's conditioning cannot be trusted
+
+
+@dataclass
+class Trial:
+    how: str  # what was tried, in words
+    cutoff: float | None
+    torque: np.ndarray  # per joint RMS of the measured torque (inner samples)
+    residual: np.ndarray  # per joint RMS of the nominal residual
+
+    @property
+    def judged(self) -> np.ndarray:
+        return self.torque > TORQUE_FLOOR * float(self.torque.max())
+
+    @property
+    def above(self) -> list[int]:
+        """0-based joints whose nominal residual exceeds their torque."""
+        return [int(j) for j in np.flatnonzero(self.judged & (self.residual > ABOVE * self.torque))]
+
+    @property
+    def share(self) -> float:
+        """Mean over judged joints of (residual / torque)^2."""
+        j = self.judged
+        return float(np.mean((self.residual[j] / self.torque[j]) ** 2)) if j.any() else 0.0
+
+
+@dataclass
+class Untrusted:
+    recording: str
+    trials: list = field(default_factory=list)  # the first is the automatic conditioning
+
+
+class Unusable(Exception):
+    """The conditioning of some recording cannot be trusted: nothing is claimed."""
+
+    def __init__(self, line: str, recordings: list):
+        super().__init__(line)
+        self.line = line
+        self.recordings = recordings  # Untrusted per recording that failed
+
+
+def trial(model, s, sig, how: str) -> Trial:
+    keep = sig.inner()
+    tau = sig.tau[keep]
+    residual = tau - model.batch(RNEA.name, sig.q[keep], sig.qd[keep], sig.qdd[keep], s)
+    return Trial(how, sig.cutoff, np.sqrt(np.mean(tau ** 2, axis=0)), np.sqrt(np.mean(residual ** 2, axis=0)))
+
+
+def _again(sig, **changes):
+    from ..data.conditioning import condition
+
+    return condition(sig.source, dataclasses.replace(sig.options, **changes))
+
+
+def _alternatives(sig):
+    """(how, signals) conditioned otherwise, highest cutoff first."""
+    from ..data.conditioning import AUTO
+
+    first = sig
+    if sig.cutoff is None or not sig.note.startswith("qd, qdd differentiated"):
+        try:
+            first = _again(sig, differentiate=True, cutoff=AUTO)
+        except ValueError:
+            return
+        yield "positions differentiated, automatic cutoff", first
+    start = first.cutoff if first.cutoff is not None else first.rate / 20
+    cutoff = start / 2
+    while cutoff >= MIN_CUTOFF and sig.t.size > 8 * first.rate / cutoff:
+        try:
+            yield f"positions differentiated, {cutoff:.3g} Hz", _again(sig, differentiate=True, cutoff=cutoff)
+        except ValueError:
+            return
+        cutoff /= 2
+
+
+def _joints(js) -> str:
+    return ", ".join(str(j + 1) for j in js)
+
+
+def checked(model, s, signals: list) -> tuple[list, list]:
+    """signals with any untrustworthy recording conditioned again; raises Unusable."""
+    from ..data.conditioning import AUTO
+
+    out, failed = [], []
+    for sig in signals:
+        if sig.tau is None or sig.t.size < 16:
+            out.append(sig)
+            continue
+        first = trial(model, s, sig, f"as conditioned ({sig.note})")
+        if not first.above:
+            out.append(sig)
+            continue
+        record = Untrusted(sig.name, [first])
+        best = None
+        if sig.source is not None and sig.options is not None and sig.options.cutoff == AUTO:
+            tried = []
+            for how, other in _alternatives(sig):
+                t = trial(model, s, other, how)
+                record.trials.append(t)
+                tried.append((t, other))
+            good = [(t, o) for t, o in tried if not t.above]
+            if good:
+                floor = min(t.share for t, _ in good)
+                best = next((t, o) for t, o in good if t.share <= KEEP * floor)  # highest cutoff first
+        if best is None:
+            failed.append(record)
+            out.append(sig)
+            continue
+        t, other = best
+        other.warnings.append(
+            f"{sig.name}: the automatic conditioning left a nominal residual above the measured torque on joint(s) "
+            f"{_joints(first.above)} ({_rms_pair(first)}); conditioned again: {t.how} (residual {_rms_pair(t)})")
+        other.note = f"conditioned again after the automatic choice failed: {other.note}"
+        out.append(other)
+    if failed:
+        worst = failed[0].trials[0]
+        line = (f"the data cannot support a diagnosis: on {', '.join(r.recording for r in failed)} the nominal "
+                f"model's residual exceeds the measured torque on joint(s) {_joints(worst.above)} ({_rms_pair(worst)}) "
+                "with every conditioning tried (a log whose rows or stamps cannot be repaired, torques that do not "
+                "belong to the positions, or parameters far off); no effect is claimed")
+        raise Unusable(line, failed)
+    return out, []
+
+
+def checked_roles(model, s, fit, select, test):
+    """checked() over the fit, select and test recordings at once (None stays None)."""
+    groups = [list(g) if g else [] for g in (fit, select, test)]
+    done, _ = checked(model, s, [x for g in groups for x in g])
+    out, k = [], 0
+    for original, g in zip((fit, select, test), groups):
+        out.append(done[k:k + len(g)] if original is not None else None)
+        k += len(g)
+    return tuple(out)
+
+
+def _rms_pair(t: Trial) -> str:
+    js = t.above or [int(np.argmax(np.where(t.judged, t.residual / np.maximum(t.torque, 1e-300), 0)))]
+    return ", ".join(f"J{j + 1} {t.residual[j]:.3g} vs {t.torque[j]:.3g} Nm" for j in js[:4])

@@ -1,0 +1,101 @@
+"""Recordings as loggers write them: the pathologies of real logs, applied to a clean recording.
+
+A controller samples the arm on a regular clock; a logger (a ROS subscriber, a bag recorder, a
+script polling the robot) writes rows at its own, irregular times, each row the latest sample it
+has, stamped when it is written. That makes, from one clean recording (CSV text, `t, q.., tau..`
+as tests/simulation/mujoco_measurements.csv_text writes it):
+
+  repeated   the same sample written twice (a new stamp, every value repeated), a share of rows
+  dropped    samples never written, a share of rows (the stamps keep the gap)
+  jittered   stamps late by a random delay of up to `late` s (the values are the clock's)
+  polled     the logger's own clock: writes every period +- jitter, with stalls now and then,
+             each row the latest sample, stamped when written (repeated rows, dropped samples
+             and late stamps at once: the franka_ros logs of Gaz et al. 2019 have 5.5 % repeated
+             rows and steps of 0.7-8.8 ms at a nominal 1 kHz)
+  held       some columns (e.g. the torques) updated only every `every`-th sample (mixed rates)
+
+The sample values are never altered, only repeated, left out or stamped elsewhere: what a
+diagnosis can do with such a log is what it could do with the clean one, or it must say why not.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+
+def parse(text: str):
+    header, _, body = text.partition("\n")
+    return header, np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2)
+
+
+def unparse(header: str, data: np.ndarray) -> str:
+    out = io.StringIO()
+    np.savetxt(out, data, fmt="%.12g", delimiter=",", header=header, comments="")
+    return out.getvalue()
+
+
+def repeated(text: str, share: float, seed: int) -> str:
+    """Every row written twice with probability `share`, the copy stamped between it and the next."""
+    header, data = parse(text)
+    rng = np.random.default_rng(seed)
+    twice = rng.random(data.shape[0] - 1) < share
+    rows = []
+    for k in range(data.shape[0]):
+        rows.append(data[k])
+        if k < data.shape[0] - 1 and twice[k]:
+            copy = data[k].copy()
+            copy[0] = data[k, 0] + rng.uniform(0.2, 0.8) * (data[k + 1, 0] - data[k, 0])
+            rows.append(copy)
+    return unparse(header, np.array(rows))
+
+
+def dropped(text: str, share: float, seed: int) -> str:
+    """Rows left out with probability `share` (never the first or the last)."""
+    header, data = parse(text)
+    keep = np.random.default_rng(seed).random(data.shape[0]) >= share
+    keep[0] = keep[-1] = True
+    return unparse(header, data[keep])
+
+
+def jittered(text: str, late: float, seed: int) -> str:
+    """Every stamp late by a uniform delay in [0, late] s (kept increasing)."""
+    header, data = parse(text)
+    t = data[:, 0] + np.random.default_rng(seed).uniform(0.0, late, data.shape[0])
+    data = data.copy()
+    data[:, 0] = np.maximum.accumulate(t + 1e-9 * np.arange(t.size))
+    return unparse(header, data)
+
+
+def polled(text: str, seed: int, jitter: float = 0.3, stall_share: float = 0.01, stall: float = 6e-3) -> str:
+    """A logger polling the latest sample on its own clock: nominally every sample period, each
+    write late by up to `jitter` periods, and with probability `stall_share` a stall of up to
+    `stall` s before the write. Rows are stamped at the write."""
+    header, data = parse(text)
+    t = data[:, 0]
+    period = float(np.median(np.diff(t)))
+    rng = np.random.default_rng(seed)
+    writes, now = [], t[0] + 0.1 * period
+    while now < t[-1]:
+        writes.append(now)
+        step = period * (1.0 + rng.uniform(-jitter, jitter))
+        if rng.random() < stall_share:
+            step += rng.uniform(0.5, 1.0) * stall
+        now += step
+    writes = np.array(writes)
+    latest = np.searchsorted(t, writes, side="right") - 1  # the last sample taken before the write
+    rows = data[latest].copy()
+    rows[:, 0] = writes
+    return unparse(header, rows)
+
+
+def held(text: str, prefix: str, every: int) -> str:
+    """Columns `prefix`1.. (e.g. "tau") updated only every `every`-th row, held in between."""
+    header, data = parse(text)
+    names = header.split(",")
+    columns = [k for k, n in enumerate(names) if n.startswith(prefix) and n[len(prefix):].isdigit()]
+    data = data.copy()
+    source = (np.arange(data.shape[0]) // every) * every
+    data[:, columns] = data[source][:, columns]
+    return unparse(header, data)
