@@ -128,7 +128,5 @@ def main(argv, prog="dyngen diagnose") -> int:
         if "export skipped" in paths:
             print(f"  URDF/MJCF not written: {paths['export skipped']}")
     elif result.warnings:
-        import sys
-
         print("\n".join(f"warning: {w}" for w in result.warnings), file=sys.stderr)
     return 0

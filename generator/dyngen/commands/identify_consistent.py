@@ -29,7 +29,7 @@ def run_consistent(args, robot, model, signals, progress) -> int:
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
     # --- hook (sanity.py): values in their physical ranges, grid edges, the simple model on --select
-    from .sanity import check, table_lines
+    from ..identification.sanity import check, table_lines
 
     prior = options.prior if options.prior is not None else (
         np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)

@@ -12,7 +12,7 @@ The stages, in order (pipeline.py runs them):
     2. selection.py  forward selection on the selection data
     3. settle.py     nonlinear settings refined (refine.py), insignificant effects pruned,
                      implausible ones refused
-    4. choose.py     per joint: effects, the simple model (baseline.py), both, or re-identified
+    4. choose.py     per joint: effects, the simple model (terms/simple_model.py), both, or re-identified
                      link parameters (joints.py, reidentify.py)
     5. judge.py      the figures on the judged data, per phase of the motion (phases.py)
     6. findings.py   the findings, notes.py the warnings, record.py the result (Diagnosis);

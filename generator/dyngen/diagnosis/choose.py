@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import baseline as simple_model
+from ..terms import simple_model
 from . import joints, reidentify, roles
 from .fit import predict, ranged
 from .refine import restricted

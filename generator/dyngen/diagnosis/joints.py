@@ -1,6 +1,6 @@
 """Per joint, the final model: the selected effects, the simple model, or both together.
 
-The simple model (baseline.py) is what every diagnosis must beat. On each joint three models
+The simple model (terms/simple_model.py) is what every diagnosis must beat. On each joint three models
 are fitted on the fit samples and compared on the selection samples:
 
   effects    the selected effects as fitted together (the diagnosis's findings);
@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import baseline
+from ..terms import simple_model as baseline
 from . import moments as dz
 
 EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple", "consistent parameters"

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import baseline as simple_model
+from ..terms import simple_model
 from . import phases
 
 

@@ -62,7 +62,7 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
     import yaml
 
     f = friction_vector(diagnosis, sign_velocity).reshape(diagnosis.joints, -1)
-    from .baseline import NAMES, VELOCITY
+    from ..terms.simple_model import NAMES, VELOCITY
 
     doc = {
         "robot": diagnosis.robot,

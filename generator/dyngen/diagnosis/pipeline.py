@@ -5,7 +5,7 @@
     2. select     forward selection on the selection data (selection.py)
     3. settle     settings refined, insignificant effects pruned, implausible ones refused
                   (settle.py, refine.py), once more with each joint weighted by what is left
-    4. choose     per joint: the effects, the simple model (baseline.py), both, or re-identified
+    4. choose     per joint: the effects, the simple model (terms/simple_model.py), both, or re-identified
                   link parameters (choose.py, joints.py, reidentify.py); then the final fit on
                   every fit sample
     5. test       the figures on the judged data (judge.py, phases.py)
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
-from . import baseline as simple_model
+from ..terms import simple_model
 from . import choose, findings_check, fit, joints, reidentify, roles, trust
 from .effects import Context, library
 from .findings import describe, fill_values, reported

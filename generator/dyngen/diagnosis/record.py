@@ -15,7 +15,7 @@ class Diagnosis:
     rms_before: list  # per joint, on the judged data, nominal model
     rms_after: list  # per joint, on the judged data, with the final model (effects; simple model where it won)
     rms_effects: list  # per joint, on the judged data, with the selected effects alone
-    rms_simple: list  # per joint, on the judged data, the simple model (baseline.py)
+    rms_simple: list  # per joint, on the judged data, the simple model (terms/simple_model.py)
     selection_before: list  # per joint, selection data
     selection_after: list
     selection_simple: list

@@ -12,7 +12,7 @@ Ranges (warnings, the values are kept and written):
     constant larger than the torque it sits in is a term making up for another);
   - the Coulomb lag and smoothing: a choice at the last value of its grid is a bound, not a
     finding (consistent.LAG_GRID, SMOOTHING_GRID).
-The simple model (diagnosis/baseline.py: the prior's residual fitted per joint by b + Fc
+The simple model (terms/simple_model.py: the prior's residual fitted per joint by b + Fc
 tanh(qd / 0.02) + Fv qd on the fit data) and the identified model are both judged on the
 --select recordings, which neither fitted; a joint where the simple model predicts better is
 named, with the advice to use the simple model there (the diagnosis does so itself:
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
-from ..diagnosis import baseline
+from ..terms import simple_model as baseline
 from .consistent import LAG_GRID, SMOOTHING_GRID
 
 ROTOR_RATIO = 10.0

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..terms.friction import SIMPLE_SCALE, coulomb
+from .friction import SIMPLE_SCALE, coulomb
 
 VELOCITY = SIMPLE_SCALE  # rad/s: the simple model's tanh scale (fixed, not fitted)
 NAMES = ("b", "Fc", "Fv")
