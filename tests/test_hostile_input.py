@@ -428,9 +428,9 @@ def test_a_results_folder_of_user_files_is_replaced_only_with_force_and_said(tmp
     (tmp_path / "gen" / "tiny" / "notes.txt").write_text("mine")
     result, _ = run(["generate", "tiny.yaml", "-o", "gen", "--force"], tmp_path, cache)
     assert result.returncode == 0, result.stderr
-    assert "replacing" in result.stderr and not (tmp_path / "gen" / "tiny" / "notes.txt").exists()
+    assert "replaced" in result.stderr and not (tmp_path / "gen" / "tiny" / "notes.txt").exists()
     again, _ = run(["generate", "tiny.yaml", "-o", "gen"], tmp_path, cache)  # dyngen's own folder: no --force
-    assert again.returncode == 0 and "replacing" in again.stderr
+    assert again.returncode == 0 and "replaced" in again.stderr
 
 
 @pytest.mark.parametrize("output", ["run.csv", "link.csv", "tiny.yaml"])

@@ -108,6 +108,8 @@ def _discard_contents(path: Path) -> None:
                 shutil.rmtree(entry.path)
             else:
                 os.unlink(entry.path)
+        except FileNotFoundError:
+            continue  # removed meanwhile (another dyngen run cleaning the same folder)
         except OSError as err:
             raise CacheError(Path(entry.path), "found in a cache folder others could write, and cannot be "
                              f"removed ({err.strerror or err})") from None

@@ -55,8 +55,14 @@ COMMANDS = {"generate": generate.main, "extract": extract.main, "identify": iden
 
 
 def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    from .output_paths import REPLACED
+
+    REPLACED.clear()  # one run's record (main may be called more than once in a process)
     try:
-        return _dispatch(list(sys.argv[1:] if argv is None else argv))
+        status = _dispatch(argv)
+        _say_replaced(argv)
+        return status
     except (InputError, Infeasible, DriverError) as err:
         print(f"dyngen: error: {_one_line(err)}", file=sys.stderr)
         return 2
@@ -72,6 +78,13 @@ def main(argv=None) -> int:
     except (RecursionError, MemoryError) as err:
         print(f"dyngen: error: the input is too large or nested too deeply ({type(err).__name__})", file=sys.stderr)
         return 2
+
+
+def _say_replaced(argv) -> None:
+    from .output_paths import REPLACED
+
+    if REPLACED and not {"-q", "--quiet"} & set(argv):
+        print("\n".join(f"dyngen: {_one_line(note)}" for note in REPLACED), file=sys.stderr)
 
 
 def _dispatch(argv) -> int:

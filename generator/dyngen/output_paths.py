@@ -10,7 +10,7 @@ diagnose --out, excite -o), checked before any work is done. docs/untrusted-inpu
   manifest.json), it is refused unless --force, so the user's own files are never deleted
   silently; what is replaced is said;
 - a file output (identify -o, excite -o) that is a folder is refused; an existing file is
-  replaced (and said so) by renaming a new file over it, so a link there is replaced, not
+  replaced (and said so at the end) by renaming a new file over it, so a link there is replaced, not
   followed;
 - nothing is written over one of the command's own inputs, or over a folder holding one.
 
@@ -31,6 +31,9 @@ from pathlib import Path
 from .errors import InputError
 
 MARKER = ".dyngen-output"
+# What this run will replace, said once it has succeeded (cli.main): a note printed before the
+# work would stand beside an error line if the run then failed.
+REPLACED: list[str] = []
 _MARKER_TEXT = "This folder was written by dyngen as a whole; the next run replaces it.\n"
 
 
@@ -104,7 +107,8 @@ def check_folder(target, inputs=(), force: bool = False) -> str | None:
     if not _made_by_dyngen(target) and not force:
         _fail(target, "holds files dyngen did not write; move them, choose another folder, or pass --force "
               "to replace the folder")
-    return f"replacing {target}/ (all of it)"
+    REPLACED.append(f"replaced {target}/ (all of it)")
+    return REPLACED[-1]
 
 
 def check_file(target, inputs=(), force: bool = False) -> str | None:
@@ -123,7 +127,8 @@ def check_file(target, inputs=(), force: bool = False) -> str | None:
         return None
     if stat.S_ISDIR(info.st_mode):
         _fail(target, "is a folder; give a file name")
-    return f"replacing {target}"
+    REPLACED.append(f"replaced {target}")
+    return REPLACED[-1]
 
 
 @contextmanager

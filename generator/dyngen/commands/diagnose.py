@@ -77,9 +77,7 @@ def main(argv, prog="dyngen diagnose") -> int:
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
     from ..output_paths import check_folder, results_folder, shown
 
-    note = check_folder(out, [args.robot, args.params, *args.data, *(args.select or []), *tests, args.model], args.force)
-    if note:
-        progress.say(f"dyngen: {note}")
+    check_folder(out, [args.robot, args.params, *args.data, *(args.select or []), *tests, args.model], args.force)
     # bad input fails before anything is announced or written
     if args.split:
         if args.select or tests:

@@ -111,9 +111,7 @@ def main(argv, prog="dyngen excite") -> int:
 
     out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"
     for path in (out, out.with_suffix(".png")):  # the output path policy, before any work
-        note = check_file(path, [args.robot, args.model])
-        if note:
-            progress.say(f"dyngen: {note}")
+        check_file(path, [args.robot, args.model])
     limits = limits_of(robot)  # missing limits fail before anything runs
     workspace = None
     if args.workspace:

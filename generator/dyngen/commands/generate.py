@@ -40,12 +40,10 @@ def main(argv, prog="dyngen generate") -> int:
 
 
 def check_output(args, folder: Path, inputs=()) -> None:
-    """The output path policy (dyngen.output_paths), before any work; says what is replaced."""
+    """The output path policy (dyngen.output_paths), before any work (what it replaces is said at the end)."""
     from ..output_paths import check_folder
 
-    note = check_folder(folder, [args.robot, *inputs], args.force)
-    if note:
-        Progress(quiet=args.quiet).say(f"dyngen: {note}")
+    check_folder(folder, [args.robot, *inputs], args.force)
 
 
 def generate_step(args, robot, out_root="from args"):

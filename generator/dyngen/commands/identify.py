@@ -94,9 +94,7 @@ def check_outputs(args, robot, kind: str, ols: bool) -> Path:
     files = [out, out.with_suffix(".md"), out.parent / f"{robot.name}.urdf", out.parent / f"{robot.name}.xml"]
     inputs = [args.robot, *args.data, *(getattr(args, "select", None) or []), getattr(args, "prior", None), args.model]
     for path in files if consistent else files[:1]:
-        note = check_file(path, inputs)
-        if note:
-            Progress(quiet=args.quiet).say(f"dyngen: {note}")
+        check_file(path, inputs)
     return out
 
 
