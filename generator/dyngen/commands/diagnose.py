@@ -75,7 +75,8 @@ def main(argv, prog="dyngen diagnose") -> int:
             raise InputError("--split", "", "cuts the --data recordings into fit, select and test: give no "
                              "--select, --test or --holdout with it")
         fractions = parse_fractions(args.split)
-        pieces = [split_recording(read_recording(x, robot.dof), fractions) for x in args.data]
+        pieces = [split_recording(read_recording(x, robot.dof, effort_topic=args.effort_topic), fractions)
+                  for x in args.data]
         for recording in (r for rs in pieces for r in rs if r is not None):
             check_enough(recording.name, recording.t)
         fit, select, test = ([condition(r[k], conditioning_of(args)) for r in pieces if r[k] is not None]

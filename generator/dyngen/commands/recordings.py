@@ -17,12 +17,28 @@ def add_data_options(parser: argparse.ArgumentParser) -> None:
     from ..data import Conditioning
 
     parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
-    parser.add_argument("--data", action="append", required=True, metavar="CSV",
-                        help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
+    parser.add_argument("--data", action=Recordings, required=True, metavar="FILE",
+                        help="a recording: CSV with header t, q1..qN, tau1..tauN, optional qd*, qdd*; or Parquet "
+                             "(.parquet, the same columns); or a ROS 2 bag's folder (joint_states); repeatable, and "
+                             "a quoted glob ('logs/*.csv') stands for every file it matches")
+    parser.add_argument("--effort-topic", metavar="TOPIC",
+                        help="ROS 2 bags: take the torques from this topic (a commanded effort: JointState or "
+                             "Float64MultiArray) instead of joint_states' measured effort")
     add_arguments(parser.add_argument_group("signal conditioning"), Conditioning)
     parser.add_argument("--model", metavar="DIR",
                         help="an already generated folder of this robot (default: generate it first)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")
+
+
+class Recordings(argparse._AppendAction):
+    """--data: appends the file, or every file a glob matches (sorted); a glob matching
+    nothing is an error naming it."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from ..data.paths import expand
+
+        for path in expand([values]):
+            super().__call__(parser, namespace, path, option_string)
 
 
 def check_enough(name: str, t) -> None:
@@ -66,4 +82,6 @@ def compiled_model(args, robot, progress):
 def read_all(paths, robot, args, require_torques=True, required=()):
     from ..data import condition, read_recording
 
-    return [condition(read_recording(p, robot.dof, require_torques, required), conditioning_of(args)) for p in paths]
+    topic = getattr(args, "effort_topic", None)
+    return [condition(read_recording(p, robot.dof, require_torques, required, topic), conditioning_of(args))
+            for p in paths]
