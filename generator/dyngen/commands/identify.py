@@ -4,11 +4,9 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
-
 from ..options import add_arguments, resolve
 from ..progress import Progress
-from .recordings import add_data_options, compiled_model, conditioning_text, read_all
+from .recordings import add_data_options, compiled_model, read_all
 
 
 def parser(prog="dyngen identify") -> argparse.ArgumentParser:
@@ -46,37 +44,20 @@ def main(argv, prog="dyngen identify") -> int:
 
     options = resolve(Options, args, {})
     from ..description import load_robot
-    from ..identification import identified_yaml, identify, summary_table
-    from ..identification.samples import stacked_inertia_columns
 
     robot = load_robot(args.robot)
     progress = Progress(quiet=args.quiet)
     kind = options.kind
     required = tuple(_inertia_names(robot)) if kind == "inertia" else ()
+    if kind != "full" or options.ols:  # least squares: accumulated per recording, in parallel
+        from .least_squares import run_least_squares
+
+        return run_least_squares(args, robot, kind, required, progress)
     # Bad input fails before anything is announced or written.
     signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required)
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
-    if kind == "full" and not options.ols:
-        return run_consistent(args, robot, model, signals, progress)
-    if kind == "inertia":
-        assert stacked_inertia_columns(model.manifest) == list(required)
-    with progress.step("least squares"):
-        estimate = identify(model, signals, kind)
-    out = Path(args.output) if args.output else Path("out") / robot.name / f"identified_{kind}.yaml"
-    from ..atomic import write_file
-
-    write_file(out, identified_yaml(robot.name, {kind: estimate}, [Path(p).name for p in args.data],
-                                    conditioning_text(signals)))
-    if not args.quiet:
-        print(f"{robot.name}: {len(estimate.names)} {kind} coefficients from {estimate.rows} equations; "
-              f"condition number {estimate.condition:.3g} (columns scaled {estimate.scaled_condition:.3g}); "
-              f"residual RMS {estimate.residual_rms:.4g}")
-        print("\n".join("  " + line for line in summary_table(kind, estimate).splitlines()))
-        for w in [*estimate.warnings(), *(w for s in signals for w in s.warnings)]:
-            print(f"  warning: {w}")
-        print(f"  written: {out}")
-    return 0
+    return run_consistent(args, robot, model, signals, progress)
 
 
 def _inertia_names(robot):

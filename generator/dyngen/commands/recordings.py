@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..arguments import whole
 from ..errors import InputError
 from ..options import add_arguments, resolve
 
@@ -25,6 +26,13 @@ def add_data_options(parser: argparse.ArgumentParser) -> None:
                         help="ROS 2 bags: take the torques from this topic (a commanded effort: JointState or "
                              "Float64MultiArray) instead of joint_states' measured effort")
     add_arguments(parser.add_argument_group("signal conditioning"), Conditioning)
+    group = parser.add_argument_group("many recordings")
+    group.add_argument("--workers", type=whole(1, 1024), metavar="N",
+                       help="worker processes for the per-recording work (default: one per core, at most one per "
+                            "recording)")
+    group.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run the per-recording work on this Dask distributed scheduler (e.g. tcp://host:8786; "
+                            "the workers must see the files at the same paths)")
     parser.add_argument("--model", metavar="DIR",
                         help="an already generated folder of this robot (default: generate it first)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")

@@ -58,40 +58,53 @@ def parquet_row(row: int) -> str:
 
 def read_parquet(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
     name = Path(path).name
+    header, batches = parquet_batches(path)
+    columns = check_header(name, header, dof, require_torques, required)
+    data = np.vstack([block for _, block in batches])
+    return from_columns(name, header, columns, data, dof, where=parquet_row)
+
+
+def parquet_batches(path, rows: int = 65536):
+    """(header, iterator of (first row, (k, columns) float values)): the file checked for size,
+    what it unpacks to, numeric columns, missing values."""
+    name = Path(path).name
     regular_file(path, MAX_CSV_BYTES)
     pq = _module("pyarrow.parquet", path)
     pa = _module("pyarrow", path)
     try:
         f = pq.ParquetFile(path)
-        rows, schema = f.metadata.num_rows, f.schema_arrow
+        count, schema = f.metadata.num_rows, f.schema_arrow
     except Exception as err:  # noqa: BLE001 -- a broken file may raise anything from the library: one line
         raise InputError(name, "", f"not a readable Parquet file ({shorten(err, 200)})") from None
     header = [str(n) for n in schema.names]
     if len(header) > MAX_COLUMNS:
         raise InputError(name, "", f"{len(header)} columns (at most {MAX_COLUMNS})")
-    if rows * max(len(header), 1) > MAX_VALUES:
-        raise InputError(name, "", f"{rows} rows of {len(header)} columns: too large (at most {MAX_VALUES} values)")
-    columns = check_header(name, header, dof, require_torques, required)
+    if count * max(len(header), 1) > MAX_VALUES:
+        raise InputError(name, "", f"{count} rows of {len(header)} columns: too large (at most {MAX_VALUES} values)")
     for field in schema:
         if not (pa.types.is_floating(field.type) or pa.types.is_integer(field.type)):
             raise InputError(name, f"column {shorten(field.name)}", f"type {field.type}: not numbers")
-    if rows == 0:
+    if count == 0:
         raise InputError(name, parquet_row(0), "no data rows")
-    data = np.empty((rows, len(header)))
-    start = 0
-    try:
-        for batch in f.iter_batches(batch_size=65536):
-            for k, column in enumerate(batch.columns):
-                if column.null_count:
-                    first = int(np.flatnonzero(column.is_null().to_numpy(zero_copy_only=False))[0])
-                    raise InputError(name, f"{parquet_row(start + first)}, column {shorten(header[k])}",
-                                     "missing value (null)")
-                data[start:start + batch.num_rows, k] = column.to_numpy(zero_copy_only=False)
-            start += batch.num_rows
-    except InputError:
-        raise
-    except Exception as err:  # noqa: BLE001 -- as above
-        raise InputError(name, parquet_row(start), f"not a readable Parquet file ({shorten(err, 200)})") from None
-    if start != rows:
-        raise InputError(name, "", f"{start} rows read, the file's metadata says {rows}")
-    return from_columns(name, header, columns, data, dof, where=parquet_row)
+
+    def batches():
+        start = 0
+        try:
+            for batch in f.iter_batches(batch_size=rows):
+                data = np.empty((batch.num_rows, len(header)))
+                for k, column in enumerate(batch.columns):
+                    if column.null_count:
+                        first = int(np.flatnonzero(column.is_null().to_numpy(zero_copy_only=False))[0])
+                        raise InputError(name, f"{parquet_row(start + first)}, column {shorten(header[k])}",
+                                         "missing value (null)")
+                    data[:, k] = column.to_numpy(zero_copy_only=False)
+                yield start, data
+                start += batch.num_rows
+        except InputError:
+            raise
+        except Exception as err:  # noqa: BLE001 -- as above
+            raise InputError(name, parquet_row(start), f"not a readable Parquet file ({shorten(err, 200)})") from None
+        if start != count:
+            raise InputError(name, "", f"{start} rows read, the file's metadata says {count}")
+
+    return header, batches()

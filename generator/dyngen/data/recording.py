@@ -69,8 +69,13 @@ def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
     """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a
     data row in messages (a CSV line, a Parquet row)."""
     _check_values(name, header, data, where)
+    _check_time(name, data[:, columns["t"]], where)
+    return as_recording(name, columns, data, dof)
+
+
+def as_recording(name, columns, data, dof) -> Recording:
+    """The Recording of checked values (a whole file, or a chunk of one: data/chunks.py)."""
     t = data[:, columns["t"]]
-    _check_time(name, t, where)
 
     def block(prefix):
         if f"{prefix}1" not in columns:
@@ -127,7 +132,7 @@ def _check_header(name, header, dof, require_torques, required, where="line 1 (h
     return columns
 
 
-def _numbers(body: str, name, header) -> np.ndarray:
+def _numbers(body: str, name, header, first_line: int = 2) -> np.ndarray:
     """Fast path with numpy; on failure, a slow pass that finds the exact line and column."""
     try:
         with warnings.catch_warnings():  # an empty body is reported below, with its line
@@ -138,7 +143,7 @@ def _numbers(body: str, name, header) -> np.ndarray:
     if data is not None and data.ndim == 2 and data.shape[1] == len(header) and data.shape[0] > 0:
         return data
     rows = []
-    for line, row in enumerate(csv.reader(io.StringIO(body)), start=2):
+    for line, row in enumerate(csv.reader(io.StringIO(body)), start=first_line):
         if not row or all(not cell.strip() for cell in row):
             continue
         if len(row) != len(header):
@@ -152,7 +157,7 @@ def _numbers(body: str, name, header) -> np.ndarray:
                                  f'not a number ("{shorten(cell.strip())}")') from None
         rows.append(values)
     if not rows:
-        raise InputError(name, "line 2", "no data rows after the header")
+        raise InputError(name, f"line {first_line}", "no data rows after the header")
     return np.array(rows, dtype=float)
 
 
