@@ -39,13 +39,16 @@ def model():
     return load(FOLDER)
 
 
-def write_robot(path, seed, seconds=6.0, payload=None, velocities=True):
+def write_robot(path, seed, seconds=6.0, payload=None, velocities=True, offset=None):
     """A CSV recording of the LWR on a Fourier trajectory: Pinocchio's torques (+ an optional
-    payload), 0.05 Nm noise, positions quantised to the encoder step."""
+    payload, + an optional torque sensor offset per joint), 0.05 Nm noise, positions quantised
+    to the encoder step."""
     t, at = fourier(N, seed, duration=seconds, rate=200.0)
     q, qd, qdd = at(t)
     arm = Arm.from_yaml(LWR)
     tau = noisy(rigid_torques(arm, nominal_parameters(LWR), q, qd, qdd, payload), 0.05, seed)
+    if offset is not None:
+        tau = tau + np.asarray(offset, dtype=float)
     q = np.round(q / ENCODER) * ENCODER
     header = ["t"] + [f"q{j}" for j in range(1, N + 1)]
     columns = [t[:, None], q]

@@ -42,6 +42,10 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="cut every --data recording in time into fit, select and test pieces of these "
                              "fractions (e.g. 0.6,0.2,0.2), each conditioned on its own")
     parser.add_argument("--out", default=None, metavar="DIR", help="output folder (default out/<robot>/diagnosis)")
+    parser.add_argument("--survey", action="store_true",
+                        help="only the gap of every --data recording and the simple model, per recording and pooled, "
+                             "and which recordings stand out; each recording read in blocks, on all cores "
+                             "(recordings.md, recordings.json)")
     add_arguments(parser.add_argument_group("diagnosis"), Options)
     return parser
 
@@ -67,6 +71,10 @@ def main(argv, prog="dyngen diagnose") -> int:
     robot = load_robot(args.robot)
     p = read_link_parameters(args.params, robot.dof)
     progress = Progress(quiet=args.quiet)
+    if args.survey:
+        from .survey import run_survey
+
+        return run_survey(args, robot, p, progress)
     start = time.perf_counter()
     tests = (args.test or []) + (args.holdout or [])
     # bad input fails before anything is announced or written
