@@ -5,7 +5,7 @@ prints, per stage (the dyngen function on the stack just below the command's top
 function, with the innermost dyngen function), the largest RSS seen while it ran and by how much
 the RSS grew over it.
 
-    python bench/memory_stages.py diagnose examples/lwr.yaml --params P.yaml --data long.csv [...]
+    python bench/memory_stages.py [--depth 2] diagnose examples/lwr.yaml --params P.yaml --data long.csv [...]
 
 A profile, not a benchmark: sampling misses peaks shorter than the period, and Python's
 allocator keeps freed memory, so a stage's "peak" can be an earlier stage's leftovers; the
@@ -29,8 +29,8 @@ def rss_mib() -> float:
         return int(f.read().split()[1]) * PAGE / 2 ** 20
 
 
-def stage_of(frame) -> tuple[str, str]:
-    """(stage: the function called by the top-level one, innermost dyngen function)."""
+def stage_of(frame, depth: int = 1) -> tuple[str, str]:
+    """(stage: the `depth` functions called below the top-level one, innermost dyngen function)."""
     chain = []
     while frame is not None:
         if "/dyngen/" in frame.f_code.co_filename:
@@ -41,13 +41,18 @@ def stage_of(frame) -> tuple[str, str]:
     inner = f"{chain[-1][0]}:{chain[-1][1]}" if chain else "-"
     for k, (name, function, line) in enumerate(chain):
         if function in TOP and name == TOP[function]:
-            below = chain[k + 1] if k + 1 < len(chain) else None
-            return (f"{function} > {below[0]}:{below[1]}" if below else f"{function} line {line}"), inner
+            below = chain[k + 1:k + 1 + depth]
+            if not below:
+                return f"{function} line {line}", inner
+            return " > ".join([function] + [f"{b[0]}:{b[1]}" for b in below]), inner
     return (chain[1][1] if len(chain) > 1 else "command"), inner
 
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    depth = 1
+    if argv[:1] == ["--depth"]:
+        depth, argv = int(argv[1]), argv[2:]
     from dyngen import blas
 
     blas.use_one_thread()
@@ -59,7 +64,7 @@ def main(argv=None) -> int:
     def sample():
         while not done.is_set():
             frame = sys._current_frames().get(main_thread)
-            samples.append((time.perf_counter(), rss_mib(), *stage_of(frame)))
+            samples.append((time.perf_counter(), rss_mib(), *stage_of(frame, depth)))
             done.wait(0.02)
 
     thread = threading.Thread(target=sample, daemon=True)

@@ -168,3 +168,27 @@ def test_command_with_a_glob(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "dyngen", "identify", str(LWR), "--ols", "--data",
                           str(tmp_path / "nothing*.csv")], capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "no file matches" in bad.stderr
+
+
+def test_command_on_a_dask_scheduler(tmp_path):
+    """`--scheduler ADDRESS`: the command connects to a running cluster (here a local one whose
+    worker is a thread of this process) and gets the in-process result."""
+    distributed = pytest.importorskip("distributed")
+    for k in range(2):
+        write_robot(tmp_path / f"robot{k}.csv", seed=k, seconds=2.0)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "generator")}
+    base = [sys.executable, "-m", "dyngen", "identify", str(LWR), "--ols", "--data", str(tmp_path / "robot*.csv"),
+            "--model", str(FOLDER), "-q"]
+    local = subprocess.run([*base, "--workers", "1", "-o", str(tmp_path / "local.yaml")], capture_output=True,
+                           text=True, timeout=300, env=env)
+    assert local.returncode == 0, local.stderr
+    with distributed.LocalCluster(n_workers=1, processes=False, threads_per_worker=1, dashboard_address=None,
+                                  protocol="tcp", host="127.0.0.1") as cluster:
+        run = subprocess.run([*base, "--scheduler", cluster.scheduler_address, "-o", str(tmp_path / "dask.yaml")],
+                             capture_output=True, text=True, timeout=300, env=env)
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "dask.yaml").read_text() == (tmp_path / "local.yaml").read_text()
+    bad = subprocess.run([*base, "--scheduler", "tcp://127.0.0.1:9", "-o", str(tmp_path / "no.yaml")],
+                         capture_output=True, text=True, timeout=300, env=env)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "cannot reach the Dask scheduler" in bad.stderr
+    assert not (tmp_path / "no.yaml").exists()
