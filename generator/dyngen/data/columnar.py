@@ -72,7 +72,7 @@ def parquet_batches(path, rows: int = 65536):
     pq = _module("pyarrow.parquet", path)
     pa = _module("pyarrow", path)
     try:
-        f = pq.ParquetFile(path)
+        f = pq.ParquetFile(path, pre_buffer=False)  # else a whole file may be buffered ahead: memory grows with it
         count, schema = f.metadata.num_rows, f.schema_arrow
     except Exception as err:  # noqa: BLE001 -- a broken file may raise anything from the library: one line
         raise InputError(name, "", f"not a readable Parquet file ({shorten(err, 200)})") from None

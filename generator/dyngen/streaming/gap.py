@@ -12,6 +12,7 @@ recording whole, the tanh column through its filter as in diagnosis/baseline.py)
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,7 +67,7 @@ def run(task: GapTask) -> Gap:
     blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
     first = next(blocks)
     if _local(first, task.conditioning):
-        for piece in (first, *blocks):
+        for piece in itertools.chain([first], blocks):  # one block at a time, never all
             add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
         return Gap(first.name, factors, rows, total, squares, True)
     blocks.close()

@@ -15,6 +15,7 @@ result, with memory of one recording.
 from __future__ import annotations
 
 import functools
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -92,7 +93,7 @@ def run(task: Task) -> Sums:
         samples += q.shape[0]
 
     if _local(first, task.conditioning):
-        for piece in (first, *blocks):
+        for piece in itertools.chain([first], blocks):  # one block at a time, never all
             add(piece.q, piece.qd, piece.qdd, piece.tau, piece.extra)
         return Sums(first.name, factors, samples, "qd, qdd as recorded, no filter", True)
     blocks.close()
