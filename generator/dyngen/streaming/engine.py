@@ -2,9 +2,11 @@
 (concurrent.futures), or on a Dask distributed cluster (`--scheduler ADDRESS`, the optional
 extra `distributed`). No scheduling of our own: the executor's map, results in task order.
 
-Local workers are started with one BLAS thread (dyngen.blas: small matrices, and the cores are
-the workers'); they are spawned fresh, not forked, so that they neither inherit the parent's
-threads nor its memory. A Dask cluster's workers are the user's: they must see the recordings
+Local workers run with one BLAS thread (dyngen.blas: small matrices, and the cores are the
+workers'). When this process already runs with one (the dyngen command sets it before NumPy
+loads, so no BLAS thread pool exists to be copied), workers are forked: they start at once with
+NumPy and the compiled model loaded, where spawning costs each worker about a second of imports.
+Otherwise they are spawned fresh with one BLAS thread set before their NumPy loads. A Dask cluster's workers are the user's: they must see the recordings
 and the generated model at the same paths (a shared file system) and should run with
 OPENBLAS_NUM_THREADS=1 (docs/many-recordings.md).
 """
@@ -32,7 +34,9 @@ def run_all(function, tasks: list, workers: int | None = None, scheduler: str | 
 
     from .. import blas
 
-    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context("spawn"),
+    single = all(os.environ.get(v) == "1" for v in blas.VARIABLES)
+    method = "fork" if single and "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    with ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context(method),
                              initializer=blas.use_one_thread) as pool:
         return list(pool.map(function, tasks))
 
