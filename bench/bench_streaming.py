@@ -8,9 +8,11 @@
 2. 20 recordings of 5 minutes (the tiled run, each one from another of the three real runs):
    wall time of `--workers 1` against `--workers 2` (target: at most 0.6x), and the same
    coefficients from both.
+3. The commands that still hold every row, for comparison: `dyngen identify` (consistent) on 5
+   and 30 minutes, `dyngen diagnose` on 5 minutes.
 Writes bench/results/streaming.md and streaming.json.
 
-    python bench/bench_streaming.py [--quick]      # quick: 5 and 30 min, 6 recordings
+    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel whole]
 """
 from __future__ import annotations
 
@@ -57,10 +59,109 @@ def values(path: Path) -> list:
     return [float(v) for v in re.findall(r"value: (\S+)\}", path.read_text())]
 
 
+def part_memory(tmp, model, quick) -> dict:
+    lengths = [(5, None, "csv"), (30, None, "csv")] + ([] if quick else [(60, None, "csv"), (60, 1000, "parquet")])
+    rows_out = []
+    for minutes, rate, suffix in lengths:
+        path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
+        rows = write(path, minutes, rate)
+        log(f"identify --ols on {path.name} ({rows} rows) ...")
+        m = identify([path], tmp / "out.yaml", model)
+        rows_out.append({"minutes": minutes, "rate": rate or 200, "format": suffix, "rows": rows,
+                         "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
+                         "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
+        path.unlink()
+    return {"rows": rows_out}
+
+
+def part_parallel(tmp, model, quick, repeat) -> dict:
+    count = 6 if quick else 20
+    files = []
+    for k in range(count):
+        path = tmp / f"robot{k:02d}.csv"
+        write(path, 5, None, REAL[k % 3])
+        files.append(path)
+    runs = {}
+    for attempt in range(repeat):  # alternating, so that a change of the machine's load hits both alike
+        for workers in (1, 2):
+            log(f"{count} recordings, --workers {workers} (run {attempt + 1}) ...")
+            m = identify(files, tmp / f"pooled{workers}.yaml", model, workers)
+            r = {"seconds": m.seconds, "stage_seconds": stage_seconds(m), "cpu_seconds": m.cpu_seconds,
+                 "peak_mib": m.max_rss_mib}
+            if str(workers) not in runs or r["seconds"] < runs[str(workers)]["seconds"]:
+                runs[str(workers)] = r
+    same = max(abs(a - b) / max(abs(b), 1e-12) for a, b in zip(values(tmp / "pooled1.yaml"), values(tmp / "pooled2.yaml")))
+    return {"recordings": count, "repeat": repeat, "runs": runs, "largest_relative_difference": same}
+
+
+def part_whole(tmp, model, quick) -> dict:
+    """The commands that still hold every row: identify (consistent), diagnose."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "generator")}
+    lwr = ROOT / "examples" / "lwr.yaml"
+    out = []
+    for minutes in ((5,) if quick else (5, 30)):
+        path = tmp / f"lwr_{minutes}min.csv"
+        rows = write(path, minutes)
+        commands = [("identify (consistent)", ["identify", lwr, "--data", path, "-o", tmp / "c" / "id.yaml"])]
+        if minutes == 5:  # 30 minutes of diagnosis would need about 23 GB
+            commands.append(("diagnose", ["diagnose", lwr, "--params", ROOT / "examples" / "lwr_paper_solution.yaml",
+                                          "--data", path, "--out", tmp / "d"]))
+        for what, argv in commands:
+            log(f"{what} on {minutes} min ...")
+            m = run_measured([sys.executable, "-m", "dyngen", *argv, "--model", model, "-q"], env=env)
+            out.append({"command": what, "minutes": minutes, "rows": rows, "seconds": m.seconds,
+                        "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib, "returncode": m.returncode})
+        path.unlink()
+    return {"rows": out}
+
+
+def markdown(doc) -> list:
+    md = ["# Hours of data, many recordings", "",
+          f"Machine: {doc['machine']}; load average {doc['load'][0]:.1f} at the end of the last part run (other "
+          "jobs share the cores: wall times are upper bounds; CPU times are this command's own).", ""]
+    if "memory" in doc:
+        md += ["`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR "
+               "factors, dyngen.streaming) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
+               "200 Hz) repeated end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest "
+               "resident set (bench/peak_memory.py) of the whole command (Python, NumPy, the compiled model).", "",
+               "| length | rate | format | rows | file | wall | CPU | peak memory |", "|---|---|---|---:|---:|---:|---:|---:|"]
+        for r in doc["memory"]["rows"]:
+            md.append(f"| {r['minutes']} min | {r['rate']} Hz | {r['format']} | {r['rows']} | {r['file_mib']:.0f} MiB "
+                      f"| {r['seconds']:.1f} s | {r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
+        md.append("")
+    if "parallel" in doc:
+        par, runs = doc["parallel"], doc["parallel"]["runs"]
+        md += [f"{par['recordings']} recordings of 5 minutes (each a tiled real run), pooled fit and per-recording "
+               "table, `--workers 1` and `--workers 2`:", "",
+               "| workers | wall, whole command | wall, per-recording stage | CPU | peak memory (largest process) |",
+               "|---|---:|---:|---:|---:|"]
+        for w, r in runs.items():
+            md.append(f"| {w} | {r['seconds']:.1f} s | {r['stage_seconds']:.1f} s | {r['cpu_seconds']:.1f} s | "
+                      f"{r['peak_mib']:.0f} MiB |")
+        ratio = runs["2"]["seconds"] / runs["1"]["seconds"]
+        stage = runs["2"]["stage_seconds"] / runs["1"]["stage_seconds"]
+        md += ["", f"Fastest of {par['repeat']} alternating runs each. Wall time with 2 workers: {ratio:.2f}x that of 1 "
+               f"for the whole command, {stage:.2f}x for the per-recording stage (target at most 0.6x); coefficients "
+               f"equal to {par['largest_relative_difference']:.1e} (largest relative difference). The command "
+               "also starts Python and imports dyngen (about 2.5 s of CPU, most of it the consistent "
+               "identification's modules that `dyngen identify`'s flags import) and loads the compiled model, in "
+               "one process whatever the workers.", ""]
+    if "whole" in doc:
+        md += ["Commands that still hold every row (not in blocks yet), on the same tiled run:", "",
+               "| command | length | rows | wall | CPU | peak memory |", "|---|---|---:|---:|---:|---:|"]
+        for r in doc["whole"]["rows"]:
+            md.append(f"| {r['command']} | {r['minutes']} min | {r['rows']} | {r['seconds']:.1f} s | "
+                      f"{r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
+        md.append("")
+    return md
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
+    ap.add_argument("--parts", nargs="+", choices=("memory", "parallel", "whole"), default=["memory", "parallel", "whole"],
+                    help="parts to run; the others are kept from the last results file")
     args = ap.parse_args(argv)
     tmp = Path(tempfile.mkdtemp(prefix="dyngen-streaming-"))
     log("generating the model ...")
@@ -68,65 +169,20 @@ def main(argv=None) -> int:
     from dyngen.generate import generate
 
     model = generate(load_robot(ROOT / "examples" / "lwr.yaml"), tmp / "gen").folder
-    lengths = [(5, None, "csv"), (30, None, "csv")] + ([] if args.quick else [(60, None, "csv"), (60, 1000, "parquet")])
-    memory = []
-    for minutes, rate, suffix in lengths:
-        path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
-        rows = write(path, minutes, rate)
-        log(f"identify --ols on {path.name} ({rows} rows) ...")
-        m = identify([path], tmp / "out.yaml", model)
-        memory.append({"minutes": minutes, "rate": rate or 200, "format": suffix, "rows": rows,
-                       "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds, "cpu_seconds": m.cpu_seconds,
-                       "peak_mib": m.max_rss_mib})
-        path.unlink()
-    count = 6 if args.quick else 20
-    files = []
-    for k in range(count):
-        path = tmp / f"robot{k:02d}.csv"
-        write(path, 5, None, REAL[k % 3])
-        files.append(path)
-    runs = {}
-    for attempt in range(args.repeat):  # alternating, so that a change of the machine's load hits both alike
-        for workers in (1, 2):
-            log(f"{count} recordings, --workers {workers} (run {attempt + 1}) ...")
-            m = identify(files, tmp / f"pooled{workers}.yaml", model, workers)
-            r = {"seconds": m.seconds, "stage_seconds": stage_seconds(m), "cpu_seconds": m.cpu_seconds,
-                 "peak_mib": m.max_rss_mib}
-            if workers not in runs or r["seconds"] < runs[workers]["seconds"]:
-                runs[workers] = r
-    same = max(abs(a - b) / max(abs(b), 1e-12) for a, b in zip(values(tmp / "pooled1.yaml"), values(tmp / "pooled2.yaml")))
-    load = os.getloadavg()
-    doc = {"machine": machine(), "load": load, "memory": memory, "parallel": {"recordings": count, "runs": runs,
-                                                                                "largest_relative_difference": same}}
+    path = RESULTS / "streaming.json"
+    doc = json.loads(path.read_text()) if path.is_file() else {}
+    doc = {k: v for k, v in doc.items() if k in ("memory", "parallel", "whole")}
+    if "memory" in args.parts:
+        doc["memory"] = part_memory(tmp, model, args.quick)
+    if "parallel" in args.parts:
+        doc["parallel"] = part_parallel(tmp, model, args.quick, args.repeat)
+    if "whole" in args.parts:
+        doc["whole"] = part_whole(tmp, model, args.quick)
+    doc.update(machine=machine(), load=os.getloadavg())
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "streaming.json").write_text(json.dumps(doc, indent=1) + "\n")
-    ratio = runs[2]["seconds"] / runs[1]["seconds"]
-    doc["parallel"]["stage_ratio"] = runs[2]["stage_seconds"] / runs[1]["stage_seconds"]
-    (RESULTS / "streaming.json").write_text(json.dumps(doc, indent=1) + "\n")
-    md = ["# Hours of data, many recordings", "",
-          f"Machine: {machine()}; load average at the end {load[0]:.1f} (other jobs share the cores: wall times "
-          "are upper bounds).", "",
-          "`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR factors, "
-          "dyngen.streaming) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at 200 Hz) repeated "
-          "end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest resident set "
-          "(bench/peak_memory.py), of the whole command (Python, NumPy, the compiled model).", "",
-          "| length | rate | format | rows | file | wall | CPU | peak memory |", "|---|---|---|---:|---:|---:|---:|---:|"]
-    for r in memory:
-        md.append(f"| {r['minutes']} min | {r['rate']} Hz | {r['format']} | {r['rows']} | {r['file_mib']:.0f} MiB | "
-                  f"{r['seconds']:.1f} s | {r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
-    md += ["", f"{count} recordings of 5 minutes (each a tiled real run), pooled fit and per-recording table:", "",
-           "| workers | wall, whole command | wall, per-recording stage | CPU | peak memory (largest process) |",
-          "|---|---:|---:|---:|---:|"]
-    for w, r in runs.items():
-        md.append(f"| {w} | {r['seconds']:.1f} s | {r['stage_seconds']:.1f} s | {r['cpu_seconds']:.1f} s | "
-                  f"{r['peak_mib']:.0f} MiB |")
-    stage = runs[2]["stage_seconds"] / runs[1]["stage_seconds"]
-    md += ["", f"Fastest of {args.repeat} alternating runs each. Wall time with 2 workers: {ratio:.2f}x that of 1 for "
-           f"the whole command, {stage:.2f}x for the per-recording stage (target at most 0.6x); coefficients equal "
-           f"to {same:.1e} (largest relative difference). The whole command also starts Python and imports "
-           "dyngen (about 2.5 s, most of it the consistent identification's modules that `dyngen identify`'s "
-           "flags import) and loads the compiled model, in one process whatever the workers."]
-    (RESULTS / "streaming.md").write_text("\n".join(md) + "\n")
+    path.write_text(json.dumps(doc, indent=1) + "\n")
+    md = markdown(doc)
+    (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
     print("\n".join(md))
     return 0
 

@@ -38,7 +38,7 @@ def stage_of(frame, depth: int = 1) -> tuple[str, str]:
             chain.append((name, frame.f_code.co_name, frame.f_lineno))
         frame = frame.f_back
     chain.reverse()  # outermost first
-    inner = f"{chain[-1][0]}:{chain[-1][1]}" if chain else "-"
+    inner = f"{chain[-1][0]}:{chain[-1][1]}:{chain[-1][2]}" if chain else "-"
     for k, (name, function, line) in enumerate(chain):
         if function in TOP and name == TOP[function]:
             below = chain[k + 1:k + 1 + depth]

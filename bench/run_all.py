@@ -16,6 +16,8 @@ its table to bench/results/):
                                        script does not exist)
     memory       bench_memory.py       peak memory of each step (last: it collects the peaks the
                                        dynamics and scaling parts recorded)
+    streaming    bench_streaming.py    identify --ols on 5-60 min recordings (flat memory), and 20
+                                       recordings with 1 and 2 workers
 
 BENCHMARKS.md gets every part's table. A part that was not run by this invocation is
 included from its last results file and marked as such; a part that failed is reported as
@@ -42,7 +44,7 @@ ROOT = BENCH.parent
 sys.path.insert(0, str(BENCH))
 from common import cpu_model, log  # noqa: E402
 RESULTS = BENCH / "results"
-PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory")
+PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory", "streaming")
 TITLES = {
     "opcounts": "Operation counts of the generated functions",
     "dynamics": "Generated C vs Pinocchio (time per call, instructions per call)",
@@ -50,6 +52,7 @@ TITLES = {
     "extraction": "Extraction: dyngen's driver vs SciPy",
     "diagnosis": "Diagnosis: 30 s of 1 kHz data",
     "memory": "Peak memory of each step",
+    "streaming": "Hours of data, many recordings",
 }
 DIAGNOSIS_SCRIPT = BENCH / "bench_diagnosis.py"
 # Reading notes for a part's table, where the script's own output can mislead.
@@ -95,6 +98,8 @@ def part_command(part: str, args) -> list | None:
         return [*py, DIAGNOSIS_SCRIPT] if DIAGNOSIS_SCRIPT.is_file() else None
     if part == "memory":
         return [*py, BENCH / "bench_memory.py"]
+    if part == "streaming":
+        return [*py, BENCH / "bench_streaming.py", *(["--quick", "--repeat", "1"] if args.quick else [])]
     raise ValueError(part)
 
 

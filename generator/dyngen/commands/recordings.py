@@ -26,7 +26,8 @@ def add_data_options(parser: argparse.ArgumentParser) -> None:
                         help="ROS 2 bags: take the torques from this topic (a commanded effort: JointState or "
                              "Float64MultiArray) instead of joint_states' measured effort")
     add_arguments(parser.add_argument_group("signal conditioning"), Conditioning)
-    group = parser.add_argument_group("many recordings")
+    group = parser.add_argument_group("many recordings (identify --ols, --kind gravity or inertia; diagnose --survey: "
+                                      "each recording read in blocks, in a worker)")
     group.add_argument("--workers", type=whole(1, 1024), metavar="N",
                        help="worker processes for the per-recording work (default: one per core, at most one per "
                             "recording)")
