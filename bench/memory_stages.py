@@ -50,9 +50,17 @@ def stage_of(frame, depth: int = 1) -> tuple[str, str]:
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    depth = 1
-    if argv[:1] == ["--depth"]:
-        depth, argv = int(argv[1]), argv[2:]
+    depth, trace = 1, False
+    while argv[:1] in (["--depth"], ["--trace"]):
+        if argv[0] == "--trace":  # also: the allocation sites that hold the most at the traced peak
+            trace, argv = True, argv[1:]
+        else:
+            depth, argv = int(argv[1]), argv[2:]
+    if trace:
+        import tracemalloc
+
+        tracemalloc.start(8)
+    best = {"size": 0, "snapshot": None}
     from dyngen import blas
 
     blas.use_one_thread()
@@ -65,6 +73,10 @@ def main(argv=None) -> int:
         while not done.is_set():
             frame = sys._current_frames().get(main_thread)
             samples.append((time.perf_counter(), rss_mib(), *stage_of(frame, depth)))
+            if trace:
+                size = tracemalloc.get_traced_memory()[0]
+                if size > 1.1 * best["size"]:  # a snapshot costs time: only on a new peak by 10 %
+                    best["size"], best["snapshot"] = size, tracemalloc.take_snapshot()
             done.wait(0.02)
 
     thread = threading.Thread(target=sample, daemon=True)
@@ -95,6 +107,14 @@ def main(argv=None) -> int:
         inner = max(s["inner"], key=s["inner"].get)
         print(f"| {key} | {s['first']:.1f} s | {s['seconds']:.1f} s | {s['peak']:.0f} MiB | {s['grew']:.0f} MiB | "
               f"{inner} |")
+    if trace and best["snapshot"] is not None:
+        print(f"\nAt the traced peak ({best['size'] / 2 ** 20:.0f} MiB traced), the allocation sites that held most:\n")
+        print("| MiB | blocks | where (innermost dyngen frames) |")
+        print("|---:|---:|---|")
+        stats = best["snapshot"].statistics("traceback")
+        for stat in stats[:12]:
+            frames = [f"{f.filename.split('/dyngen/')[-1]}:{f.lineno}" for f in stat.traceback if "/dyngen/" in f.filename]
+            print(f"| {stat.size / 2 ** 20:.0f} | {stat.count} | {' < '.join(frames[-3:][::-1]) or stat.traceback[0]} |")
     return code
 
 
