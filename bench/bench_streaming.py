@@ -45,6 +45,16 @@ def identify(data: list, out: Path, model: Path, workers: int = 1):
     return m
 
 
+def survey(path: Path, tmp: Path, model: Path):
+    cmd = [sys.executable, "-m", "dyngen", "diagnose", ROOT / "examples" / "lwr.yaml", "--params",
+           ROOT / "examples" / "lwr_paper_solution.yaml", "--survey", "--data", path, "--model", model,
+           "--out", tmp / "survey", "-q"]
+    m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    if m.returncode != 0:
+        raise SystemExit(f"failed: {' '.join(map(str, cmd))}\n{m.stderr}")
+    return m
+
+
 def stage_seconds(m) -> float:
     """The per-recording stage's wall time, from the command's progress line."""
     import re
@@ -65,11 +75,12 @@ def part_memory(tmp, model, quick) -> dict:
     for minutes, rate, suffix in lengths:
         path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
         rows = write(path, minutes, rate)
-        log(f"identify --ols on {path.name} ({rows} rows) ...")
-        m = identify([path], tmp / "out.yaml", model)
-        rows_out.append({"minutes": minutes, "rate": rate or 200, "format": suffix, "rows": rows,
-                         "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
-                         "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
+        for command in ("identify --ols", "diagnose --survey"):
+            log(f"{command} on {path.name} ({rows} rows) ...")
+            m = identify([path], tmp / "out.yaml", model) if command.startswith("identify") else survey(path, tmp, model)
+            rows_out.append({"command": command, "minutes": minutes, "rate": rate or 200, "format": suffix,
+                             "rows": rows, "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
+                             "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
         path.unlink()
     return {"rows": rows_out}
 
@@ -121,12 +132,14 @@ def markdown(doc) -> list:
           "jobs share the cores: wall times are upper bounds; CPU times are this command's own).", ""]
     if "memory" in doc:
         md += ["`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR "
-               "factors, dyngen.streaming) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
+               "factors, dyngen.streaming) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
+               "streaming/gap.py) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
                "200 Hz) repeated end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest "
                "resident set (bench/peak_memory.py) of the whole command (Python, NumPy, the compiled model).", "",
-               "| length | rate | format | rows | file | wall | CPU | peak memory |", "|---|---|---|---:|---:|---:|---:|---:|"]
+               "| command | length | rate | format | rows | file | wall | CPU | peak memory |",
+               "|---|---|---|---|---:|---:|---:|---:|---:|"]
         for r in doc["memory"]["rows"]:
-            md.append(f"| {r['minutes']} min | {r['rate']} Hz | {r['format']} | {r['rows']} | {r['file_mib']:.0f} MiB "
+            md.append(f"| {r.get('command', 'identify --ols')} | {r['minutes']} min | {r['rate']} Hz | {r['format']} | {r['rows']} | {r['file_mib']:.0f} MiB "
                       f"| {r['seconds']:.1f} s | {r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
         md.append("")
     if "parallel" in doc:

@@ -214,3 +214,26 @@ def test_memory_does_not_grow_with_the_length(tmp_path):
         assert sums.streamed and sums.samples == path.read_text().count("\n") - 1
     data_bytes = 320 * 200 * 29 * 8  # the long recording's values: 15 MB
     assert peaks[1] < 1.2 * peaks[0] + 100_000 and peaks[1] < data_bytes / 3, peaks
+
+
+def test_block_reader_bounds_like_the_whole_file_reader(tmp_path):
+    import gzip
+
+    path = write_robot(tmp_path / "r.csv", seed=1, seconds=0.5)
+    packed = tmp_path / "r.csv.gz"
+    packed.write_bytes(gzip.compress(path.read_bytes()))
+    a, b = read_recording(packed, N), whole(packed, N, rows=9)
+    assert np.array_equal(a.q, b.q) and np.array_equal(a.tau, b.tau)
+    latin = tmp_path / "latin.csv"
+    latin.write_bytes(path.read_bytes().replace(b"\n0.01", b"\n0.01\xe9", 1))
+    with pytest.raises(InputError) as whole_file:
+        read_recording(latin, N)
+    with pytest.raises(InputError) as blocks:
+        list(chunks(latin, N, rows=9))
+    assert str(blocks.value) == str(whole_file.value) and "latin.csv: line 4: not UTF-8" in str(blocks.value)
+    fifo = tmp_path / "fifo.csv"
+    os.mkfifo(fifo)
+    with pytest.raises(InputError, match="not a regular file"):
+        list(chunks(fifo, N))  # refused before opening: opening a FIFO would wait for a writer
+    with pytest.raises(InputError, match="not a regular file"):
+        list(chunks("/dev/zero", N))

@@ -65,33 +65,43 @@ def _csv_blocks(path, rows: int):
     raw = open(path, "rb")
     try:
         binary = gzip.GzipFile(fileobj=raw) if path.suffix == ".gz" else raw
-        text = io.TextIOWrapper(_Bounded(binary, name, MAX_CSV_BYTES), encoding="utf-8-sig", newline="")
-        line = 1
+        lines_of = io.BufferedReader(_Bounded(binary, name, MAX_CSV_BYTES))
         try:
-            header_line = text.readline()
+            head = lines_of.readline()
+            header_line = _decoded([head], name, 1, 0, "utf-8-sig")
+            offset = len(head)
             header = [h.strip() for h in next(csv.reader([header_line]), [])]
             yield header
             first, start = 2, 0
             while True:
-                lines = list(islice(text, rows))
-                if not lines:
+                chunk = list(islice(lines_of, rows))
+                if not chunk:
                     break
-                line = first
+                lines = _decoded(chunk, name, first, offset).splitlines(keepends=True)
+                offset += sum(len(x) for x in chunk)
                 if any(x.strip() for x in lines):
                     data = _block(lines, name, header, first)
                     yield start, data, csv_line
                     start += data.shape[0]
-                first += len(lines)
+                first += len(chunk)
             if start == 0:
                 raise InputError(name, "line 2", "no data rows after the header")
-        except UnicodeDecodeError:
-            raise InputError(name, f"line {line}", "not UTF-8 text; save the file as UTF-8") from None
         except (OSError, EOFError, zlib.error) as err:
-            if isinstance(err, InputError):
-                raise
             raise InputError(name, "", f"not a readable gzip file ({err or 'truncated'})") from None
     finally:
         raw.close()
+
+
+def _decoded(chunk: list, name, first_line: int, offset: int, encoding: str = "utf-8") -> str:
+    """The lines (starting at line first_line, byte offset of the file) as text, or the whole-file
+    reader's InputError naming the line and byte that are not UTF-8."""
+    data = b"".join(chunk)
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as err:
+        line = first_line + data[:err.start].count(b"\n")
+        raise InputError(name, f"line {line}", f"not UTF-8 text (byte {offset + err.start}); save the file as UTF-8"
+                         ) from None
 
 
 def _block(lines, name, header, first_line) -> np.ndarray:
