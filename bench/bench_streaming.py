@@ -85,6 +85,30 @@ def part_memory(tmp, model, quick) -> dict:
     return {"rows": rows_out}
 
 
+def _burn(n: int) -> float:
+    x = 0
+    for i in range(n):
+        x += i * i
+    return float(x)
+
+
+def calibration(repeat: int) -> float:
+    """Wall time of 8 pure-Python CPU tasks on 2 worker processes over that on 1 (fastest of
+    `repeat`): what this machine allows two processes of this benchmark at this moment (1.0 when
+    its scheduler gives them one core's worth in all, e.g. a session's autogroup on a loaded machine)."""
+    import time
+    from concurrent.futures import ProcessPoolExecutor
+
+    best = {}
+    for _ in range(repeat):
+        for workers in (1, 2):
+            start = time.perf_counter()
+            with ProcessPoolExecutor(workers) as pool:
+                list(pool.map(_burn, [3_000_000] * 8))
+            best[workers] = min(best.get(workers, 1e9), time.perf_counter() - start)
+    return best[2] / best[1]
+
+
 def part_parallel(tmp, model, quick, repeat) -> dict:
     count = 6 if quick else 20
     files = []
@@ -102,7 +126,8 @@ def part_parallel(tmp, model, quick, repeat) -> dict:
             if str(workers) not in runs or r["seconds"] < runs[str(workers)]["seconds"]:
                 runs[str(workers)] = r
     same = max(abs(a - b) / max(abs(b), 1e-12) for a, b in zip(values(tmp / "pooled1.yaml"), values(tmp / "pooled2.yaml")))
-    return {"recordings": count, "repeat": repeat, "runs": runs, "largest_relative_difference": same}
+    return {"recordings": count, "repeat": repeat, "runs": runs, "largest_relative_difference": same,
+            "calibration": calibration(repeat)}
 
 
 def part_whole(tmp, model, quick) -> dict:
@@ -158,7 +183,12 @@ def markdown(doc) -> list:
                f"equal to {par['largest_relative_difference']:.1e} (largest relative difference). The command "
                "also starts Python and imports dyngen (about 2.5 s of CPU, most of it the consistent "
                "identification's modules that `dyngen identify`'s flags import) and loads the compiled model, in "
-               "one process whatever the workers.", ""]
+               "one process whatever the workers."]
+        if "calibration" in par:
+            md += ["", f"Calibration at the same time: 8 pure-Python CPU tasks on 2 processes took "
+                   f"{par['calibration']:.2f}x the wall time of 1 process (what the machine allowed two processes; "
+                   "about 0.5 on an idle 2-core machine)."]
+        md.append("")
     if "whole" in doc:
         md += ["Commands that still hold every row (not in blocks yet), on the same tiled run:", "",
                "| command | length | rows | wall | CPU | peak memory |", "|---|---|---:|---:|---:|---:|"]
