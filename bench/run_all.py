@@ -16,6 +16,8 @@ its table to bench/results/):
                                        script does not exist)
     memory       bench_memory.py       peak memory of each step (last: it collects the peaks the
                                        dynamics and scaling parts recorded)
+    streaming    bench_streaming.py    identify --ols on 5-60 min recordings (flat memory), and 20
+                                       recordings with 1 and 2 workers
 
 BENCHMARKS.md gets every part's table. A part that was not run by this invocation is
 included from its last results file and marked as such; a part that failed is reported as
@@ -41,7 +43,7 @@ BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
 from common import arguments, cpu_model, log  # noqa: E402  (bench/ is sys.path[0])
 RESULTS = BENCH / "results"
-PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory", "kinematics", "firmware")
+PARTS = ("opcounts", "dynamics", "scaling", "extraction", "diagnosis", "memory", "kinematics", "firmware", "streaming")
 TITLES = {
     "opcounts": "Operation counts of the generated functions",
     "dynamics": "Generated C vs Pinocchio (time per call, instructions per call)",
@@ -51,6 +53,7 @@ TITLES = {
     "memory": "Peak memory of each step",
     "kinematics": "Kinematics and control() vs Pinocchio (time per call, instructions per call)",
     "firmware": "Firmware build: size and stack of every function (Cortex-M4F, Cortex-M7)",
+    "streaming": "Hours of data, many recordings",
 }
 DIAGNOSIS_SCRIPT = BENCH / "bench_diagnosis.py"
 # Reading notes for a part's table, where the script's own output can mislead.
@@ -102,6 +105,8 @@ def part_command(part: str, args) -> list | None:
                 *quick, "--output", RESULTS / "kinematics.md"]
     if part == "firmware":
         return [*py, BENCH / "bench_firmware.py"] if shutil.which("arm-none-eabi-gcc") else None
+    if part == "streaming":
+        return [*py, BENCH / "bench_streaming.py", *(["--quick", "--repeat", "1"] if args.quick else [])]
     raise ValueError(part)
 
 

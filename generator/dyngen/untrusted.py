@@ -24,6 +24,41 @@ MAX_CSV_BYTES = 1 << 30  # an hour at 1 kHz for 12 joints is about 0.5 GB of tex
 MAX_RATIO, RATIO_FROM = 50, 64 << 20
 
 
+def regular_file(path, limit: int) -> int:
+    """The size of `path` if it is a regular file of at most `limit` bytes, for readers that
+    open files themselves (Parquet, ROS 2 bags); a device, FIFO or folder is refused (reading
+    /dev/zero or a FIFO would never end)."""
+    path = Path(path)
+    try:
+        info = path.stat()
+    except OSError as err:
+        raise InputError(str(path), "", f"cannot read the file ({err.strerror or err})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError(str(path), "", "not a regular file")
+    if info.st_size > limit:
+        raise InputError(path.name, "", f"file too large (at most {limit >> 20} MB)")
+    return info.st_size
+
+
+def regular_folder(path, limit: int, most: int = 1000) -> None:
+    """A folder (a ROS 2 bag) holding only regular files (no links, no subfolders), at most
+    `most` of them and `limit` bytes in all."""
+    path = Path(path)
+    try:
+        entries = list(os.scandir(path))
+    except OSError as err:
+        raise InputError(str(path), "", f"cannot read the folder ({err.strerror or err})") from None
+    if len(entries) > most:
+        raise InputError(path.name, "", f"{len(entries)} entries; a bag folder has at most {most}")
+    total = 0
+    for entry in entries:
+        if not entry.is_file(follow_symlinks=False):
+            raise InputError(path.name, shorten(entry.name), "not a regular file (links and folders are refused)")
+        total += entry.stat(follow_symlinks=False).st_size
+    if total > limit:
+        raise InputError(path.name, "", f"folder too large (at most {limit >> 20} MB)")
+
+
 def read_bytes(path, limit: int) -> bytes:
     """The file's bytes (a .gz file: unpacked), at most `limit` of them. Anything but a regular
     file (a FIFO would block, /dev/zero never ends, a folder) is refused before a byte is read,

@@ -47,6 +47,10 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
     parser.add_argument("--force", action="store_true",
                         help="replace an output folder that holds files dyngen did not write (docs/untrusted-input.md)")
 
+    parser.add_argument("--survey", action="store_true",
+                        help="only the gap of every --data recording and the simple model, per recording and pooled, "
+                             "and which recordings stand out; each recording read in blocks, on all cores "
+                             "(recordings.md, recordings.json)")
     add_arguments(parser.add_argument_group("diagnosis"), Options)
     return parser
 
@@ -72,6 +76,10 @@ def main(argv, prog="dyngen diagnose") -> int:
     robot = load_robot(args.robot)
     p = read_link_parameters(args.params, robot.dof)
     progress = Progress(quiet=args.quiet)
+    if args.survey:
+        from .survey import run_survey
+
+        return run_survey(args, robot, p, progress)
     start = time.perf_counter()
     tests = (args.test or []) + (args.holdout or [])
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
@@ -84,7 +92,8 @@ def main(argv, prog="dyngen diagnose") -> int:
             raise InputError("--split", "", "cuts the --data recordings into fit, select and test: give no "
                              "--select, --test or --holdout with it")
         fractions = parse_fractions(args.split)
-        pieces = [split_recording(read_recording(x, robot.dof), fractions) for x in args.data]
+        pieces = [split_recording(read_recording(x, robot.dof, effort_topic=args.effort_topic), fractions)
+                  for x in args.data]
         for recording in (r for rs in pieces for r in rs if r is not None):
             check_enough(recording.name, recording.t)
         fit, select, test = ([condition(r[k], conditioning_of(args)) for r in pieces if r[k] is not None]

@@ -4,12 +4,10 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
-
 from ..options import add_arguments, resolve
 from ..errors import printable
 from ..progress import Progress
-from .recordings import add_data_options, compiled_model, conditioning_text, read_all
+from .recordings import add_data_options, compiled_model, read_all
 
 
 def parser(prog="dyngen identify") -> argparse.ArgumentParser:
@@ -50,8 +48,6 @@ def main(argv, prog="dyngen identify") -> int:
 
     options = resolve(Options, args, {})
     from ..description import load_robot
-    from ..identification import identified_yaml, identify, summary_table
-    from ..identification.samples import stacked_inertia_columns
 
     robot = load_robot(args.robot)
     progress = Progress(quiet=args.quiet)
@@ -59,29 +55,15 @@ def main(argv, prog="dyngen identify") -> int:
     required = tuple(_inertia_names(robot)) if kind == "inertia" else ()
     # Bad input fails before anything is announced or written.
     out = check_outputs(args, robot, kind, options.ols)
+    if kind != "full" or options.ols:  # least squares: accumulated per recording, in parallel
+        from .least_squares import run_least_squares
+
+        return run_least_squares(args, robot, kind, required, progress, out)
     signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required,
                        need_motion=kind == "full")
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
-    if kind == "full" and not options.ols:
-        return run_consistent(args, robot, model, signals, progress)
-    if kind == "inertia":
-        assert stacked_inertia_columns(model.manifest) == list(required)
-    with progress.step("least squares"):
-        estimate = identify(model, signals, kind)
-    from ..atomic import write_file
-
-    write_file(out, identified_yaml(robot.name, {kind: estimate}, [printable(Path(p).name) for p in args.data],
-                                    conditioning_text(signals)))
-    if not args.quiet:
-        print(f"{robot.name}: {len(estimate.names)} {kind} coefficients from {estimate.rows} equations; "
-              f"condition number {estimate.condition:.3g} (columns scaled {estimate.scaled_condition:.3g}); "
-              f"residual RMS {estimate.residual_rms:.4g}")
-        print("\n".join("  " + line for line in summary_table(kind, estimate).splitlines()))
-        for w in [*estimate.warnings(), *(w for s in signals for w in s.warnings)]:
-            print(f"  warning: {w}")
-        print(f"  written: {out}")
-    return 0
+    return run_consistent(args, robot, model, signals, progress)
 
 
 def check_outputs(args, robot, kind: str, ols: bool) -> Path:
@@ -92,8 +74,10 @@ def check_outputs(args, robot, kind: str, ols: bool) -> Path:
     out = Path(args.output) if args.output else Path("out") / robot.name / (
         "identified_consistent.yaml" if consistent else f"identified_{kind}.yaml")
     files = [out, out.with_suffix(".md"), out.parent / f"{robot.name}.urdf", out.parent / f"{robot.name}.xml"]
+    if not consistent:  # least squares: the YAML, and the per-recording table with several recordings
+        files = [out, out.with_suffix(".recordings.md")]
     inputs = [args.robot, *args.data, *(getattr(args, "select", None) or []), getattr(args, "prior", None), args.model]
-    for path in files if consistent else files[:1]:
+    for path in files:
         check_file(path, inputs)
     return out
 

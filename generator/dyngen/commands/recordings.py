@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..arguments import whole
 from ..errors import InputError
 from ..options import add_arguments, resolve
 
@@ -17,12 +18,36 @@ def add_data_options(parser: argparse.ArgumentParser) -> None:
     from ..data import Conditioning
 
     parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
-    parser.add_argument("--data", action="append", required=True, metavar="CSV",
-                        help="a recording: header t, q1..qN, tau1..tauN, optional qd*, qdd*; repeatable")
+    parser.add_argument("--data", action=Recordings, required=True, metavar="FILE",
+                        help="a recording: CSV with header t, q1..qN, tau1..tauN, optional qd*, qdd*; or Parquet "
+                             "(.parquet, the same columns); or a ROS 2 bag's folder (joint_states); repeatable, and "
+                             "a quoted glob ('logs/*.csv') stands for every file it matches")
+    parser.add_argument("--effort-topic", metavar="TOPIC",
+                        help="ROS 2 bags: take the torques from this topic (a commanded effort: JointState or "
+                             "Float64MultiArray) instead of joint_states' measured effort")
     add_arguments(parser.add_argument_group("signal conditioning"), Conditioning)
+    group = parser.add_argument_group("many recordings (identify --ols, --kind gravity or inertia; diagnose --survey: "
+                                      "each recording read in blocks, in a worker)")
+    group.add_argument("--workers", type=whole(1, 1024), metavar="N",
+                       help="worker processes for the per-recording work (default: one per core, at most one per "
+                            "recording)")
+    group.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run the per-recording work on this Dask distributed scheduler (e.g. tcp://host:8786; "
+                            "the workers must see the files at the same paths)")
     parser.add_argument("--model", metavar="DIR",
                         help="an already generated folder of this robot (default: generate it first)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors and warnings")
+
+
+class Recordings(argparse._AppendAction):
+    """--data: appends the file, or every file a glob matches (sorted); a glob matching
+    nothing is an error naming it."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from ..data.paths import expand
+
+        for path in expand([values]):
+            super().__call__(parser, namespace, path, option_string)
 
 
 def check_enough(name: str, t) -> None:
@@ -69,6 +94,7 @@ def read_all(paths, robot, args, require_torques=True, required=(), need_motion=
     from ..data import condition, read_recording
     from ..data.recording import check_informative
 
-    recordings = [read_recording(p, robot.dof, require_torques, required) for p in paths]
+    topic = getattr(args, "effort_topic", None)
+    recordings = [read_recording(p, robot.dof, require_torques, required, topic) for p in paths]
     check_informative(recordings, need_motion)
     return [condition(r, conditioning_of(args)) for r in recordings]

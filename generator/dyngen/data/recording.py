@@ -46,10 +46,17 @@ class Recording:
     extra: dict = field(default_factory=dict)  # other columns by name, (T,)
 
 
-def read_recording(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
+def read_recording(path, dof: int, require_torques: bool = True, required: tuple = (),
+                   effort_topic: str | None = None) -> Recording:
     """Read and check `path` for a robot of `dof` joints. `required` names further columns
-    (e.g. the stacked inertia entries) that must be present."""
+    (e.g. the stacked inertia entries) that must be present. Parquet files and ROS 2 bags are
+    read by data/columnar.py into the same columns and through the same checks (`effort_topic`:
+    a bag's topic of commanded efforts, data/rosbag.py)."""
     path = Path(path)
+    from . import columnar
+
+    if columnar.format_of(path) is not None:
+        return columnar.read(path, dof, require_torques, required, effort_topic)
     name = printable(path.name)  # the name reaches comments of written files and the terminal
     text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
     if "\r" in text:  # Windows (CR LF) and old Mac (CR alone) line ends are line ends
@@ -58,9 +65,25 @@ def read_recording(path, dof: int, require_torques: bool = True, required: tuple
     header = _header(name, header_line)
     columns = _check_header(name, header, dof, require_torques, required)
     data = _numbers(body, name, header)
-    _check_values(name, header, data)
+    return from_columns(name, header, columns, data, dof)
+
+
+def csv_line(row: int) -> str:
+    """Where data row `row` (0-based) is in a CSV file: the header is line 1."""
+    return f"line {row + 2}"
+
+
+def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
+    """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a
+    data row in messages (a CSV line, a Parquet row)."""
+    _check_values(name, header, data, where)
+    _check_time(name, data[:, columns["t"]], where)
+    return as_recording(name, columns, data, dof)
+
+
+def as_recording(name, columns, data, dof) -> Recording:
+    """The Recording of checked values (a whole file, or a chunk of one: data/chunks.py)."""
     t = data[:, columns["t"]]
-    _check_time(name, t)
 
     def block(prefix):
         if f"{prefix}1" not in columns:
@@ -88,8 +111,12 @@ def _header(name, line: str) -> list[str]:
     return header
 
 
-def _check_header(name, header, dof, require_torques, required) -> dict:
-    where = "line 1 (header)"
+def check_header(name, header, dof, require_torques=True, required=(), where="columns") -> dict:
+    """{column name: index} of a header, or an InputError naming what is wrong (at `where`)."""
+    return _check_header(name, header, dof, require_torques, required, where)
+
+
+def _check_header(name, header, dof, require_torques, required, where="line 1 (header)") -> dict:
     if not header or header == [""]:
         raise InputError(name, where, "empty file; expected a header such as t, q1..qN, tau1..tauN")
     columns = {}
@@ -129,7 +156,7 @@ def _check_header(name, header, dof, require_torques, required) -> dict:
     return columns
 
 
-def _numbers(body: str, name, header) -> np.ndarray:
+def _numbers(body: str, name, header, first_line: int = 2) -> np.ndarray:
     """Fast path with numpy; on failure, a slow pass that finds the exact line and column."""
     try:
         with warnings.catch_warnings():  # an empty body is reported below, with its line
@@ -140,9 +167,9 @@ def _numbers(body: str, name, header) -> np.ndarray:
     if data is not None and data.ndim == 2 and data.shape[1] == len(header) and data.shape[0] > 0:
         return data
     rows = []
-    line = 1
+    line = first_line - 1
     try:
-        for line, row in enumerate(csv.reader(io.StringIO(body)), start=2):
+        for line, row in enumerate(csv.reader(io.StringIO(body)), start=first_line):
             if not row or all(not cell.strip() for cell in row):
                 continue
             if len(row) != len(header):
@@ -151,7 +178,7 @@ def _numbers(body: str, name, header) -> np.ndarray:
     except csv.Error as err:
         raise InputError(name, f"line {line + 1}", f"not CSV ({shorten(str(err))})") from None
     if not rows:
-        raise InputError(name, "line 2", "no data rows after the header")
+        raise InputError(name, f"line {first_line}", "no data rows after the header")
     return np.array(rows, dtype=float)
 
 
@@ -165,31 +192,31 @@ def _cell(cell: str, name, line, column) -> float:
         raise InputError(name, where, f'not a number ("{shorten(cell.strip())}")') from None
 
 
-def _check_values(name, header, data) -> None:
+def _check_values(name, header, data, where=csv_line) -> None:
     bad = np.argwhere(~np.isfinite(data))
     if bad.size:
         row, col = bad[0]
-        raise InputError(name, f"line {row + 2}, column {shorten(header[col])}",
+        raise InputError(name, f"{where(row)}, column {shorten(header[col])}",
                          f"{float(data[row, col])} (NaN or infinite value)")
     bad = np.argwhere(np.abs(data) > MAX_VALUE)
     if bad.size:
         row, col = bad[0]
-        raise InputError(name, f"line {row + 2}, column {shorten(header[col])}",
+        raise InputError(name, f"{where(row)}, column {shorten(header[col])}",
                          f"{float(data[row, col]):g}: value out of range (|x| at most {MAX_VALUE:g})")
 
 
-def _check_time(name, t) -> None:
+def _check_time(name, t, where=csv_line) -> None:
     if t.size < 2:
         raise InputError(name, "column t", f"{t.size} sample(s); at least 2 are needed")
     steps = np.diff(t)
     bad = np.flatnonzero(steps <= 0)
     if bad.size:
         k = bad[0]
-        raise InputError(name, f"line {k + 3}, column t", f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})")
+        raise InputError(name, f"{where(k + 1)}, column t", f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})")
     bad = np.flatnonzero(steps < MIN_STEP)
     if bad.size:
         k = bad[0]
-        raise InputError(name, f"line {k + 3}, column t", f"a time step of {float(steps[k]):.3g} s (at least "
+        raise InputError(name, f"{where(k + 1)}, column t", f"a time step of {float(steps[k]):.3g} s (at least "
                          f"{MIN_STEP:g} s: t is in seconds, and no sensor samples faster than 1 MHz)")
 
 

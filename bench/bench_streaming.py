@@ -1,0 +1,234 @@
+#!/usr/bin/env python3
+"""Benchmark: hours of data and many recordings (dyngen.streaming).
+
+1. Peak memory and wall time of `dyngen identify --ols` (least squares accumulated in blocks)
+   on the real LWR4+ run tiled to 5, 30 and 60 minutes at 200 Hz (CSV), and to 60 minutes at
+   1 kHz (Parquet: 3.6 M rows of 7 joints), each in its own child process (peak_memory.py).
+   Flat means: the peak does not grow with the length.
+2. 20 recordings of 5 minutes (the tiled run, each one from another of the three real runs):
+   wall time of `--workers 1` against `--workers 2` (target: at most 0.6x), and the same
+   coefficients from both.
+3. The commands that still hold every row, for comparison: `dyngen identify` (consistent) on 5
+   and 30 minutes, `dyngen diagnose` on 5 minutes.
+Writes bench/results/streaming.md and streaming.json.
+
+    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel whole]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parent
+ROOT = BENCH.parent
+sys.path.insert(0, str(BENCH))
+from common import log, machine  # noqa: E402
+from long_recordings import write  # noqa: E402
+from peak_memory import run_measured  # noqa: E402
+
+RESULTS = BENCH / "results"
+REAL = [ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv" for k in (1, 2, 3)]
+
+
+def identify(data: list, out: Path, model: Path, workers: int = 1):
+    cmd = [sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", "--ols", "--model", model,
+           "-o", out, "--workers", str(workers)]
+    for d in data:
+        cmd += ["--data", d]
+    m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    if m.returncode != 0:
+        raise SystemExit(f"failed: {' '.join(map(str, cmd))}\n{m.stderr}")
+    return m
+
+
+def survey(path: Path, tmp: Path, model: Path):
+    cmd = [sys.executable, "-m", "dyngen", "diagnose", ROOT / "examples" / "lwr.yaml", "--params",
+           ROOT / "examples" / "lwr_paper_solution.yaml", "--survey", "--data", path, "--model", model,
+           "--out", tmp / "survey", "-q"]
+    m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    if m.returncode != 0:
+        raise SystemExit(f"failed: {' '.join(map(str, cmd))}\n{m.stderr}")
+    return m
+
+
+def stage_seconds(m) -> float:
+    """The per-recording stage's wall time, from the command's progress line."""
+    import re
+
+    found = re.search(r"in blocks done \(([0-9.]+) s\)", m.stdout + m.stderr)
+    return float(found.group(1)) if found else float("nan")
+
+
+def values(path: Path) -> list:
+    import re
+
+    return [float(v) for v in re.findall(r"value: (\S+)\}", path.read_text())]
+
+
+def part_memory(tmp, model, quick) -> dict:
+    lengths = [(5, None, "csv"), (30, None, "csv")] + ([] if quick else [(60, None, "csv"), (60, 1000, "parquet")])
+    rows_out = []
+    for minutes, rate, suffix in lengths:
+        path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
+        rows = write(path, minutes, rate)
+        for command in ("identify --ols", "diagnose --survey"):
+            log(f"{command} on {path.name} ({rows} rows) ...")
+            m = identify([path], tmp / "out.yaml", model) if command.startswith("identify") else survey(path, tmp, model)
+            rows_out.append({"command": command, "minutes": minutes, "rate": rate or 200, "format": suffix,
+                             "rows": rows, "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
+                             "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
+        path.unlink()
+    return {"rows": rows_out}
+
+
+def _burn(n: int) -> float:
+    x = 0
+    for i in range(n):
+        x += i * i
+    return float(x)
+
+
+def calibration(repeat: int) -> float:
+    """Wall time of 8 pure-Python CPU tasks on 2 worker processes over that on 1 (fastest of
+    `repeat`): what this machine allows two processes of this benchmark at this moment (1.0 when
+    its scheduler gives them one core's worth in all, e.g. a session's autogroup on a loaded machine)."""
+    import time
+    from concurrent.futures import ProcessPoolExecutor
+
+    best = {}
+    for _ in range(repeat):
+        for workers in (1, 2):
+            start = time.perf_counter()
+            with ProcessPoolExecutor(workers) as pool:
+                list(pool.map(_burn, [3_000_000] * 8))
+            best[workers] = min(best.get(workers, 1e9), time.perf_counter() - start)
+    return best[2] / best[1]
+
+
+def part_parallel(tmp, model, quick, repeat) -> dict:
+    count = 6 if quick else 20
+    files = []
+    for k in range(count):
+        path = tmp / f"robot{k:02d}.csv"
+        write(path, 5, None, REAL[k % 3])
+        files.append(path)
+    runs = {}
+    for attempt in range(repeat):  # alternating, so that a change of the machine's load hits both alike
+        for workers in (1, 2):
+            log(f"{count} recordings, --workers {workers} (run {attempt + 1}) ...")
+            m = identify(files, tmp / f"pooled{workers}.yaml", model, workers)
+            r = {"seconds": m.seconds, "stage_seconds": stage_seconds(m), "cpu_seconds": m.cpu_seconds,
+                 "peak_mib": m.max_rss_mib}
+            if str(workers) not in runs or r["seconds"] < runs[str(workers)]["seconds"]:
+                runs[str(workers)] = r
+    same = max(abs(a - b) / max(abs(b), 1e-12) for a, b in zip(values(tmp / "pooled1.yaml"), values(tmp / "pooled2.yaml")))
+    return {"recordings": count, "repeat": repeat, "runs": runs, "largest_relative_difference": same,
+            "calibration": calibration(repeat)}
+
+
+def part_whole(tmp, model, quick) -> dict:
+    """The commands that still hold every row: identify (consistent), diagnose."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "generator")}
+    lwr = ROOT / "examples" / "lwr.yaml"
+    out = []
+    for minutes in ((5,) if quick else (5, 30)):
+        path = tmp / f"lwr_{minutes}min.csv"
+        rows = write(path, minutes)
+        commands = [("identify (consistent)", ["identify", lwr, "--data", path, "-o", tmp / "c" / "id.yaml"])]
+        if minutes == 5:  # 30 minutes of diagnosis would need about 23 GB
+            commands.append(("diagnose", ["diagnose", lwr, "--params", ROOT / "examples" / "lwr_paper_solution.yaml",
+                                          "--data", path, "--out", tmp / "d"]))
+        for what, argv in commands:
+            log(f"{what} on {minutes} min ...")
+            m = run_measured([sys.executable, "-m", "dyngen", *argv, "--model", model, "-q"], env=env)
+            out.append({"command": what, "minutes": minutes, "rows": rows, "seconds": m.seconds,
+                        "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib, "returncode": m.returncode})
+        path.unlink()
+    return {"rows": out}
+
+
+def markdown(doc) -> list:
+    md = ["# Hours of data, many recordings", "",
+          f"Machine: {doc['machine']}; load average {doc['load'][0]:.1f} at the end of the last part run (other "
+          "jobs share the cores: wall times are upper bounds; CPU times are this command's own).", ""]
+    if "memory" in doc:
+        md += ["`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR "
+               "factors, dyngen.streaming) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
+               "streaming/gap.py) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
+               "200 Hz) repeated end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest "
+               "resident set (bench/peak_memory.py) of the whole command (Python, NumPy, the compiled model).", "",
+               "| command | length | rate | format | rows | file | wall | CPU | peak memory |",
+               "|---|---|---|---|---:|---:|---:|---:|---:|"]
+        for r in doc["memory"]["rows"]:
+            md.append(f"| {r.get('command', 'identify --ols')} | {r['minutes']} min | {r['rate']} Hz | {r['format']} | {r['rows']} | {r['file_mib']:.0f} MiB "
+                      f"| {r['seconds']:.1f} s | {r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
+        md.append("")
+    if "parallel" in doc:
+        par, runs = doc["parallel"], doc["parallel"]["runs"]
+        md += [f"{par['recordings']} recordings of 5 minutes (each a tiled real run), pooled fit and per-recording "
+               "table, `--workers 1` and `--workers 2`:", "",
+               "| workers | wall, whole command | wall, per-recording stage | CPU | peak memory (largest process) |",
+               "|---|---:|---:|---:|---:|"]
+        for w, r in runs.items():
+            md.append(f"| {w} | {r['seconds']:.1f} s | {r['stage_seconds']:.1f} s | {r['cpu_seconds']:.1f} s | "
+                      f"{r['peak_mib']:.0f} MiB |")
+        ratio = runs["2"]["seconds"] / runs["1"]["seconds"]
+        stage = runs["2"]["stage_seconds"] / runs["1"]["stage_seconds"]
+        md += ["", f"Fastest of {par['repeat']} alternating runs each. Wall time with 2 workers: {ratio:.2f}x that of 1 "
+               f"for the whole command, {stage:.2f}x for the per-recording stage (target at most 0.6x); coefficients "
+               f"equal to {par['largest_relative_difference']:.1e} (largest relative difference). The command "
+               "also starts Python and imports dyngen (about 2.5 s of CPU, most of it the consistent "
+               "identification's modules that `dyngen identify`'s flags import) and loads the compiled model, in "
+               "one process whatever the workers."]
+        if "calibration" in par:
+            md += ["", f"Calibration at the same time: 8 pure-Python CPU tasks on 2 processes took "
+                   f"{par['calibration']:.2f}x the wall time of 1 process (what the machine allowed two processes; "
+                   "about 0.5 on an idle 2-core machine)."]
+        md.append("")
+    if "whole" in doc:
+        md += ["Commands that still hold every row (not in blocks yet), on the same tiled run:", "",
+               "| command | length | rows | wall | CPU | peak memory |", "|---|---|---:|---:|---:|---:|"]
+        for r in doc["whole"]["rows"]:
+            md.append(f"| {r['command']} | {r['minutes']} min | {r['rows']} | {r['seconds']:.1f} s | "
+                      f"{r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
+        md.append("")
+    return md
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
+    ap.add_argument("--parts", nargs="+", choices=("memory", "parallel", "whole"), default=["memory", "parallel", "whole"],
+                    help="parts to run; the others are kept from the last results file")
+    args = ap.parse_args(argv)
+    tmp = Path(tempfile.mkdtemp(prefix="dyngen-streaming-"))
+    log("generating the model ...")
+    from dyngen.description import load_robot
+    from dyngen.generate import generate
+
+    model = generate(load_robot(ROOT / "examples" / "lwr.yaml"), tmp / "gen").folder
+    path = RESULTS / "streaming.json"
+    doc = json.loads(path.read_text()) if path.is_file() else {}
+    doc = {k: v for k, v in doc.items() if k in ("memory", "parallel", "whole")}
+    if "memory" in args.parts:
+        doc["memory"] = part_memory(tmp, model, args.quick)
+    if "parallel" in args.parts:
+        doc["parallel"] = part_parallel(tmp, model, args.quick, args.repeat)
+    if "whole" in args.parts:
+        doc["whole"] = part_whole(tmp, model, args.quick)
+    doc.update(machine=machine(), load=os.getloadavg())
+    RESULTS.mkdir(exist_ok=True)
+    path.write_text(json.dumps(doc, indent=1) + "\n")
+    md = markdown(doc)
+    (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
+    print("\n".join(md))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

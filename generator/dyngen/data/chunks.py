@@ -1,0 +1,153 @@
+"""A recording read a block of rows at a time, for work whose memory must not grow with the
+recording's length (identification by accumulated least squares: streaming/).
+
+    for piece in chunks(path, dof):      # Recording objects of at most `rows` samples each
+        ...
+
+Every block goes through the checks read_recording applies to the whole file (header, numbers,
+finite and bounded values, increasing time, also across blocks) and fails with the same one
+line naming the file, line (row) and column, so the two readers accept and refuse the same
+files. CSV (plain or .gz) and Parquet are read in blocks; a ROS 2 bag is read whole.
+"""
+
+from __future__ import annotations
+
+import csv
+import gzip
+import io
+import warnings
+import zlib
+from itertools import islice
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..untrusted import MAX_CSV_BYTES, regular_file
+from . import columnar
+from .recording import (Recording, _check_time, _check_values, _numbers, as_recording, check_header, csv_line,
+                        read_recording)
+
+ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
+
+
+def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), rows: int = ROWS,
+           effort_topic: str | None = None):
+    """Recordings of consecutive blocks of at most `rows` samples (at least one block)."""
+    kind = columnar.format_of(path)
+    if kind == "rosbag":
+        yield read_recording(path, dof, require_torques, required, effort_topic)
+        return
+    blocks = _parquet_blocks(path, rows) if kind == "parquet" else _csv_blocks(path, rows)
+    name = Path(path).name
+    where_header = "columns" if kind == "parquet" else "line 1 (header)"
+    header = next(blocks)
+    columns = check_header(name, header, dof, require_torques, required, where_header)
+    last, total = None, 0
+    for start, data, where in blocks:
+        _check_values(name, header, data, lambda row: where(start + row))
+        t = data[:, columns["t"]]
+        joined = t if last is None else np.r_[last, t]
+        if joined.size >= 2:
+            _check_time(name, joined, lambda row: where(start + row - (last is not None)))
+        last = t[-1]
+        total += t.size
+        yield as_recording(name, columns, data, dof)
+    if total < 2:
+        _check_time(name, np.zeros(total), csv_line)  # the whole-file reader's message
+
+
+def _csv_blocks(path, rows: int):
+    """The header, then (first row, (k, columns) values, where) per block of CSV lines."""
+    path = Path(path)
+    name = path.name
+    regular_file(path, MAX_CSV_BYTES)
+    raw = open(path, "rb")
+    try:
+        binary = gzip.GzipFile(fileobj=raw) if path.suffix == ".gz" else raw
+        lines_of = io.BufferedReader(_Bounded(binary, name, MAX_CSV_BYTES))
+        try:
+            head = lines_of.readline()
+            header_line = _decoded([head], name, 1, 0, "utf-8-sig")
+            offset = len(head)
+            header = [h.strip() for h in next(csv.reader([header_line]), [])]
+            yield header
+            first, start = 2, 0
+            while True:
+                chunk = list(islice(lines_of, rows))
+                if not chunk:
+                    break
+                lines = _decoded(chunk, name, first, offset).splitlines(keepends=True)
+                offset += sum(len(x) for x in chunk)
+                if any(x.strip() for x in lines):
+                    data = _block(lines, name, header, first)
+                    yield start, data, csv_line
+                    start += data.shape[0]
+                first += len(chunk)
+            if start == 0:
+                raise InputError(name, "line 2", "no data rows after the header")
+        except (OSError, EOFError, zlib.error) as err:
+            raise InputError(name, "", f"not a readable gzip file ({err or 'truncated'})") from None
+    finally:
+        raw.close()
+
+
+def _decoded(chunk: list, name, first_line: int, offset: int, encoding: str = "utf-8") -> str:
+    """The lines (starting at line first_line, byte offset of the file) as text, or the whole-file
+    reader's InputError naming the line and byte that are not UTF-8."""
+    data = b"".join(chunk)
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as err:
+        line = first_line + data[:err.start].count(b"\n")
+        raise InputError(name, f"line {line}", f"not UTF-8 text (byte {offset + err.start}); save the file as UTF-8"
+                         ) from None
+
+
+def _block(lines, name, header, first_line) -> np.ndarray:
+    """The block's numbers (fast path numpy; else the slow pass naming line and column)."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            data = np.loadtxt(lines, delimiter=",", ndmin=2, dtype=float)
+        if data.ndim == 2 and data.shape[1] == len(header) and data.shape[0] > 0:
+            return data
+    except ValueError:
+        pass
+    return _numbers("".join(lines), name, header, first_line)
+
+
+class _Bounded(io.RawIOBase):
+    """A binary stream that refuses to deliver more than `limit` bytes (a small .gz may
+    unpack to gigabytes)."""
+
+    def __init__(self, inner, name, limit):
+        self.inner, self.name, self.left = inner, name, limit
+
+    def readable(self):
+        return True
+
+    def readinto(self, buffer):
+        data = self.inner.read(min(len(buffer), self.left + 1))
+        if len(data) > self.left:
+            raise InputError(self.name, "", f"file too large (at most {MAX_CSV_BYTES >> 20} MB)")
+        self.left -= len(data)
+        buffer[:len(data)] = data
+        return len(data)
+
+
+def _parquet_blocks(path, rows: int):
+    header, batches = columnar.parquet_batches(path, rows)
+    yield header
+    for start, data in batches:
+        yield start, data, columnar.parquet_row
+
+
+def whole(path, dof: int, **kw) -> Recording:
+    """The blocks joined: what read_recording returns (for tests of the two readers)."""
+    pieces = list(chunks(path, dof, **kw))
+    first = pieces[0]
+    cat = (lambda xs: None if xs[0] is None else np.concatenate(xs))
+    return Recording(first.name, cat([p.t for p in pieces]), cat([p.q for p in pieces]),
+                     cat([p.tau for p in pieces]), cat([p.qd for p in pieces]), cat([p.qdd for p in pieces]),
+                     {k: cat([p.extra[k] for p in pieces]) for k in first.extra})

@@ -1,0 +1,164 @@
+"""A ROS 2 bag's joint states as a Recording (through rosbags, the optional extra `formats`).
+
+The bag is its folder (metadata.yaml beside the .db3 or .mcap storage; a storage file given
+instead stands for its folder). Read from it: the sensor_msgs/JointState topic (the one whose
+name ends in joint_states, or the only one), its header stamps as t, positions as q, velocities
+as qd (when every message has them) and efforts as tau, the measured effort. With
+`effort_topic`, tau is the effort of that topic instead (a JointState's effort or a
+std_msgs/Float64MultiArray's data, such as ros2_control's effort command), the latest message
+at or before each joint state by the bag's clock (a controller holds its command); joint states
+before the first command are left out. Joints are in the order of the first message's names;
+every message must name the same joints.
+
+Messages are decoded by rosbags' CDR reader for these fixed message types only (the bag's own
+type definitions are not used): nothing in the bag is executed.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, shorten
+from ..untrusted import MAX_CSV_BYTES, regular_folder
+from .columnar import BAG_FILES, _module
+from .recording import Recording, check_header, from_columns
+
+JOINT_STATE = "sensor_msgs/msg/JointState"
+ARRAY = "std_msgs/msg/Float64MultiArray"
+
+
+def bag_folder(path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() in BAG_FILES and not path.is_dir():
+        return path.parent
+    return path
+
+
+def _stamp(message) -> float:
+    return message.header.stamp.sec + 1e-9 * message.header.stamp.nanosec
+
+
+def read_bag(path, dof: int, require_torques: bool = True, effort_topic: str | None = None) -> Recording:
+    folder = bag_folder(path)
+    name = folder.name
+    regular_folder(folder, MAX_CSV_BYTES)
+    rosbag2 = _module("rosbags.rosbag2", folder)
+    typesys = _module("rosbags.typesys", folder)
+    store = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
+    try:
+        with rosbag2.Reader(folder) as reader:
+            return _read(reader, store, name, dof, require_torques, effort_topic)
+    except InputError:
+        raise
+    except Exception as err:  # noqa: BLE001 -- a broken bag may raise anything from the library: one line
+        raise InputError(name, "", f"not a readable ROS 2 bag ({shorten(err, 200)})") from None
+
+
+def _topic(reader, name, wanted=None) -> object:
+    states = [c for c in reader.connections if c.msgtype == JOINT_STATE]
+    if wanted is not None:
+        found = [c for c in reader.connections if c.topic == wanted]
+        if not found:
+            raise InputError(name, f"topic {shorten(wanted)}", "not in the bag (topics: "
+                             f"{shorten(', '.join(sorted({c.topic for c in reader.connections})), 200)})")
+        if found[0].msgtype not in (JOINT_STATE, ARRAY):
+            raise InputError(name, f"topic {shorten(wanted)}", f"type {shorten(found[0].msgtype)}; expected "
+                             f"{JOINT_STATE} or {ARRAY}")
+        return found
+    named = [c for c in states if c.topic.endswith("joint_states")]
+    chosen = named or states
+    if not chosen:
+        raise InputError(name, "", f"no {JOINT_STATE} topic in the bag")
+    if len({c.topic for c in chosen}) > 1:
+        raise InputError(name, "", "several joint state topics (" + shorten(", ".join(sorted({c.topic for c in chosen})),
+                                                                        200) + "); keep one in the bag")
+    return chosen
+
+
+def _read(reader, store, name, dof, require_torques, effort_topic) -> Recording:
+    states = _topic(reader, name)
+    topic = states[0].topic
+    commands = _topic(reader, name, effort_topic) if effort_topic else None
+    joints, stamps, clock, q, qd, tau = None, [], [], [], [], []
+    for k, (connection, time, raw) in enumerate(reader.messages(connections=states)):
+        m = store.deserialize_cdr(raw, connection.msgtype)
+        where = f"message {k + 1} on {topic}"
+        names = [str(n) for n in m.name]
+        if joints is None:
+            joints = names
+            if len(joints) != dof:
+                raise InputError(name, where, f"the robot has {dof} joints but the message names {len(joints)} "
+                                 f"({shorten(', '.join(joints), 120)})")
+            if len(set(joints)) != len(joints):
+                raise InputError(name, where, "a joint is named twice")
+        order = _order(name, where, joints, names)
+        position, velocity, effort = (np.asarray(v, dtype=float) for v in (m.position, m.velocity, m.effort))
+        for label, values, needed in (("position", position, True), ("velocity", velocity, False),
+                                      ("effort", effort, require_torques and not effort_topic)):
+            if values.size not in ((0, len(names)) if not needed else (len(names),)):
+                raise InputError(name, where, f"{values.size} {label} values for {len(names)} joints")
+        stamps.append(_stamp(m))
+        clock.append(time)
+        q.append(position[order])
+        qd.append(velocity[order] if velocity.size else None)
+        tau.append(effort[order] if effort.size else None)
+    if not stamps:
+        raise InputError(name, f"topic {topic}", "no messages")
+    clock = np.asarray(clock)
+    keep = np.ones(len(stamps), dtype=bool)
+    if commands is not None:
+        tau, keep = _commanded(reader, store, name, commands, joints, clock)
+    elif any(x is None for x in tau):  # efforts are optional only when not required (checked above)
+        tau = None
+    velocities = None if any(x is None for x in qd) else np.vstack(qd)[keep]
+    header = ["t", *(f"q{j}" for j in range(1, dof + 1))]
+    blocks = [np.asarray(stamps)[keep, None] - stamps[0], np.vstack(q)[keep]]
+    if velocities is not None:
+        header += [f"qd{j}" for j in range(1, dof + 1)]
+        blocks.append(velocities)
+    if tau is not None:
+        header += [f"tau{j}" for j in range(1, dof + 1)]
+        blocks.append(np.vstack(tau) if isinstance(tau, list) else tau)
+    columns = check_header(name, header, dof, require_torques)
+    rows = np.flatnonzero(keep)
+    return from_columns(name, header, columns, np.hstack(blocks), dof,
+                        where=lambda row: f"message {rows[row] + 1} on {topic}")
+
+
+def _order(name, where, joints, names) -> list:
+    if names == joints:
+        return list(range(len(names)))
+    if sorted(names) != sorted(joints):
+        raise InputError(name, where, f"joints {shorten(', '.join(names), 120)}; the first message named "
+                         f"{shorten(', '.join(joints), 120)}")
+    return [names.index(j) for j in joints]
+
+
+def _commanded(reader, store, name, connections, joints, clock):
+    """(tau (kept states, N), keep): the latest command at or before each joint state."""
+    topic = connections[0].topic
+    times, values = [], []
+    for k, (connection, time, raw) in enumerate(reader.messages(connections=connections)):
+        m = store.deserialize_cdr(raw, connection.msgtype)
+        where = f"message {k + 1} on {topic}"
+        if connection.msgtype == ARRAY:
+            v = np.asarray(m.data, dtype=float)
+        else:
+            v = np.asarray(m.effort, dtype=float)[_order(name, where, joints, [str(n) for n in m.name])] \
+                if len(m.effort) == len(m.name) else np.zeros(0)
+        if v.size != len(joints):
+            raise InputError(name, where, f"{v.size} effort values for {len(joints)} joints")
+        times.append(time)
+        values.append(v)
+    if not times:
+        raise InputError(name, f"topic {topic}", "no messages")
+    times = np.asarray(times)
+    if np.any(np.diff(times) < 0):
+        raise InputError(name, f"topic {topic}", "messages out of order in the bag")
+    latest = np.searchsorted(times, clock, side="right") - 1
+    keep = latest >= 0
+    if not keep.any():
+        raise InputError(name, f"topic {topic}", "every command comes after the last joint state")
+    return np.vstack(values)[latest[keep]], keep

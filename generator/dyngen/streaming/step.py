@@ -1,0 +1,106 @@
+"""The per-recording step of identification by least squares: read one recording in blocks,
+evaluate the generated regressor on each block and fold its rows into per-joint triangular
+factors (triangular.py). What it returns is (c+1)^2 numbers per joint, whatever the
+recording's length; the step runs in a worker process or on a Dask worker (engine.py), so its
+task and result are plain picklable data.
+
+The blocks are conditioned on their own when that is what conditioning the whole recording
+would do: the recording has qd and qdd columns and the conditioning is automatic or no filter
+(then the signals are the recorded columns, data/conditioning.py). Otherwise (positions to
+differentiate, a low-pass filter: zero-phase filters and the automatic cutoff need the whole
+recording) the recording is read and conditioned whole, then folded in blocks: the same
+result, with memory of one recording.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .triangular import Triangular
+
+KINDS = ("full", "gravity", "inertia")
+
+
+@dataclass(frozen=True)
+class Task:
+    path: str
+    dof: int
+    kind: str  # "full", "gravity" or "inertia"
+    folder: str  # the generated, compiled model
+    conditioning: object  # data.Conditioning
+    required: tuple = ()  # the stacked inertia columns, for kind inertia
+    effort_topic: str | None = None
+    rows: int = 8192  # samples per block
+
+
+@dataclass
+class Sums:
+    name: str
+    factors: Triangular  # per joint (per stacked inertia entry for kind inertia)
+    samples: int
+    note: str  # what conditioning did
+    streamed: bool  # read in blocks (memory independent of the length) or whole
+    warnings: list = field(default_factory=list)
+
+
+@functools.lru_cache(maxsize=4)
+def _model(folder: str):
+    from ..runtime import load
+
+    return load(folder)
+
+
+def _local(first, conditioning) -> bool:
+    from ..data.conditioning import AUTO
+
+    return first.qd is not None and first.qdd is not None and not conditioning.differentiate \
+        and conditioning.cutoff in (AUTO, None)
+
+
+def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray, np.ndarray]:
+    """(Y (T, m, c), b (T, m)): the regressor rows and measurements of T samples, m rows each,
+    as identification.samples.stacked orders them."""
+    from ..identification.samples import REGRESSOR, stacked_inertia_columns
+
+    if kind == "gravity":
+        return model.batch(REGRESSOR[kind], q), tau
+    if kind == "inertia":
+        names = stacked_inertia_columns(model.manifest)
+        return model.batch(REGRESSOR[kind], q), np.column_stack([extra[c] for c in names])
+    return model.batch(REGRESSOR[kind], q, qd, qdd), tau
+
+
+def run(task: Task) -> Sums:
+    from ..data import condition, read_recording
+    from ..data.chunks import chunks
+
+    model = _model(task.folder)
+    need_tau = task.kind != "inertia"
+    blocks = chunks(task.path, task.dof, need_tau, task.required, task.rows, task.effort_topic)
+    first = next(blocks)
+    factors, samples = None, 0
+
+    def add(q, qd, qdd, tau, extra):
+        nonlocal factors, samples
+        Y, b = regressor_rows(model, task.kind, q, qd, qdd, tau, extra)
+        if factors is None:
+            factors = Triangular(Y.shape[-1], Y.shape[1])
+        factors.add(Y, b)
+        samples += q.shape[0]
+
+    if _local(first, task.conditioning):
+        for piece in itertools.chain([first], blocks):  # one block at a time, never all
+            add(piece.q, piece.qd, piece.qdd, piece.tau, piece.extra)
+        return Sums(first.name, factors, samples, "qd, qdd as recorded, no filter", True)
+    blocks.close()
+    s = condition(read_recording(task.path, task.dof, need_tau, task.required, task.effort_topic),
+                  task.conditioning)
+    for a in range(0, s.t.size, task.rows):
+        cut = slice(a, a + task.rows)
+        add(s.q[cut], s.qd[cut], s.qdd[cut], None if s.tau is None else s.tau[cut],
+            {k: v[cut] for k, v in s.extra.items()})
+    return Sums(s.name, factors, samples, s.note, False, list(s.warnings))

@@ -1,0 +1,93 @@
+"""Least squares accumulated block by block, per joint: memory independent of the row count.
+
+For joint j, the rows [A_j | b_j] of every block are folded into the triangular factor R_j of
+their QR decomposition (R_j^T R_j = [A_j b_j]^T [A_j b_j], the normal equations, but formed
+without squaring the condition number):
+
+    R_j <- triu(qr([R_j; A_block b_block]))
+
+R_j holds everything a least-squares fit over those rows needs: the singular values and right
+singular vectors of A_j (those of R_j's first c columns), U^T b (through R_j's last column) and
+the part of b no x can explain (the last diagonal entry). Factors of several recordings, joints
+or machines stack the same way, so the pooled fit, each recording's own fit and any fit's
+residual on any recording and joint come from these (c+1)^2 numbers. `fit` gives what
+identification.least_squares.fit gives for the stacked rows (the in-memory oracle, equal to
+rounding): values, standard deviations, condition numbers, unexcited coefficients.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..identification.least_squares import WEAK, Estimate
+
+
+def fold(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:
+    """The (c+1, c+1) factor of R's rows and `rows` (k, c+1) together."""
+    stacked = rows if R is None else np.vstack([R, rows])
+    if stacked.shape[0] < stacked.shape[1]:  # fewer rows than columns: keep them as they are
+        return stacked
+    return np.linalg.qr(stacked, mode="r")
+
+
+class Triangular:
+    """Per-joint factors of [A_j | b_j] and row counts, for c columns and `dof` joints."""
+
+    def __init__(self, columns: int, dof: int):
+        self.c, self.dof = columns, dof
+        self.R = [None] * dof
+        self.rows = np.zeros(dof, dtype=np.int64)
+
+    def add(self, Y: np.ndarray, b: np.ndarray) -> None:
+        """Y (T, dof, c) the regressor rows of T samples, b (T, dof) their measurements."""
+        for j in range(self.dof):
+            self.R[j] = fold(self.R[j], np.column_stack([Y[:, j, :], b[:, j]]))
+            self.rows[j] += b.shape[0]
+
+    def merged(self, other: "Triangular") -> "Triangular":
+        out = Triangular(self.c, self.dof)
+        for j in range(self.dof):
+            parts = [R for R in (self.R[j], other.R[j]) if R is not None]
+            out.R[j] = fold(None, np.vstack(parts)) if parts else None
+        out.rows = self.rows + other.rows
+        return out
+
+    def factor(self) -> np.ndarray:
+        """All joints' rows together: the (c+1, c+1) factor of the stacked [A | b]."""
+        return fold(None, np.vstack([self._full(j) for j in range(self.dof)]))
+
+    def _full(self, j) -> np.ndarray:
+        R = self.R[j]
+        if R is None:
+            return np.zeros((0, self.c + 1))
+        return R
+
+    def sse(self, x: np.ndarray) -> np.ndarray:
+        """(dof,): each joint's sum of squared residuals |b_j - A_j x|^2."""
+        v = np.r_[x, -1.0]
+        return np.array([float(np.sum((self._full(j) @ v) ** 2)) for j in range(self.dof)])
+
+
+def fit(R: np.ndarray, rows: int, names: list[str], weak: float = WEAK) -> Estimate:
+    """identification.least_squares.fit of the rows whose [A | b] factor is R."""
+    c = R.shape[1] - 1
+    A, b = R[:, :c], R[:, c]
+    norms = np.linalg.norm(A, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    U, sv, Vt = np.linalg.svd(A / scale, full_matrices=False)
+    strong = sv > weak * sv[0]
+    x_scaled = Vt[strong].T @ ((U[:, strong].T @ b) / sv[strong])
+    x = x_scaled / scale
+    sse = float(np.sum((R @ np.r_[x, -1.0]) ** 2))  # |b - A x|^2 over the original rows
+    dof = max(rows - int(strong.sum()), 1)
+    sigma2 = sse / dof
+    loading = (Vt[~strong] ** 2).sum(axis=0)
+    unexcited = [k for k in range(c) if loading[k] > 0.5 or norms[k] == 0]
+    cov_scaled = (Vt[strong].T / sv[strong] ** 2) @ Vt[strong]
+    std = np.sqrt(sigma2 * np.diag(cov_scaled)) / scale
+    std[unexcited] = np.inf
+    raw = np.linalg.svd(A, compute_uv=False)
+    condition = float(raw[0] / raw[-1]) if raw[-1] > 0 else float("inf")
+    scaled_condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    return Estimate(list(names), x, std, condition, scaled_condition, float(np.sqrt(sse / max(rows, 1))),
+                    rows, unexcited)
