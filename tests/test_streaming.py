@@ -200,6 +200,8 @@ def test_memory_does_not_grow_with_the_length(tmp_path):
     import tracemalloc
 
     from dyngen.streaming import step
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))  # the benchmark's tiler
     from long_recordings import write
 
     peaks = []

@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from ..options import add_arguments, resolve
-from ..errors import printable
 from ..progress import Progress
 from .recordings import add_data_options, compiled_model, read_all
 

@@ -29,6 +29,8 @@ def run_consistent(args, robot, model, signals, progress) -> int:
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
     # --- hook (sanity.py): values in their physical ranges, grid edges, the simple model on --select
+    import numpy as np
+
     from ..identification.sanity import check, table_lines
 
     prior = options.prior if options.prior is not None else (
