@@ -468,8 +468,10 @@ def casadi_table(arms: list, times: dict, irs: dict | None) -> list:
             if irs:
                 di, pi, ci, cbi = irs[(a["name"], f)]
                 best = min(ci, cbi)
-                missed = [f"CasADi by {GOAL_CASADI * di / best:.2f}x" if best / di < GOAL_CASADI else "",
-                          f"Pinocchio by {GOAL_PINOCCHIO * di / pi:.2f}x" if pi / di < GOAL_PINOCCHIO else ""]
+                missed = [f"CasADi {best / di:.2f}x of {GOAL_CASADI}x (dyngen needs {di - best / GOAL_CASADI:.0f} Ir less)"
+                          if best / di < GOAL_CASADI else "",
+                          f"Pinocchio {pi / di:.2f}x of {GOAL_PINOCCHIO}x (dyngen needs {di - pi / GOAL_PINOCCHIO:.0f} Ir less)"
+                          if pi / di < GOAL_PINOCCHIO else ""]
                 row += [f"{di:.0f}", f"{ci:.0f}", f"{cbi:.0f}", f"{pi:.0f}", f"{best / di:.2f}x", f"{pi / di:.2f}x",
                         ("missed: " + ", ".join(m for m in missed if m)) if any(missed) else "met"]
             rows.append(row)

@@ -85,6 +85,29 @@ def test_rnea_matches_pinocchio(built):
     assert worst < TOL
 
 
+def test_inverse_dynamics_over_base_coefficients(built):
+    """ID(q, qd, qdd, pi_full(p)) = rnea(q, qd, qdd, s(p)) = Pinocchio's rnea, and for coefficients
+    no parameters give (identified ones need not be consistent) ID(pi) = Y(q, qd, qdd) pi."""
+    rng = np.random.default_rng(6)
+    n = built.robot.dof
+    worst = {}
+    for label, p in parameter_sets(built).items():
+        s = built.c("standard_from_dynamic", p)
+        pi = built.c("pi_full", p)
+        arbitrary = rng.normal(size=pi.shape) * np.abs(pi).max()
+        for _ in range(N_STATES):
+            q, qd, qdd = random_state(built, rng)
+            tau = built.c("inverse_dynamics", q, qd, qdd, pi)
+            checks = {"rnea": (tau, built.c("rnea", q, qd, qdd, s)),
+                      "pinocchio": (tau, pin_arm.rnea(built.arm, p, q, qd, qdd)),
+                      "Y pi, any pi": (built.c("inverse_dynamics", q, qd, qdd, arbitrary),
+                                       built.c("regressor", q, qd, qdd) @ arbitrary),
+                      "gravity": (built.c("inverse_dynamics", q, np.zeros(n), np.zeros(n), pi), lag.gravity(built.arm, q, p))}
+            for name, (got, want) in checks.items():
+                worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+    assert all(err < TOL for err in worst.values()), worst
+
+
 @pytest.mark.parametrize("kind", ["gravity", "inertia", "full"])
 def test_base_count_is_numerical_rank_of_pinocchio_regressor(built, kind):
     """Minimal means minimal: the count equals the numerical rank, not just full column rank."""

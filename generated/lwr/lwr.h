@@ -20,18 +20,19 @@
  *
  * Operation counts (multiplications, additions, divisions, sin/cos):
  *   lwr_standard_from_dynamic    126 mul, 63 add, 0 div, 0 sin/cos
- *   lwr_pi_gravity               25 mul, 13 add, 0 div, 0 sin/cos
+ *   lwr_pi_gravity               19 mul, 13 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity_jacobian      0 mul, 2 add, 0 div, 0 sin/cos
- *   lwr_pi_inertia               133 mul, 102 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia               119 mul, 102 add, 0 div, 0 sin/cos
  *   lwr_pi_inertia_jacobian      123 mul, 35 add, 0 div, 0 sin/cos
- *   lwr_pi_full                  138 mul, 106 add, 0 div, 0 sin/cos
+ *   lwr_pi_full                  120 mul, 106 add, 0 div, 0 sin/cos
  *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
- *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 12 sin/cos
- *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 12 sin/cos
- *   lwr_regressor                696 mul, 420 add, 0 div, 12 sin/cos
- *   lwr_rnea                     375 mul, 368 add, 0 div, 12 sin/cos
- *   lwr_gravity                  108 mul, 72 add, 0 div, 12 sin/cos
- *   lwr_mass_matrix              781 mul, 584 add, 0 div, 12 sin/cos
+ *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 6 sin/cos
+ *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 6 sin/cos
+ *   lwr_regressor                696 mul, 420 add, 0 div, 6 sin/cos
+ *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
+ *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix              781 mul, 584 add, 0 div, 6 sin/cos
+ *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -52,6 +53,17 @@ typedef float lwr_real;
 typedef double lwr_real;
 #define LWR_SIN sin
 #define LWR_COS cos
+#endif
+/* sin and cos of one angle in one call: glibc's sincos (the generated sources define
+ * _GNU_SOURCE before including this header), else the two calls. */
+#if defined(__GLIBC__) && defined(_GNU_SOURCE)
+#ifdef LWR_USE_FLOAT
+#define LWR_SINCOS(x, s, c) sincosf((x), (s), (c))
+#else
+#define LWR_SINCOS(x, s, c) sincos((x), (s), (c))
+#endif
+#else
+#define LWR_SINCOS(x, s, c) ((void)(*(s) = LWR_SIN(x)), (void)(*(c) = LWR_COS(x)))
 #endif
 /* A constant in the working precision (folded by the compiler). */
 #define LWR_K(x) ((lwr_real)(x))
@@ -77,7 +89,7 @@ void lwr_standard_from_dynamic(const lwr_real *p, lwr_real *s);
 /* Base coefficients pi_gravity(p) of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [12]  pi_gravity (written)
- * 25 mul, 13 add, 0 div, 0 sin/cos
+ * 19 mul, 13 add, 0 div, 0 sin/cos
  */
 void lwr_pi_gravity(const lwr_real *p, lwr_real *pi);
 
@@ -91,7 +103,7 @@ void lwr_pi_gravity_jacobian(const lwr_real *p, lwr_real *J);
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [39]  pi_inertia (written)
- * 133 mul, 102 add, 0 div, 0 sin/cos
+ * 119 mul, 102 add, 0 div, 0 sin/cos
  */
 void lwr_pi_inertia(const lwr_real *p, lwr_real *pi);
 
@@ -105,7 +117,7 @@ void lwr_pi_inertia_jacobian(const lwr_real *p, lwr_real *J);
 /* Base coefficients pi_full(p) of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [43]  pi_full (written)
- * 138 mul, 106 add, 0 div, 0 sin/cos
+ * 120 mul, 106 add, 0 div, 0 sin/cos
  */
 void lwr_pi_full(const lwr_real *p, lwr_real *pi);
 
@@ -119,14 +131,14 @@ void lwr_pi_full_jacobian(const lwr_real *p, lwr_real *J);
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   q        [7]  joint positions [rad or m]
  *   Y        [7 x 12]  row-major (written)
- * 130 mul, 58 add, 0 div, 12 sin/cos
+ * 130 mul, 58 add, 0 div, 6 sin/cos
  */
 void lwr_regressor_gravity(const lwr_real *q, lwr_real *Y);
 
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body).
  *   q        [7]  joint positions [rad or m]
  *   Y        [28 x 39]  row-major (written)
- * 1383 mul, 757 add, 0 div, 12 sin/cos
+ * 1383 mul, 757 add, 0 div, 6 sin/cos
  */
 void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y);
 
@@ -135,7 +147,7 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y);
  *   qd       [7]  joint velocities
  *   qdd      [7]  joint accelerations
  *   Y        [7 x 43]  row-major (written)
- * 696 mul, 420 add, 0 div, 12 sin/cos
+ * 696 mul, 420 add, 0 div, 6 sin/cos
  */
 void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *Y);
 
@@ -145,7 +157,7 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
  *   qdd      [7]  joint accelerations
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   tau      [7]  joint torques/forces (written)
- * 375 mul, 368 add, 0 div, 12 sin/cos
+ * 299 mul, 339 add, 0 div, 6 sin/cos
  */
 void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *tau);
 
@@ -153,7 +165,7 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
  *   q        [7]  joint positions [rad or m]
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   g        [7]  gravity torques (written)
- * 108 mul, 72 add, 0 div, 12 sin/cos
+ * 66 mul, 51 add, 0 div, 6 sin/cos
  */
 void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
 
@@ -161,9 +173,19 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
  *   q        [7]  joint positions [rad or m]
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [7 x 7]  row-major, symmetric (written)
- * 781 mul, 584 add, 0 div, 12 sin/cos
+ * 781 mul, 584 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
+
+/* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qdd      [7]  joint accelerations
+ *   pi_full  [43]  base coefficients pi_full (e.g. identified; from p: pi_full())
+ *   tau      [7]  joint torques/forces (written)
+ * 293 mul, 301 add, 0 div, 6 sin/cos
+ */
+void lwr_inverse_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *pi_full, lwr_real *tau);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [35] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

@@ -757,9 +757,9 @@ static const double rnea_expected[N_STATES][7] = {
     { 1.7386532234570373, 27.346167648335772, 0.15553532125572447, -3.4038309868602843, 0.19518528148367612, -0.011334215939752118, -0.00197068511341263 },
 };
 static const double gravity_expected[N_STATES][7] = {
-    { 4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0 },
-    { 1.0331493317774011e-40, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0 },
-    { -1.463628220017985e-40, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0 },
+    { -4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0 },
+    { 0.0, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0 },
+    { -2.0089014784560578e-41, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0 },
 };
 static const double mass_matrix_expected[N_STATES][49] = {
     { 0.2930101972874403, -0.3853840413056096, 0.12285593020697558, 0.15891672479242305, 0.006270240597101434, -0.002434154876322384, 1.124143495952837e-05,
@@ -806,6 +806,7 @@ static lwr_real regressor_out[301];
 static lwr_real rnea_out[7];
 static lwr_real gravity_out[7];
 static lwr_real mass_matrix_out[49];
+static lwr_real inverse_dynamics_out[7];
 static lwr_real friction_out[7];
 static double got[3010], want[3010];
 
@@ -916,6 +917,10 @@ int main(void)
 
         lwr_mass_matrix(q, standard_from_dynamic_out, mass_matrix_out);
         failures += !compare("mass_matrix", k, mass_matrix_out, mass_matrix_expected[k], 49);
+        ++checks;
+
+        lwr_inverse_dynamics(q, qd, qdd, pi_full_out, inverse_dynamics_out);
+        failures += !compare("inverse_dynamics", k, inverse_dynamics_out, rnea_expected[k], 7);
         ++checks;
 
         lwr_friction(qd, f, friction_out);

@@ -22,16 +22,17 @@
  *   stanford_standard_from_dynamic 108 mul, 54 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity          14 mul, 9 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity_jacobian 0 mul, 1 add, 0 div, 0 sin/cos
- *   stanford_pi_inertia          104 mul, 80 add, 0 div, 0 sin/cos
+ *   stanford_pi_inertia          102 mul, 80 add, 0 div, 0 sin/cos
  *   stanford_pi_inertia_jacobian 110 mul, 31 add, 0 div, 0 sin/cos
  *   stanford_pi_full             100 mul, 78 add, 0 div, 0 sin/cos
  *   stanford_pi_full_jacobian    100 mul, 28 add, 0 div, 0 sin/cos
- *   stanford_regressor_gravity   59 mul, 23 add, 0 div, 8 sin/cos
- *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 8 sin/cos
- *   stanford_regressor           402 mul, 259 add, 0 div, 8 sin/cos
- *   stanford_rnea                311 mul, 314 add, 0 div, 8 sin/cos
- *   stanford_gravity             83 mul, 56 add, 0 div, 8 sin/cos
- *   stanford_mass_matrix         454 mul, 347 add, 0 div, 8 sin/cos
+ *   stanford_regressor_gravity   59 mul, 23 add, 0 div, 4 sin/cos
+ *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 4 sin/cos
+ *   stanford_regressor           402 mul, 259 add, 0 div, 4 sin/cos
+ *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
+ *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix         454 mul, 347 add, 0 div, 4 sin/cos
+ *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -52,6 +53,17 @@ typedef float stanford_real;
 typedef double stanford_real;
 #define STANFORD_SIN sin
 #define STANFORD_COS cos
+#endif
+/* sin and cos of one angle in one call: glibc's sincos (the generated sources define
+ * _GNU_SOURCE before including this header), else the two calls. */
+#if defined(__GLIBC__) && defined(_GNU_SOURCE)
+#ifdef STANFORD_USE_FLOAT
+#define STANFORD_SINCOS(x, s, c) sincosf((x), (s), (c))
+#else
+#define STANFORD_SINCOS(x, s, c) sincos((x), (s), (c))
+#endif
+#else
+#define STANFORD_SINCOS(x, s, c) ((void)(*(s) = STANFORD_SIN(x)), (void)(*(c) = STANFORD_COS(x)))
 #endif
 /* A constant in the working precision (folded by the compiler). */
 #define STANFORD_K(x) ((stanford_real)(x))
@@ -91,7 +103,7 @@ void stanford_pi_gravity_jacobian(const stanford_real *p, stanford_real *J);
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [60]  dynamic parameters, 10 per link
  *   pi       [31]  pi_inertia (written)
- * 104 mul, 80 add, 0 div, 0 sin/cos
+ * 102 mul, 80 add, 0 div, 0 sin/cos
  */
 void stanford_pi_inertia(const stanford_real *p, stanford_real *pi);
 
@@ -119,14 +131,14 @@ void stanford_pi_full_jacobian(const stanford_real *p, stanford_real *J);
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   q        [6]  joint positions [rad or m]
  *   Y        [6 x 9]  row-major (written)
- * 59 mul, 23 add, 0 div, 8 sin/cos
+ * 59 mul, 23 add, 0 div, 4 sin/cos
  */
 void stanford_regressor_gravity(const stanford_real *q, stanford_real *Y);
 
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body).
  *   q        [6]  joint positions [rad or m]
  *   Y        [21 x 31]  row-major (written)
- * 912 mul, 519 add, 0 div, 8 sin/cos
+ * 912 mul, 519 add, 0 div, 4 sin/cos
  */
 void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y);
 
@@ -135,7 +147,7 @@ void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y);
  *   qd       [6]  joint velocities
  *   qdd      [6]  joint accelerations
  *   Y        [6 x 33]  row-major (written)
- * 402 mul, 259 add, 0 div, 8 sin/cos
+ * 402 mul, 259 add, 0 div, 4 sin/cos
  */
 void stanford_regressor(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *Y);
 
@@ -145,7 +157,7 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
  *   qdd      [6]  joint accelerations
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   tau      [6]  joint torques/forces (written)
- * 311 mul, 314 add, 0 div, 8 sin/cos
+ * 237 mul, 270 add, 0 div, 4 sin/cos
  */
 void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *tau);
 
@@ -153,7 +165,7 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
  *   q        [6]  joint positions [rad or m]
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   g        [6]  gravity torques (written)
- * 83 mul, 56 add, 0 div, 8 sin/cos
+ * 46 mul, 34 add, 0 div, 4 sin/cos
  */
 void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_real *g);
 
@@ -161,9 +173,19 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
  *   q        [6]  joint positions [rad or m]
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [6 x 6]  row-major, symmetric (written)
- * 454 mul, 347 add, 0 div, 8 sin/cos
+ * 454 mul, 347 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
+
+/* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qdd      [6]  joint accelerations
+ *   pi_full  [33]  base coefficients pi_full (e.g. identified; from p: pi_full())
+ *   tau      [6]  joint torques/forces (written)
+ * 232 mul, 239 add, 0 div, 4 sin/cos
+ */
+void stanford_inverse_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *pi_full, stanford_real *tau);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [30] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

@@ -532,9 +532,9 @@ static const double rnea_expected[N_STATES][6] = {
     { 93.15795829795469, -394.5157463977943, 64.53839516811594, 1.2720452554610973, 9.31720909565781, 0.0002396305424168252 },
 };
 static const double gravity_expected[N_STATES][6] = {
-    { 1.8367099231598242e-40, 137.6296388821344, 55.70077951097528, 0.9905115140334522, -5.993299024795948, 0.0 },
-    { 0.0, 237.24767814354192, 20.01373106688138, -7.21503508487568, 0.766699737148648, 0.0 },
-    { 5.510129769479473e-40, -139.4051001728202, 46.44080468962962, -5.2248328584925785, 5.608472212105922, 0.0 },
+    { -9.183549615799121e-41, 137.6296388821344, 55.70077951097528, 0.9905115140334522, -5.993299024795948, 0.0 },
+    { 4.591774807899561e-41, 237.24767814354192, 20.01373106688138, -7.21503508487568, 0.766699737148648, 0.0 },
+    { 0.0, -139.4051001728202, 46.44080468962962, -5.2248328584925785, 5.608472212105922, 0.0 },
 };
 static const double mass_matrix_expected[N_STATES][36] = {
     { 53.26449125253937, 4.27000559412122, -0.5786595914504244, 0.41228267545553776, -0.28777797871356725, 0.00022132196813901486,
@@ -578,6 +578,7 @@ static stanford_real regressor_out[198];
 static stanford_real rnea_out[6];
 static stanford_real gravity_out[6];
 static stanford_real mass_matrix_out[36];
+static stanford_real inverse_dynamics_out[6];
 static stanford_real friction_out[6];
 static double got[1980], want[1980];
 
@@ -688,6 +689,10 @@ int main(void)
 
         stanford_mass_matrix(q, standard_from_dynamic_out, mass_matrix_out);
         failures += !compare("mass_matrix", k, mass_matrix_out, mass_matrix_expected[k], 36);
+        ++checks;
+
+        stanford_inverse_dynamics(q, qd, qdd, pi_full_out, inverse_dynamics_out);
+        failures += !compare("inverse_dynamics", k, inverse_dynamics_out, rnea_expected[k], 6);
         ++checks;
 
         stanford_friction(qd, f, friction_out);

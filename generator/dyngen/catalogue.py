@@ -39,6 +39,7 @@ ARGUMENTS = {
     "s": Argument(("parameters",), "standard parameters, 10 per link (docs/conventions.md)", "Parameters"),
     "gravity": Argument(("gravity_symbols",), "gravity symbols", "GravitySymbols"),  # only when gravity has symbols
     "f": Argument(("friction",), "per joint Fc, Fv, Fs, vs, eps", "Friction"),
+    "pi_full": Argument(("pi_full",), "base coefficients pi_full (e.g. identified; from p: pi_full())", "PiFull"),
 }
 
 
@@ -121,6 +122,11 @@ GRAVITY = Function(
 MASS_MATRIX = Function(
     "mass_matrix", "dynamics", "mass_matrix", ("q", "s"),
     Output("M", ("dof", "dof"), "row-major, symmetric", "MassMatrix"), "Inertia matrix M(q).", Check())
+INVERSE_DYNAMICS = Function(
+    "inverse_dynamics", "dynamics", "inverse_dynamics", ("q", "qd", "qdd", "pi_full", "gravity"),
+    Output("tau", ("dof",), "joint torques/forces", "Joints"),
+    "Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the "
+    "grouped parameters (for controllers that hold identified coefficients).", Check("rnea"))
 FRICTION = Function(
     "friction", "friction", "template", ("qd", "f"),
     Output("tau", ("dof",), "friction torques", "Joints"),
@@ -128,7 +134,7 @@ FRICTION = Function(
 
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
-             FRICTION)
+             INVERSE_DYNAMICS, FRICTION)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
 JACOBIANS = {"gravity": PI_GRAVITY_JACOBIAN, "inertia": PI_INERTIA_JACOBIAN, "full": PI_FULL_JACOBIAN}

@@ -115,7 +115,7 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
 def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
     """What the self-test calls and compares, one entry per catalogue function, in catalogue
     order (the functions of p alone first: their outputs feed the others)."""
-    arrays = {"s": "standard_from_dynamic_out"}  # an argument computed by another function
+    arrays = {"s": "standard_from_dynamic_out", "pi_full": "pi_full_out"}  # arguments computed by another function
 
     def size(shape):
         return math.prod(dims[d] for d in shape)
@@ -125,7 +125,8 @@ def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
         args = [arrays.get(a, a) for a in fn.arguments(has_gravity)] + [f"{fn.name}_out"]
         check = {"name": fn.name, "state": fn.state, "out": f"{fn.name}_out", "length": size(fn.output.shape),
                  "call": f"{prefix}_{fn.name}({', '.join(args)})", "expected": f"{BY_NAME[fn.expected].name}_expected",
-                 "label": fn.name, "times": None, "stacked": fn.check.stacked}
+                 "label": fn.name, "times": None, "stacked": fn.check.stacked,
+                 "own": not fn.check.expected}  # whether its expected values are its own (declared once)
         if fn.check.times:
             rows, cols = (dims[d] for d in fn.output.shape)
             check["times"] = {"out": f"{fn.check.times}_out", "rows": rows, "cols": cols}
