@@ -383,14 +383,25 @@ def timing(exe: Path, models: Path, states: int, batches: int, warmup: int) -> t
     return times, errors, (res.max_rss_mib, res.floor_kib / 1024)
 
 
+LIBM = re.compile(r"sysdeps/ieee754|fenv_private|libm\.so")  # callgrind_annotate lines of libm's sin/cos
+
+
 def callgrind_ir(exe: Path, models: Path, states: int, arm: str, function: str, side: str, calls: int,
-                 work: Path) -> int:
+                 work: Path) -> tuple[int, int]:
+    """(total Ir, Ir inside libm) of one run."""
     out = work / "callgrind" / f"{arm}.{function}.{side}.{calls}.out"
     run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(exe), "callgrind", str(models),
          str(states), arm, function, side, str(calls)])
+    libm = 0
+    if shutil.which("callgrind_annotate"):
+        listing = run(["callgrind_annotate", "--threshold=100", str(out)]).stdout
+        for line in listing.splitlines():
+            m = re.match(r"\s*([\d,]+)\s", line)
+            if m and LIBM.search(line):
+                libm += int(m.group(1).replace(",", ""))
     for line in out.read_text().splitlines():
         if line.startswith(("summary:", "totals:")):
-            return int(line.split()[1])
+            return int(line.split()[1]), libm
     raise SystemExit(f"no instruction total in {out}")
 
 
@@ -408,13 +419,15 @@ def callgrind_all(exe: Path, models: Path, states: int, arms: list, calls: int, 
     jobs += [(a["name"], f, side, calls) for a in arms for f in FUNCTIONS for side in sides_of(f)]
     with ThreadPoolExecutor(max_workers=max(1, min(2, os.cpu_count() or 1))) as pool:
         irs = dict(zip(jobs, pool.map(lambda j: callgrind_ir(exe, models, states, *j, work), jobs)))
-    out = {}
+    out, libm = {}, {}
     for a in arms:
-        base = irs[(a["name"], "rnea", "dyngen", 0)]
+        base, base_libm = irs[(a["name"], "rnea", "dyngen", 0)]
         for f in FUNCTIONS:
-            out[(a["name"], f)] = tuple((irs[(a["name"], f, side, calls)] - base) / calls
+            out[(a["name"], f)] = tuple((irs[(a["name"], f, side, calls)][0] - base) / calls
                                         if side in sides_of(f) else float("nan") for side in SIDES)
-    return out
+            libm[(a["name"], f)] = tuple((irs[(a["name"], f, side, calls)][1] - base_libm) / calls
+                                         if side in sides_of(f) else float("nan") for side in SIDES)
+    return out, libm
 
 
 # --- report -------------------------------------------------------------------------------
@@ -454,12 +467,13 @@ def table(arms: list, times: dict, irs: dict | None) -> list:
 GOAL_CASADI, GOAL_PINOCCHIO = 1.5, 3.0  # issue 24: fewer instructions than the better CasADi, Pinocchio
 
 
-def casadi_table(arms: list, times: dict, irs: dict | None) -> list:
+def casadi_table(arms: list, times: dict, irs: dict | None, libm: dict | None) -> list:
     """dyngen against both CasADi variants (and Pinocchio) on rnea, gravity and M."""
     head = ["arm", "function", "dyngen ns", "CasADi ns", "CasADi baked ns", "Pinocchio ns"]
     if irs:
         head += ["dyngen Ir", "CasADi Ir", "CasADi baked Ir", "Pinocchio Ir", "best CasADi / dyngen",
-                 "Pinocchio / dyngen", f"goals {GOAL_CASADI}x, {GOAL_PINOCCHIO}x"]
+                 "Pinocchio / dyngen", f"goals {GOAL_CASADI}x, {GOAL_PINOCCHIO}x",
+                 "libm Ir: dyngen / CasADi / baked", "best CasADi / dyngen without libm"]
     rows = [head]
     for a in arms:
         for f in CASADI_FUNCTIONS:
@@ -472,8 +486,11 @@ def casadi_table(arms: list, times: dict, irs: dict | None) -> list:
                           if best / di < GOAL_CASADI else "",
                           f"Pinocchio {pi / di:.2f}x of {GOAL_PINOCCHIO}x (dyngen needs {di - pi / GOAL_PINOCCHIO:.0f} Ir less)"
                           if pi / di < GOAL_PINOCCHIO else ""]
+                li = libm[(a["name"], f)]
+                own = min(ci - li[2], cbi - li[3]) / (di - li[0])
                 row += [f"{di:.0f}", f"{ci:.0f}", f"{cbi:.0f}", f"{pi:.0f}", f"{best / di:.2f}x", f"{pi / di:.2f}x",
-                        ("missed: " + ", ".join(m for m in missed if m)) if any(missed) else "met"]
+                        ("missed: " + ", ".join(m for m in missed if m)) if any(missed) else "met",
+                        f"{li[0]:.0f} / {li[2]:.0f} / {li[3]:.0f}", f"{own:.2f}x"]
             rows.append(row)
     return rows
 
@@ -524,12 +541,30 @@ def plain(rows: list) -> str:
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    work = Path(args.keep).resolve() if args.keep else Path(tempfile.mkdtemp(prefix="dyngen-bench-"))
-    try:
-        return bench(args, work)
-    finally:
-        if not args.keep:
-            shutil.rmtree(work, ignore_errors=True)
+    runs = [args]
+    if args.native:  # the same again with -march=native, into <output>_native.md, summarised in <output>
+        native = argparse.Namespace(**vars(args))
+        native.flags = args.flags + " -march=native"
+        native.output = str(Path(args.output).with_name(Path(args.output).stem + "_native.md")) if args.output else ""
+        native.keep = str(Path(args.keep) / "native") if args.keep else None
+        runs.append(native)
+    for run_args in runs:
+        work = Path(run_args.keep).resolve() if run_args.keep else Path(tempfile.mkdtemp(prefix="dyngen-bench-"))
+        try:
+            rc = bench(run_args, work)
+        finally:
+            if not run_args.keep:
+                shutil.rmtree(work, ignore_errors=True)
+        if rc:
+            return rc
+    if args.native and args.output:
+        main_md, native_md = Path(args.output), Path(runs[1].output)
+        text = native_md.read_text()
+        start = text.index("## dyngen vs CasADi-generated C")
+        main_md.write_text(main_md.read_text() + f"\n## The same with `{runs[1].flags}`\n\n"
+                           f"Written by the same command into {native_md.name}; its CasADi table:\n\n"
+                           + text[start:].split("\n", 2)[2])
+    return 0
 
 
 def parse_args(argv):
@@ -547,6 +582,9 @@ def parse_args(argv):
                     help="time the wheel's precompiled Pinocchio algorithms (libpinocchio_default, built by the "
                          "wheel's own compiler and flags) instead of compiling Pinocchio's headers with --flags")
     ap.add_argument("--rebuild", action="store_true", help="recompile the cached Pinocchio side")
+    ap.add_argument("--native", action="store_true",
+                    help="run again with --flags plus -march=native (results in <output>_native.md; its CasADi "
+                         "table appended to <output>)")
     ap.add_argument("--keep", metavar="DIR", help="build in DIR and keep it (default: a temporary folder)")
     ap.add_argument("--output", default=str(BENCH / "results" / "dynamics.md"),
                     help="markdown results file (default bench/results/dynamics.md); '' to skip")
@@ -584,9 +622,9 @@ def bench(args, work: Path) -> int:
     irs = None
     if args.callgrind:
         log(f"callgrind ({args.calls} calls per function and side, minus a 0-call baseline) ...")
-        irs = callgrind_all(exe, work / "models", args.states, arms, args.calls, work)
+        irs, libm = callgrind_all(exe, work / "models", args.states, arms, args.calls, work)
     rows = table(arms, times, irs)
-    cas_rows = casadi_table(arms, times, irs)
+    cas_rows = casadi_table(arms, times, irs, libm if irs else None)
 
     cc_v, cxx_v = compiler_version(cc), compiler_version(cxx)
     info = [
@@ -637,6 +675,10 @@ def bench(args, work: Path) -> int:
         "- CasADi: the body parameters are an input (Pinocchio's 10 per body); CasADi baked: the same with the "
         "parameters substituted as numbers before code generation (what an MPC user does); dyngen reads its "
         "standard parameters s",
+        "- libm Ir: the instructions each side spends inside libm's sin and cos (callgrind_annotate, lines of "
+        "glibc's math sources); dyngen evaluates sin and cos of each angle with its own polynomial sincos "
+        "(emission/c_code.py), the CasADi code calls libm's sin and cos. 'without libm' compares the rest: the "
+        "arithmetic of the recursion itself",
         "- agreement with Pinocchio (max relative error): " + "; ".join(
             f"{a['name']} " + ", ".join(f"{v} {f} {errors[(a['name'], f'{v}_{f}')]:.1e}"
                                         for v in ("casadi", "casadi_baked") for f in CASADI_FUNCTIONS)

@@ -80,7 +80,7 @@ def part_command(part: str, args) -> list | None:
     if part == "opcounts":
         return [*py, BENCH / "bench_opcounts.py", *arms]
     if part == "dynamics":
-        quick = ["--batches", "30"] if args.quick else ["--callgrind"]
+        quick = ["--batches", "30"] if args.quick else ["--callgrind", "--native"]
         if not args.quick and not shutil.which("valgrind"):
             log("warning: valgrind is not installed (DYNGEN_BENCH=1 bash scripts/setup.sh): no instruction counts")
             quick = []

@@ -11,9 +11,6 @@
  *   lwr_pi_full                  120 mul, 106 add, 0 div, 0 sin/cos
  *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
  */
-#ifndef _GNU_SOURCE
-#define _GNU_SOURCE /* sincos() in glibc's <math.h> */
-#endif
 #include "lwr.h"
 
 /* Standard parameters s from dynamic parameters p. */

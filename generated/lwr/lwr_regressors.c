@@ -7,9 +7,6 @@
  *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 6 sin/cos
  *   lwr_regressor                696 mul, 420 add, 0 div, 6 sin/cos
  */
-#ifndef _GNU_SOURCE
-#define _GNU_SOURCE /* sincos() in glibc's <math.h> */
-#endif
 #include "lwr.h"
 
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity. */

@@ -5,12 +5,9 @@
  *
  *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix         454 mul, 347 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix         340 mul, 268 add, 0 div, 4 sin/cos
  *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
  */
-#ifndef _GNU_SOURCE
-#define _GNU_SOURCE /* sincos() in glibc's <math.h> */
-#endif
 #include "stanford.h"
 
 /* Inverse dynamics tau = M(q) qdd + c(q, qd) + g(q), recursive Newton-Euler. */
@@ -337,387 +334,358 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     STANFORD_SINCOS(q[4], &s5, &c5);
     stanford_real s6, c6;
     STANFORD_SINCOS(q[5], &s6, &c6);
+    /* base coefficients pi_inertia = K s */
+    const stanford_real x0 = STANFORD_K(0.023716)*s[10];
+    const stanford_real x1 = STANFORD_K(0.308)*s[12];
+    const stanford_real x2 = s[7] + s[19] + s[29] + x0 + x1;
+    const stanford_real x3 = -s[15] + s[25];
+    const stanford_real x4 = STANFORD_K(500.0/77.0)*x3;
+    const stanford_real x5 = s[11] + x4;
+    const stanford_real x6 = s[26] - s[18];
+    const stanford_real x7 = STANFORD_K(500.0/77.0)*x6;
+    const stanford_real x8 = s[13] + x7;
+    const stanford_real x9 = s[14] + s[27] - s[19] - s[29] + s[39];
+    const stanford_real x10 = s[16] + s[28];
+    const stanford_real x11 = s[24] + s[17] + s[39];
+    const stanford_real x12 = s[20] + s[30] + s[40] + s[50];
+    const stanford_real x13 = -s[32] + s[23];
+    const stanford_real x14 = s[42] + s[33];
+    const stanford_real x15 = s[34] - s[39] + s[49];
+    const stanford_real x16 = s[37] + s[49];
+    const stanford_real x17 = STANFORD_K(0.263)*s[50];
+    const stanford_real x18 = s[43] + s[53] + x17;
+    const stanford_real x19 = STANFORD_K(0.069169)*s[50];
+    const stanford_real x20 = STANFORD_K(0.526)*s[53];
+    const stanford_real x21 = s[44] + s[57] - s[49] + x19 + x20;
+    const stanford_real x22 = s[47] + s[57] + x19 + x20;
+    const stanford_real x23 = s[54] - s[57];
     /* link 2: velocities and accelerations */
-    const stanford_real x0 = -STANFORD_K(0.154)*c2;
-    const stanford_real x1 = -STANFORD_K(0.154)*s2;
+    const stanford_real x24 = -STANFORD_K(0.154)*c2;
+    const stanford_real x25 = -STANFORD_K(0.154)*s2;
     /* link 3: velocities and accelerations */
-    const stanford_real x2 = -q[2]*s2;
+    const stanford_real x26 = -q[2]*s2;
     /* link 4: velocities and accelerations */
-    const stanford_real x3 = -s2*s4;
-    const stanford_real x4 = -c4*s2;
-    const stanford_real x5 = c4*x2 + s4*x0;
-    const stanford_real x6 = c4*x0 - s4*x2;
+    const stanford_real x27 = -s2*s4;
+    const stanford_real x28 = -c4*s2;
+    const stanford_real x29 = c4*x26 + s4*x24;
+    const stanford_real x30 = c4*x24 - s4*x26;
     /* link 5: velocities and accelerations */
-    const stanford_real x7 = -c2*s5 + c5*x3;
-    const stanford_real x8 = c2*c5 + s5*x3;
-    const stanford_real x9 = c5*x5 - s5*x1;
-    const stanford_real x10 = c5*x1 + s5*x5;
+    const stanford_real x31 = -c2*s5 + c5*x27;
+    const stanford_real x32 = c2*c5 + s5*x27;
+    const stanford_real x33 = c5*x29 - s5*x25;
+    const stanford_real x34 = c5*x25 + s5*x29;
     /* link 6: velocities and accelerations */
-    const stanford_real x11 = c6*x7 + s6*x4;
-    const stanford_real x12 = c6*x4 - s6*x7;
-    const stanford_real x13 = c6*x9 + s6*x6;
-    const stanford_real x14 = c6*x6 - s6*x9;
-    const stanford_real x15 = STANFORD_K(0.263)*x12 + x13;
-    const stanford_real x16 = -STANFORD_K(0.263)*x11 + x14;
+    const stanford_real x35 = c6*x31 + s6*x28;
+    const stanford_real x36 = c6*x28 - s6*x31;
+    const stanford_real x37 = c6*x33 + s6*x30;
+    const stanford_real x38 = c6*x30 - s6*x33;
+    const stanford_real x39 = STANFORD_K(0.263)*x36 + x37;
+    const stanford_real x40 = -STANFORD_K(0.263)*x35 + x38;
     /* link 2: link wrench */
-    const stanford_real x17 = -c2*s[12] + s[10]*x0;
-    const stanford_real x18 = s[10]*x1 - s[12]*s2;
-    const stanford_real x19 = -s[14]*s2 + s[16]*c2 + s[12]*x1;
-    const stanford_real x20 = -s[16]*s2 + s[19]*c2 - s[12]*x0;
+    const stanford_real x41 = c2*x10 - s2*x9;
+    const stanford_real x42 = -s2*x10;
     /* link 3: link wrench */
-    const stanford_real x21 = -c2*s[22] + s[20]*x2 - s[23]*s2;
-    const stanford_real x22 = c2*s[21] + s[20]*x0;
-    const stanford_real x23 = s[20]*x1 + s[21]*s2;
-    const stanford_real x24 = -s[27]*s2 + s[28]*c2 - s[21]*x1 + s[23]*x2;
-    const stanford_real x25 = -s[28]*s2 + s[29]*c2 + s[21]*x0 - s[22]*x2;
+    const stanford_real x43 = -c2*s[22] - s2*x13 + x12*x26;
+    const stanford_real x44 = c2*s[21] + x12*x24;
+    const stanford_real x45 = s[21]*s2 + x12*x25;
+    const stanford_real x46 = -s[21]*x25 + x13*x26;
+    const stanford_real x47 = s[21]*x24 - s[22]*x26;
     /* link 4: link wrench */
-    const stanford_real x26 = -c2*s[33] + s[30]*x5 - s[32]*x4;
-    const stanford_real x27 = -s[30]*x1 + s[31]*x4 - s[33]*x3;
-    const stanford_real x28 = c2*s[31] + s[30]*x6 + s[32]*x3;
-    const stanford_real x29 = s[34]*x3 - s[35]*c2 + s[36]*x4 + s[32]*x6 + s[33]*x1;
-    const stanford_real x30 = s[35]*x3 - s[37]*c2 + s[38]*x4 - s[31]*x6 + s[33]*x5;
-    const stanford_real x31 = s[36]*x3 - s[38]*c2 + s[39]*x4 - s[31]*x1 - s[32]*x5;
+    const stanford_real x48 = -c2*x14;
+    const stanford_real x49 = s[31]*x28 - x14*x27;
+    const stanford_real x50 = c2*s[31];
+    const stanford_real x51 = -s[35]*c2 + s[36]*x28 + x14*x25 + x15*x27;
+    const stanford_real x52 = s[35]*x27 + s[38]*x28 - c2*x16 - s[31]*x30 + x14*x29;
+    const stanford_real x53 = s[36]*x27 - s[38]*c2 - s[31]*x25;
     /* link 5: link wrench */
-    const stanford_real x32 = s[40]*x9 - s[42]*x8 + s[43]*x4;
-    const stanford_real x33 = s[40]*x6 + s[41]*x8 - s[43]*x7;
-    const stanford_real x34 = s[40]*x10 - s[41]*x4 + s[42]*x7;
-    const stanford_real x35 = s[44]*x7 + s[45]*x4 + s[46]*x8 + s[42]*x10 - s[43]*x6;
-    const stanford_real x36 = s[45]*x7 + s[47]*x4 + s[48]*x8 - s[41]*x10 + s[43]*x9;
-    const stanford_real x37 = s[46]*x7 + s[48]*x4 + s[49]*x8 + s[41]*x6 - s[42]*x9;
+    const stanford_real x54 = x18*x28;
+    const stanford_real x55 = s[41]*x32 - x18*x31;
+    const stanford_real x56 = -s[41]*x28;
+    const stanford_real x57 = s[45]*x28 + s[46]*x32 - x18*x30 + x21*x31;
+    const stanford_real x58 = s[45]*x31 + s[48]*x32 - s[41]*x34 + x18*x33 + x22*x28;
+    const stanford_real x59 = s[46]*x31 + s[48]*x28 + s[41]*x30;
     /* link 6: link wrench */
-    const stanford_real x38 = s[50]*x15 - s[52]*x8 + s[53]*x12;
-    const stanford_real x39 = s[50]*x16 + s[51]*x8 - s[53]*x11;
-    const stanford_real x40 = s[50]*x10 - s[51]*x12 + s[52]*x11;
-    const stanford_real x41 = s[54]*x11 + s[55]*x12 + s[56]*x8 + s[52]*x10 - s[53]*x16;
-    const stanford_real x42 = s[55]*x11 + s[57]*x12 + s[58]*x8 - s[51]*x10 + s[53]*x15;
-    const stanford_real x43 = s[56]*x11 + s[58]*x12 + s[59]*x8 + s[51]*x16 - s[52]*x15;
+    const stanford_real x60 = -s[52]*x32;
+    const stanford_real x61 = s[51]*x32;
+    const stanford_real x62 = -s[51]*x36 + s[52]*x35;
+    const stanford_real x63 = s[55]*x36 + s[56]*x32 + s[52]*x34 + x23*x35;
+    const stanford_real x64 = s[55]*x35 + s[58]*x32 - s[51]*x34;
+    const stanford_real x65 = s[56]*x35 + s[58]*x36 + s[59]*x32 + s[51]*x40 - s[52]*x39;
     /* link 6: forces */
-    const stanford_real x44 = -STANFORD_K(0.263)*x39 + x41;
-    const stanford_real x45 = STANFORD_K(0.263)*x38 + x42;
-    const stanford_real x46 = c6*x38 - s6*x39;
-    const stanford_real x47 = c6*x39 + s6*x38;
-    const stanford_real x48 = c6*x44 - s6*x45;
-    const stanford_real x49 = c6*x45 + s6*x44;
+    const stanford_real x66 = -STANFORD_K(0.263)*x61 + x63;
+    const stanford_real x67 = STANFORD_K(0.263)*x60 + x64;
+    const stanford_real x68 = c6*x60 - s6*x61;
+    const stanford_real x69 = c6*x61 + s6*x60;
+    const stanford_real x70 = c6*x66 - s6*x67;
+    const stanford_real x71 = c6*x67 + s6*x66;
     /* link 5: forces */
-    const stanford_real x50 = x32 + x46;
-    const stanford_real x51 = x33 + x47;
-    const stanford_real x52 = x34 + x40;
-    const stanford_real x53 = x35 + x48;
-    const stanford_real x54 = x36 + x49;
-    const stanford_real x55 = x37 + x43;
-    const stanford_real x56 = c5*x50 + s5*x52;
-    const stanford_real x57 = -c5*x52 + s5*x50;
-    const stanford_real x58 = c5*x53 + s5*x55;
-    const stanford_real x59 = -c5*x55 + s5*x53;
+    const stanford_real x72 = x54 + x68;
+    const stanford_real x73 = x55 + x69;
+    const stanford_real x74 = x56 + x62;
+    const stanford_real x75 = x57 + x70;
+    const stanford_real x76 = x58 + x71;
+    const stanford_real x77 = x59 + x65;
+    const stanford_real x78 = c5*x72 + s5*x74;
+    const stanford_real x79 = -c5*x74 + s5*x72;
+    const stanford_real x80 = c5*x75 + s5*x77;
+    const stanford_real x81 = -c5*x77 + s5*x75;
     /* link 4: forces */
-    const stanford_real x60 = x26 + x56;
-    const stanford_real x61 = x27 + x57;
-    const stanford_real x62 = x28 + x51;
-    const stanford_real x63 = x29 + x58;
-    const stanford_real x64 = x30 + x59;
-    const stanford_real x65 = x31 + x54;
-    const stanford_real x66 = c4*x60 - s4*x62;
-    const stanford_real x67 = c4*x62 + s4*x60;
-    const stanford_real x68 = c4*x65 + s4*x63;
+    const stanford_real x82 = x48 + x78;
+    const stanford_real x83 = x49 + x79;
+    const stanford_real x84 = x50 + x73;
+    const stanford_real x85 = x51 + x80;
+    const stanford_real x86 = x52 + x81;
+    const stanford_real x87 = x53 + x76;
+    const stanford_real x88 = c4*x82 - s4*x84;
+    const stanford_real x89 = c4*x84 + s4*x82;
+    const stanford_real x90 = c4*x87 + s4*x85;
     /* link 3: forces */
-    const stanford_real x69 = x21 + x66;
-    const stanford_real x70 = x22 + x67;
-    const stanford_real x71 = x23 - x61;
-    const stanford_real x72 = x24 + x68;
-    const stanford_real x73 = x25 - x64;
-    const stanford_real x74 = q[2]*x69 + x72;
+    const stanford_real x91 = x43 + x88;
+    const stanford_real x92 = x44 + x89;
+    const stanford_real x93 = x45 - x83;
+    const stanford_real x94 = x46 + x90;
+    const stanford_real x95 = x47 - x86;
+    const stanford_real x96 = q[2]*x91 + x94;
     /* link 2: forces */
-    const stanford_real x75 = x17 + x70;
-    const stanford_real x76 = x18 + x71;
-    const stanford_real x77 = x19 + x74;
-    const stanford_real x78 = x20 + x73;
-    const stanford_real x79 = STANFORD_K(0.154)*x76 + x77;
-    const stanford_real x80 = -STANFORD_K(0.154)*x75 + x78;
-    const stanford_real x81 = -c2*x80 + s2*x79;
+    const stanford_real x97 = x96 + x41;
+    const stanford_real x98 = x95 + x42;
+    const stanford_real x99 = x97 + STANFORD_K(0.154)*x93;
+    const stanford_real x100 = x98 - STANFORD_K(0.154)*x92;
+    const stanford_real x101 = -c2*x100 + s2*x99;
     /* link 1: forces */
-    const stanford_real x82 = -s[7] + x81;
+    const stanford_real x102 = x101 - x2;
     /* link 4: velocities and accelerations */
-    const stanford_real x83 = q[2]*s4;
-    const stanford_real x84 = c4*q[2];
+    const stanford_real x103 = q[2]*s4;
+    const stanford_real x104 = c4*q[2];
     /* link 5: velocities and accelerations */
-    const stanford_real x85 = -c4*c5;
-    const stanford_real x86 = -c4*s5;
-    const stanford_real x87 = c5*x83;
-    const stanford_real x88 = s5*x83;
+    const stanford_real x105 = -c4*c5;
+    const stanford_real x106 = -c4*s5;
+    const stanford_real x107 = c5*x103;
+    const stanford_real x108 = s5*x103;
     /* link 6: velocities and accelerations */
-    const stanford_real x89 = c6*x85 + s4*s6;
-    const stanford_real x90 = c6*s4 - s6*x85;
-    const stanford_real x91 = c6*x87 + s6*x84;
-    const stanford_real x92 = c6*x84 - s6*x87;
-    const stanford_real x93 = STANFORD_K(0.263)*x90 + x91;
-    const stanford_real x94 = -STANFORD_K(0.263)*x89 + x92;
+    const stanford_real x109 = c6*x105 + s4*s6;
+    const stanford_real x110 = c6*s4 - s6*x105;
+    const stanford_real x111 = c6*x107 + s6*x104;
+    const stanford_real x112 = c6*x104 - s6*x107;
+    const stanford_real x113 = STANFORD_K(0.263)*x110 + x111;
+    const stanford_real x114 = -STANFORD_K(0.263)*x109 + x112;
     /* link 3: link wrench */
-    const stanford_real x95 = s[20]*q[2] + s[23];
-    const stanford_real x96 = -s[24] - s[23]*q[2];
-    const stanford_real x97 = -s[26] + s[21]*q[2];
+    const stanford_real x115 = q[2]*x12 + x13;
+    const stanford_real x116 = -q[2]*x13;
+    const stanford_real x117 = s[21]*q[2];
     /* link 4: link wrench */
-    const stanford_real x98 = s[30]*x83 - s[32]*s4;
-    const stanford_real x99 = c4*s[33] + s[31]*s4;
-    const stanford_real x100 = -c4*s[32] + s[30]*x84;
-    const stanford_real x101 = -s[34]*c4 + s[36]*s4 + s[32]*x84;
-    const stanford_real x102 = -s[35]*c4 + s[38]*s4 - s[31]*x84 + s[33]*x83;
-    const stanford_real x103 = -s[36]*c4 + s[39]*s4 - s[32]*x83;
+    const stanford_real x118 = c4*x14 + s[31]*s4;
+    const stanford_real x119 = s[36]*s4 - c4*x15;
+    const stanford_real x120 = -s[35]*c4 + s[38]*s4 - s[31]*x104 + x103*x14;
+    const stanford_real x121 = -s[36]*c4;
     /* link 5: link wrench */
-    const stanford_real x104 = s[40]*x87 - s[42]*x86 + s[43]*s4;
-    const stanford_real x105 = s[40]*x84 + s[41]*x86 - s[43]*x85;
-    const stanford_real x106 = s[40]*x88 - s[41]*s4 + s[42]*x85;
-    const stanford_real x107 = s[44]*x85 + s[45]*s4 + s[46]*x86 + s[42]*x88 - s[43]*x84;
-    const stanford_real x108 = s[45]*x85 + s[47]*s4 + s[48]*x86 - s[41]*x88 + s[43]*x87;
-    const stanford_real x109 = s[46]*x85 + s[48]*s4 + s[49]*x86 + s[41]*x84 - s[42]*x87;
+    const stanford_real x122 = s4*x18;
+    const stanford_real x123 = s[41]*x106 - x105*x18;
+    const stanford_real x124 = -s[41]*s4;
+    const stanford_real x125 = s[45]*s4 + s[46]*x106 - x104*x18 + x105*x21;
+    const stanford_real x126 = s[45]*x105 + s[48]*x106 - s[41]*x108 + s4*x22 + x107*x18;
+    const stanford_real x127 = s[46]*x105 + s[48]*s4 + s[41]*x104;
     /* link 6: link wrench */
-    const stanford_real x110 = s[50]*x93 - s[52]*x86 + s[53]*x90;
-    const stanford_real x111 = s[50]*x94 + s[51]*x86 - s[53]*x89;
-    const stanford_real x112 = s[50]*x88 - s[51]*x90 + s[52]*x89;
-    const stanford_real x113 = s[54]*x89 + s[55]*x90 + s[56]*x86 + s[52]*x88 - s[53]*x94;
-    const stanford_real x114 = s[55]*x89 + s[57]*x90 + s[58]*x86 - s[51]*x88 + s[53]*x93;
-    const stanford_real x115 = s[56]*x89 + s[58]*x90 + s[59]*x86 + s[51]*x94 - s[52]*x93;
+    const stanford_real x128 = -s[52]*x106;
+    const stanford_real x129 = s[51]*x106;
+    const stanford_real x130 = -s[51]*x110 + s[52]*x109;
+    const stanford_real x131 = s[55]*x110 + s[56]*x106 + s[52]*x108 + x109*x23;
+    const stanford_real x132 = s[55]*x109 + s[58]*x106 - s[51]*x108;
+    const stanford_real x133 = s[56]*x109 + s[58]*x110 + s[59]*x106 + s[51]*x114 - s[52]*x113;
     /* link 6: forces */
-    const stanford_real x116 = -STANFORD_K(0.263)*x111 + x113;
-    const stanford_real x117 = STANFORD_K(0.263)*x110 + x114;
-    const stanford_real x118 = c6*x110 - s6*x111;
-    const stanford_real x119 = c6*x111 + s6*x110;
-    const stanford_real x120 = c6*x116 - s6*x117;
-    const stanford_real x121 = c6*x117 + s6*x116;
+    const stanford_real x134 = -STANFORD_K(0.263)*x129 + x131;
+    const stanford_real x135 = STANFORD_K(0.263)*x128 + x132;
+    const stanford_real x136 = c6*x128 - s6*x129;
+    const stanford_real x137 = c6*x129 + s6*x128;
+    const stanford_real x138 = c6*x134 - s6*x135;
+    const stanford_real x139 = c6*x135 + s6*x134;
     /* link 5: forces */
-    const stanford_real x122 = x104 + x118;
-    const stanford_real x123 = x105 + x119;
-    const stanford_real x124 = x106 + x112;
-    const stanford_real x125 = x107 + x120;
-    const stanford_real x126 = x108 + x121;
-    const stanford_real x127 = x109 + x115;
-    const stanford_real x128 = c5*x122 + s5*x124;
-    const stanford_real x129 = -c5*x124 + s5*x122;
-    const stanford_real x130 = c5*x125 + s5*x127;
-    const stanford_real x131 = -c5*x127 + s5*x125;
+    const stanford_real x140 = x122 + x136;
+    const stanford_real x141 = x123 + x137;
+    const stanford_real x142 = x124 + x130;
+    const stanford_real x143 = x125 + x138;
+    const stanford_real x144 = x126 + x139;
+    const stanford_real x145 = x127 + x133;
+    const stanford_real x146 = c5*x140 + s5*x142;
+    const stanford_real x147 = -c5*x142 + s5*x140;
+    const stanford_real x148 = c5*x143 + s5*x145;
+    const stanford_real x149 = -c5*x145 + s5*x143;
     /* link 4: forces */
-    const stanford_real x132 = x98 + x128;
-    const stanford_real x133 = x99 + x129;
-    const stanford_real x134 = x100 + x123;
-    const stanford_real x135 = x101 + x130;
-    const stanford_real x136 = x102 + x131;
-    const stanford_real x137 = x103 + x126;
-    const stanford_real x138 = c4*x132 - s4*x134;
-    const stanford_real x139 = c4*x134 + s4*x132;
-    const stanford_real x140 = c4*x135 - s4*x137;
-    const stanford_real x141 = c4*x137 + s4*x135;
+    const stanford_real x150 = x118 + x147;
+    const stanford_real x151 = x119 + x148;
+    const stanford_real x152 = x120 + x149;
+    const stanford_real x153 = x121 + x144;
+    const stanford_real x154 = c4*x146 - s4*x141;
+    const stanford_real x155 = c4*x141 + s4*x146;
+    const stanford_real x156 = c4*x151 - s4*x153;
+    const stanford_real x157 = c4*x153 + s4*x151;
     /* link 3: forces */
-    const stanford_real x142 = x95 + x139;
-    const stanford_real x143 = -s[22] - x133;
-    const stanford_real x144 = x96 + x140;
-    const stanford_real x145 = -s[25] + x141;
-    const stanford_real x146 = x97 - x136;
-    const stanford_real x147 = -q[2]*x142 + x144;
-    const stanford_real x148 = q[2]*x138 + x145;
+    const stanford_real x158 = x115 + x155;
+    const stanford_real x159 = -s[22] - x150;
+    const stanford_real x160 = x116 + x156;
+    const stanford_real x161 = x117 - x152;
+    const stanford_real x162 = -q[2]*x158 + x160;
+    const stanford_real x163 = q[2]*x154 + x157;
     /* link 2: forces */
-    const stanford_real x149 = s[13] + x142;
-    const stanford_real x150 = -s[11] + x143;
-    const stanford_real x151 = s[15] + x148;
-    const stanford_real x152 = s[17] - x147;
-    const stanford_real x153 = s[18] + x146;
-    const stanford_real x154 = STANFORD_K(0.154)*x150 + x151;
-    const stanford_real x155 = -STANFORD_K(0.154)*x149 + x153;
-    const stanford_real x156 = -c2*x155 + s2*x154;
+    const stanford_real x164 = x158 + x8;
+    const stanford_real x165 = x159 - x5;
+    const stanford_real x166 = x11 - x162;
+    const stanford_real x167 = x163 + STANFORD_K(0.154)*x165;
+    const stanford_real x168 = x161 - STANFORD_K(0.154)*x164;
+    const stanford_real x169 = -c2*x168 + s2*x167;
     /* link 6: velocities and accelerations */
-    const stanford_real x157 = -c6*s5;
-    const stanford_real x158 = s5*s6;
+    const stanford_real x170 = -c6*s5;
+    const stanford_real x171 = s5*s6;
     /* link 5: link wrench */
-    const stanford_real x159 = -s[40]*s5;
-    const stanford_real x160 = c5*s[40];
-    const stanford_real x161 = c5*s[42];
-    const stanford_real x162 = -c5*s[41] - s[43]*s5;
-    const stanford_real x163 = s[42]*s5;
+    const stanford_real x172 = -c5*s[41] - s5*x18;
     /* link 6: link wrench */
-    const stanford_real x164 = s[50]*x157;
-    const stanford_real x165 = s[50]*x158;
-    const stanford_real x166 = c5*s[50];
-    const stanford_real x167 = c5*s[52] - s[53]*x158;
-    const stanford_real x168 = -c5*s[51] + s[53]*x157;
-    const stanford_real x169 = s[51]*x158 - s[52]*x157;
+    const stanford_real x173 = c5*s[52];
+    const stanford_real x174 = -c5*s[51];
+    const stanford_real x175 = s[51]*x171 - s[52]*x170;
     /* link 6: forces */
-    const stanford_real x170 = -STANFORD_K(0.263)*x165 + x167;
-    const stanford_real x171 = STANFORD_K(0.263)*x164 + x168;
-    const stanford_real x172 = c6*x164 - s6*x165;
-    const stanford_real x173 = c6*x165 + s6*x164;
-    const stanford_real x174 = c6*x170 - s6*x171;
-    const stanford_real x175 = c6*x171 + s6*x170;
+    const stanford_real x176 = c6*x173 - s6*x174;
+    const stanford_real x177 = c6*x174 + s6*x173;
     /* link 5: forces */
-    const stanford_real x176 = x159 + x172;
-    const stanford_real x177 = x160 + x166;
-    const stanford_real x178 = x161 + x174;
-    const stanford_real x179 = x162 + x175;
-    const stanford_real x180 = x163 + x169;
-    const stanford_real x181 = c5*x176 + s5*x177;
-    const stanford_real x182 = -c5*x177 + s5*x176;
-    const stanford_real x183 = c5*x178 + s5*x180;
-    const stanford_real x184 = -c5*x180 + s5*x178;
+    const stanford_real x178 = x172 + x177;
+    const stanford_real x179 = c5*x176 + s5*x175;
+    const stanford_real x180 = -c5*x175 + s5*x176;
     /* link 4: forces */
-    const stanford_real x185 = -s[30] + x182;
-    const stanford_real x186 = s[33] + x183;
-    const stanford_real x187 = -s[31] + x179;
-    const stanford_real x188 = c4*x181 - s4*x173;
-    const stanford_real x189 = c4*x173 + s4*x181;
-    const stanford_real x190 = c4*x186 - s4*x187;
-    const stanford_real x191 = c4*x187 + s4*x186;
+    const stanford_real x181 = x14 + x179;
+    const stanford_real x182 = -s[31] + x178;
+    const stanford_real x183 = c4*x181 - s4*x182;
+    const stanford_real x184 = c4*x182 + s4*x181;
     /* link 3: forces */
-    const stanford_real x192 = s[20] - x185;
-    const stanford_real x193 = s[22] + x190;
-    const stanford_real x194 = -s[21] + x191;
-    const stanford_real x195 = -q[2]*x189 + x193;
-    const stanford_real x196 = q[2]*x188 + x194;
+    const stanford_real x185 = s[22] + x183;
+    const stanford_real x186 = -s[21] + x184;
     /* link 2: forces */
-    const stanford_real x197 = STANFORD_K(0.154)*x192 + x196;
-    const stanford_real x198 = -x184 - STANFORD_K(0.154)*x189;
-    const stanford_real x199 = -c2*x198 + s2*x197;
+    const stanford_real x187 = STANFORD_K(0.154)*x12 + x186;
+    const stanford_real x188 = c2*x180 + s2*x187;
     /* link 6: velocities and accelerations */
-    const stanford_real x200 = STANFORD_K(0.263)*x158;
-    const stanford_real x201 = -STANFORD_K(0.263)*x157;
+    const stanford_real x189 = STANFORD_K(0.263)*x171;
+    const stanford_real x190 = -STANFORD_K(0.263)*x170;
     /* link 5: link wrench */
-    const stanford_real x202 = -s[44]*s5 + s[46]*c5;
-    const stanford_real x203 = -s[45]*s5 + s[48]*c5;
-    const stanford_real x204 = -s[46]*s5 + s[49]*c5;
+    const stanford_real x191 = s[46]*c5 - s5*x21;
+    const stanford_real x192 = -s[45]*s5 + s[48]*c5;
+    const stanford_real x193 = -s[46]*s5;
     /* link 6: link wrench */
-    const stanford_real x205 = -c5*s[52] + s[50]*x200 + s[53]*x158;
-    const stanford_real x206 = c5*s[51] + s[50]*x201 - s[53]*x157;
-    const stanford_real x207 = s[54]*x157 + s[55]*x158 + s[56]*c5 - s[53]*x201;
-    const stanford_real x208 = s[55]*x157 + s[57]*x158 + s[58]*c5 + s[53]*x200;
-    const stanford_real x209 = s[56]*x157 + s[58]*x158 + s[59]*c5 + s[51]*x201 - s[52]*x200;
+    const stanford_real x194 = s[55]*x171 + s[56]*c5 + x170*x23;
+    const stanford_real x195 = s[55]*x170 + s[58]*c5;
+    const stanford_real x196 = s[56]*x170 + s[58]*x171 + s[59]*c5 + s[51]*x190 - s[52]*x189;
     /* link 6: forces */
-    const stanford_real x210 = -STANFORD_K(0.263)*x206 + x207;
-    const stanford_real x211 = STANFORD_K(0.263)*x205 + x208;
-    const stanford_real x212 = c6*x205 - s6*x206;
-    const stanford_real x213 = c6*x206 + s6*x205;
-    const stanford_real x214 = c6*x210 - s6*x211;
-    const stanford_real x215 = c6*x211 + s6*x210;
+    const stanford_real x197 = STANFORD_K(0.263)*x174 + x194;
+    const stanford_real x198 = -STANFORD_K(0.263)*x173 + x195;
+    const stanford_real x199 = c6*x197 - s6*x198;
+    const stanford_real x200 = c6*x198 + s6*x197;
     /* link 5: forces */
-    const stanford_real x216 = -x161 + x212;
-    const stanford_real x217 = -x162 + x213;
-    const stanford_real x218 = x202 + x214;
-    const stanford_real x219 = x203 + x215;
-    const stanford_real x220 = x204 + x209;
-    const stanford_real x221 = c5*x216 - s5*x180;
-    const stanford_real x222 = c5*x180 + s5*x216;
-    const stanford_real x223 = c5*x218 + s5*x220;
-    const stanford_real x224 = -c5*x220 + s5*x218;
+    const stanford_real x201 = x191 + x199;
+    const stanford_real x202 = x192 + x200;
+    const stanford_real x203 = x193 + x196;
+    const stanford_real x204 = c5*x201 + s5*x203;
+    const stanford_real x205 = -c5*x203 + s5*x201;
     /* link 4: forces */
-    const stanford_real x225 = -s[33] + x221;
-    const stanford_real x226 = s[31] + x217;
-    const stanford_real x227 = -s[35] + x223;
-    const stanford_real x228 = -s[37] + x224;
-    const stanford_real x229 = -s[38] + x219;
-    const stanford_real x230 = c4*x225 - s4*x226;
-    const stanford_real x231 = c4*x226 + s4*x225;
-    const stanford_real x232 = c4*x227 - s4*x229;
-    const stanford_real x233 = c4*x229 + s4*x227;
+    const stanford_real x206 = -s[35] + x204;
+    const stanford_real x207 = -x16 + x205;
+    const stanford_real x208 = -s[38] + x202;
+    const stanford_real x209 = c4*x206 - s4*x208;
+    const stanford_real x210 = c4*x208 + s4*x206;
     /* link 3: forces */
-    const stanford_real x234 = -q[2]*x231 + x232;
-    const stanford_real x235 = q[2]*x230 + x233;
+    const stanford_real x211 = q[2]*x184 + x209;
+    const stanford_real x212 = -q[2]*x183 + x210;
     /* link 2: forces */
-    const stanford_real x236 = -STANFORD_K(0.154)*x222 + x235;
-    const stanford_real x237 = -x228 - STANFORD_K(0.154)*x231;
-    const stanford_real x238 = -c2*x237 + s2*x236;
+    const stanford_real x213 = STANFORD_K(0.154)*x180 + x212;
+    const stanford_real x214 = STANFORD_K(0.154)*x184 - x207;
+    const stanford_real x215 = -c2*x214 + s2*x213;
     /* link 6: velocities and accelerations */
-    const stanford_real x239 = STANFORD_K(0.263)*c6;
-    const stanford_real x240 = -STANFORD_K(0.263)*s6;
+    const stanford_real x216 = STANFORD_K(0.263)*c6;
+    const stanford_real x217 = -STANFORD_K(0.263)*s6;
     /* link 6: link wrench */
-    const stanford_real x241 = c6*s[53] + s[50]*x239;
-    const stanford_real x242 = s[50]*x240 - s[53]*s6;
-    const stanford_real x243 = -c6*s[51] + s[52]*s6;
-    const stanford_real x244 = s[54]*s6 + s[55]*c6 - s[53]*x240;
-    const stanford_real x245 = s[55]*s6 + s[57]*c6 + s[53]*x239;
-    const stanford_real x246 = s[56]*s6 + s[58]*c6 + s[51]*x240 - s[52]*x239;
+    const stanford_real x218 = -c6*s[51] + s[52]*s6;
+    const stanford_real x219 = s[55]*c6 + s6*x23;
+    const stanford_real x220 = s[55]*s6;
+    const stanford_real x221 = s[56]*s6 + s[58]*c6 + s[51]*x217 - s[52]*x216;
     /* link 6: forces */
-    const stanford_real x247 = -STANFORD_K(0.263)*x242 + x244;
-    const stanford_real x248 = STANFORD_K(0.263)*x241 + x245;
-    const stanford_real x249 = c6*x241 - s6*x242;
-    const stanford_real x250 = c6*x242 + s6*x241;
-    const stanford_real x251 = c6*x247 - s6*x248;
-    const stanford_real x252 = c6*x248 + s6*x247;
+    const stanford_real x222 = c6*x219 - s6*x220;
+    const stanford_real x223 = c6*x220 + s6*x219;
     /* link 5: forces */
-    const stanford_real x253 = s[43] + x249;
-    const stanford_real x254 = -s[41] + x243;
-    const stanford_real x255 = s[45] + x251;
-    const stanford_real x256 = s[47] + x252;
-    const stanford_real x257 = s[48] + x246;
-    const stanford_real x258 = c5*x253 + s5*x254;
-    const stanford_real x259 = -c5*x254 + s5*x253;
-    const stanford_real x260 = c5*x255 + s5*x257;
-    const stanford_real x261 = -c5*x257 + s5*x255;
+    const stanford_real x224 = -s[41] + x218;
+    const stanford_real x225 = s[45] + x222;
+    const stanford_real x226 = x22 + x223;
+    const stanford_real x227 = s[48] + x221;
+    const stanford_real x228 = c5*x18 + s5*x224;
+    const stanford_real x229 = -c5*x224 + s5*x18;
+    const stanford_real x230 = c5*x225 + s5*x227;
+    const stanford_real x231 = -c5*x227 + s5*x225;
     /* link 4: forces */
-    const stanford_real x262 = c4*x258 - s4*x250;
-    const stanford_real x263 = c4*x250 + s4*x258;
-    const stanford_real x264 = c4*x260 - s4*x256;
-    const stanford_real x265 = c4*x256 + s4*x260;
+    const stanford_real x232 = c4*x228;
+    const stanford_real x233 = s4*x228;
+    const stanford_real x234 = c4*x230 - s4*x226;
+    const stanford_real x235 = c4*x226 + s4*x230;
     /* link 3: forces */
-    const stanford_real x266 = -q[2]*x263 + x264;
-    const stanford_real x267 = q[2]*x262 + x265;
+    const stanford_real x236 = -q[2]*x233 + x234;
+    const stanford_real x237 = q[2]*x232 + x235;
     /* link 2: forces */
-    const stanford_real x268 = -STANFORD_K(0.154)*x259 + x267;
-    const stanford_real x269 = -x261 - STANFORD_K(0.154)*x263;
-    const stanford_real x270 = -c2*x269 + s2*x268;
+    const stanford_real x238 = -STANFORD_K(0.154)*x229 + x237;
+    const stanford_real x239 = -x231 - STANFORD_K(0.154)*x233;
+    const stanford_real x240 = -c2*x239 + s2*x238;
     /* link 6: forces */
-    const stanford_real x271 = s[56] - STANFORD_K(0.263)*s[51];
-    const stanford_real x272 = s[58] - STANFORD_K(0.263)*s[52];
-    const stanford_real x273 = -c6*s[52] - s[51]*s6;
-    const stanford_real x274 = c6*x271 - s6*x272;
-    const stanford_real x275 = c6*x272 + s6*x271;
+    const stanford_real x241 = s[56] - STANFORD_K(0.263)*s[51];
+    const stanford_real x242 = s[58] - STANFORD_K(0.263)*s[52];
+    const stanford_real x243 = -c6*s[52] - s[51]*s6;
+    const stanford_real x244 = c6*x241 - s6*x242;
+    const stanford_real x245 = c6*x242 + s6*x241;
     /* link 5: forces */
-    const stanford_real x276 = c5*x273;
-    const stanford_real x277 = s5*x273;
-    const stanford_real x278 = s[59]*s5 + c5*x274;
-    const stanford_real x279 = -s[59]*c5 + s5*x274;
+    const stanford_real x246 = c5*x243;
+    const stanford_real x247 = s5*x243;
+    const stanford_real x248 = s[59]*s5 + c5*x244;
+    const stanford_real x249 = -s[59]*c5 + s5*x244;
     /* link 4: forces */
-    const stanford_real x280 = c4*x276 + s4*x243;
-    const stanford_real x281 = -c4*x243 + s4*x276;
-    const stanford_real x282 = c4*x278 - s4*x275;
-    const stanford_real x283 = c4*x275 + s4*x278;
+    const stanford_real x250 = c4*x246 + s4*x218;
+    const stanford_real x251 = -c4*x218 + s4*x246;
+    const stanford_real x252 = c4*x248 - s4*x245;
+    const stanford_real x253 = c4*x245 + s4*x248;
     /* link 3: forces */
-    const stanford_real x284 = -q[2]*x281 + x282;
-    const stanford_real x285 = q[2]*x280 + x283;
+    const stanford_real x254 = -q[2]*x251 + x252;
+    const stanford_real x255 = q[2]*x250 + x253;
     /* link 2: forces */
-    const stanford_real x286 = -STANFORD_K(0.154)*x277 + x285;
-    const stanford_real x287 = -x279 - STANFORD_K(0.154)*x281;
-    const stanford_real x288 = -c2*x287 + s2*x286;
+    const stanford_real x256 = -STANFORD_K(0.154)*x247 + x255;
+    const stanford_real x257 = -x249 - STANFORD_K(0.154)*x251;
+    const stanford_real x258 = -c2*x257 + s2*x256;
     /* M */
-    M[0] = -x82;
-    M[1] = -x156;
-    M[2] = -x199;
-    M[3] = -x238;
-    M[4] = -x270;
-    M[5] = -x288;
-    M[6] = -x156;
-    M[7] = x152;
-    M[8] = -x195;
-    M[9] = -x234;
-    M[10] = -x266;
-    M[11] = -x284;
-    M[12] = -x199;
-    M[13] = -x195;
-    M[14] = x192;
-    M[15] = -x222;
-    M[16] = -x259;
-    M[17] = -x277;
-    M[18] = -x238;
-    M[19] = -x234;
-    M[20] = -x222;
-    M[21] = -x228;
-    M[22] = -x261;
-    M[23] = -x279;
-    M[24] = -x270;
-    M[25] = -x266;
-    M[26] = -x259;
-    M[27] = -x261;
-    M[28] = x256;
-    M[29] = x275;
-    M[30] = -x288;
-    M[31] = -x284;
-    M[32] = -x277;
-    M[33] = -x279;
-    M[34] = x275;
+    M[0] = -x102;
+    M[1] = -x169;
+    M[2] = -x188;
+    M[3] = -x215;
+    M[4] = -x240;
+    M[5] = -x258;
+    M[6] = -x169;
+    M[7] = x166;
+    M[8] = -x185;
+    M[9] = -x211;
+    M[10] = -x236;
+    M[11] = -x254;
+    M[12] = -x188;
+    M[13] = -x185;
+    M[14] = x12;
+    M[15] = x180;
+    M[16] = -x229;
+    M[17] = -x247;
+    M[18] = -x215;
+    M[19] = -x211;
+    M[20] = x180;
+    M[21] = -x207;
+    M[22] = -x231;
+    M[23] = -x249;
+    M[24] = -x240;
+    M[25] = -x236;
+    M[26] = -x229;
+    M[27] = -x231;
+    M[28] = x226;
+    M[29] = x245;
+    M[30] = -x258;
+    M[31] = -x254;
+    M[32] = -x247;
+    M[33] = -x249;
+    M[34] = x245;
     M[35] = s[59];
 }
 

@@ -11,9 +11,6 @@
  *   stanford_pi_full             100 mul, 78 add, 0 div, 0 sin/cos
  *   stanford_pi_full_jacobian    100 mul, 28 add, 0 div, 0 sin/cos
  */
-#ifndef _GNU_SOURCE
-#define _GNU_SOURCE /* sincos() in glibc's <math.h> */
-#endif
 #include "stanford.h"
 
 /* Standard parameters s from dynamic parameters p. */

@@ -7,9 +7,6 @@
  *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 4 sin/cos
  *   stanford_regressor           402 mul, 259 add, 0 div, 4 sin/cos
  */
-#ifndef _GNU_SOURCE
-#define _GNU_SOURCE /* sincos() in glibc's <math.h> */
-#endif
 #include "stanford.h"
 
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity. */

@@ -41,6 +41,9 @@ class Model:
         return self.program.pruned(self.outputs)
 
 
+GROUPING_LIMIT = 10  # largest |K| entry for which rnea, gravity and M run over the base coefficients
+
+
 class Derivation:
     """Builds the models of one robot; each model has its own program."""
 
@@ -114,10 +117,12 @@ class Derivation:
 
     def _grouped(self, program, base) -> list:
         """The parameters the recursion reads: s itself, or s* from pi = K s (see above). Only
-        where no entry of K exceeds 1 in size: an entry like 1/0.0203 (a regrouping that divides
-        by a short length, PUMA 560) makes pi and the products with it cancel in float (2e-4 of
-        the torques instead of 1e-6); there the standard parameters stay."""
-        if base is None or any(abs(k) > 1 for row in base.K for k in row):
+        where no entry of K exceeds GROUPING_LIMIT in size: an entry like 1/0.0203 (a regrouping
+        that divides by a short length, PUMA 560) makes pi and the products with it cancel in
+        float (2e-4 of the torques instead of 2e-6); there the standard parameters stay. The
+        other example arms' largest entries (1/0.4 on the LWR, 6.5 on the UR5) cost nothing in
+        float (bench/bench_opcounts.py)."""
+        if base is None or any(abs(k) > GROUPING_LIMIT for row in base.K for k in row):
             return self.s
         program.section = f"base coefficients pi_{base.kind} = K s"
         return self._placed(base, [_linear_form(program, row, self.s) for row in base.K])
