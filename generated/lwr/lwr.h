@@ -31,7 +31,7 @@
  *   lwr_regressor                696 mul, 420 add, 0 div, 6 sin/cos
  *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
  *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
- *   lwr_mass_matrix              638 mul, 473 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
  *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
@@ -207,7 +207,7 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
  *   q        [7]  joint positions [rad or m]
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [7 x 7]  row-major, symmetric (written)
- * 638 mul, 473 add, 0 div, 6 sin/cos
+ * 243 mul, 193 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
 

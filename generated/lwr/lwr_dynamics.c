@@ -5,7 +5,7 @@
  *
  *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
  *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
- *   lwr_mass_matrix              638 mul, 473 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
  *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
  */
 #include "lwr.h"
@@ -447,557 +447,184 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x23 = s[54] + s[67] - s[59];
     const lwr_real x24 = s[57] + s[67];
     const lwr_real x25 = s[64] - s[67];
-    /* link 3: velocities and accelerations */
-    const lwr_real x26 = c3*s2;
-    const lwr_real x27 = -s2*s3;
-    const lwr_real x28 = LWR_K(0.4)*x27;
-    const lwr_real x29 = -LWR_K(0.4)*x26;
-    /* link 4: velocities and accelerations */
-    const lwr_real x30 = -c2*s4 + c4*x26;
-    const lwr_real x31 = c2*c4 + s4*x26;
-    const lwr_real x32 = c4*x28;
-    const lwr_real x33 = s4*x28;
-    /* link 5: velocities and accelerations */
-    const lwr_real x34 = c5*x30 + s5*x27;
-    const lwr_real x35 = -c5*x27 + s5*x30;
-    const lwr_real x36 = c5*x32 + s5*x29;
-    const lwr_real x37 = -c5*x29 + s5*x32;
-    const lwr_real x38 = -LWR_K(0.39)*x35 + x36;
-    const lwr_real x39 = LWR_K(0.39)*x34 + x37;
-    /* link 6: velocities and accelerations */
-    const lwr_real x40 = c6*x34 + s6*x31;
-    const lwr_real x41 = c6*x31 - s6*x34;
-    const lwr_real x42 = c6*x38 + s6*x33;
-    const lwr_real x43 = c6*x33 - s6*x38;
-    /* link 7: velocities and accelerations */
-    const lwr_real x44 = c7*x40 - s7*x35;
-    const lwr_real x45 = -c7*x35 - s7*x40;
-    const lwr_real x46 = c7*x42 - s7*x39;
-    const lwr_real x47 = -c7*x39 - s7*x42;
-    /* link 2: link wrench */
-    const lwr_real x48 = s[16]*c2 + s2*x4;
-    const lwr_real x49 = s[16]*s2;
-    /* link 3: link wrench */
-    const lwr_real x50 = -c2*x9;
-    const lwr_real x51 = c2*x7;
-    const lwr_real x52 = s[26]*x27 + x10*x26;
-    const lwr_real x53 = -c2*x11 + x28*x9 - x29*x7;
-    const lwr_real x54 = s[26]*x26;
-    /* link 4: link wrench */
-    const lwr_real x55 = x14*x27;
-    const lwr_real x56 = s[31]*x31 - x14*x30;
-    const lwr_real x57 = -s[31]*x27;
-    const lwr_real x58 = s[35]*x27 + s[36]*x31 - x14*x29 + x17*x30;
-    const lwr_real x59 = s[35]*x30 + s[38]*x31 - s[31]*x33 + x14*x32 + x18*x27;
-    const lwr_real x60 = s[36]*x30 + s[38]*x27 + s[31]*x29;
-    /* link 5: link wrench */
-    const lwr_real x61 = x19*x31;
-    const lwr_real x62 = s[41]*x35 - x19*x34;
-    const lwr_real x63 = -s[41]*x31;
-    const lwr_real x64 = s[45]*x31 + s[46]*x35 - x19*x33 + x20*x34;
-    const lwr_real x65 = s[45]*x34 + s[48]*x35 - s[41]*x39 + x19*x38 + x21*x31;
-    const lwr_real x66 = s[46]*x34 + s[48]*x31 + s[41]*x33;
-    /* link 6: link wrench */
-    const lwr_real x67 = -x22*x35;
-    const lwr_real x68 = s[51]*x41 - x22*x40;
-    const lwr_real x69 = s[51]*x35;
-    const lwr_real x70 = -s[55]*x35 + s[56]*x41 + x22*x39 + x23*x40;
-    const lwr_real x71 = s[55]*x40 + s[58]*x41 - s[51]*x43 + x22*x42 - x24*x35;
-    const lwr_real x72 = s[56]*x40 - s[58]*x35 - s[51]*x39;
-    /* link 7: link wrench */
-    const lwr_real x73 = -s[62]*x41;
-    const lwr_real x74 = s[61]*x41;
-    const lwr_real x75 = -s[61]*x45 + s[62]*x44;
-    const lwr_real x76 = s[65]*x45 + s[66]*x41 + s[62]*x43 + x25*x44;
-    const lwr_real x77 = s[65]*x44 + s[68]*x41 - s[61]*x43;
-    const lwr_real x78 = s[66]*x44 + s[68]*x45 + s[69]*x41 + s[61]*x47 - s[62]*x46;
-    /* link 7: forces */
-    const lwr_real x79 = c7*x73 - s7*x74;
-    const lwr_real x80 = c7*x74 + s7*x73;
-    const lwr_real x81 = c7*x76 - s7*x77;
-    const lwr_real x82 = c7*x77 + s7*x76;
-    /* link 6: forces */
-    const lwr_real x83 = x67 + x79;
-    const lwr_real x84 = x68 + x80;
-    const lwr_real x85 = x69 + x75;
-    const lwr_real x86 = x70 + x81;
-    const lwr_real x87 = x71 + x82;
-    const lwr_real x88 = x72 + x78;
-    const lwr_real x89 = c6*x83 - s6*x85;
-    const lwr_real x90 = c6*x85 + s6*x83;
-    const lwr_real x91 = c6*x86 - s6*x88;
-    const lwr_real x92 = c6*x88 + s6*x86;
-    /* link 5: forces */
-    const lwr_real x93 = x61 + x89;
-    const lwr_real x94 = x62 + x90;
-    const lwr_real x95 = x63 - x84;
-    const lwr_real x96 = x64 + x91;
-    const lwr_real x97 = x65 + x92;
-    const lwr_real x98 = x66 - x87;
-    const lwr_real x99 = LWR_K(0.39)*x95 + x96;
-    const lwr_real x100 = x98 - LWR_K(0.39)*x93;
-    const lwr_real x101 = c5*x93 + s5*x95;
-    const lwr_real x102 = -c5*x95 + s5*x93;
-    const lwr_real x103 = c5*x99 + s5*x100;
-    const lwr_real x104 = -c5*x100 + s5*x99;
-    /* link 4: forces */
-    const lwr_real x105 = x101 + x55;
-    const lwr_real x106 = x102 + x56;
-    const lwr_real x107 = x57 + x94;
-    const lwr_real x108 = x103 + x58;
-    const lwr_real x109 = x104 + x59;
-    const lwr_real x110 = x60 + x97;
-    const lwr_real x111 = c4*x105 + s4*x107;
-    const lwr_real x112 = c4*x108 + s4*x110;
-    const lwr_real x113 = -c4*x110 + s4*x108;
-    /* link 3: forces */
-    const lwr_real x114 = x111 + x50;
-    const lwr_real x115 = x106 + x51;
-    const lwr_real x116 = x112 + x52;
-    const lwr_real x117 = x113 + x53;
-    const lwr_real x118 = x109 + x54;
-    const lwr_real x119 = -LWR_K(0.4)*x115 + x116;
-    const lwr_real x120 = LWR_K(0.4)*x114 + x118;
-    const lwr_real x121 = c3*x119 - s3*x120;
-    /* link 2: forces */
-    const lwr_real x122 = x121 + x48;
-    const lwr_real x123 = -x117 + x49;
-    const lwr_real x124 = c2*x123 + s2*x122;
-    /* link 1: forces */
-    const lwr_real x125 = x0 + x124;
-    /* link 3: velocities and accelerations */
-    const lwr_real x126 = -LWR_K(0.4)*c3;
-    const lwr_real x127 = LWR_K(0.4)*s3;
-    /* link 4: velocities and accelerations */
-    const lwr_real x128 = -c4*s3;
-    const lwr_real x129 = -s3*s4;
-    const lwr_real x130 = c4*x126;
-    const lwr_real x131 = s4*x126;
-    /* link 5: velocities and accelerations */
-    const lwr_real x132 = -c3*s5 + c5*x128;
-    const lwr_real x133 = c3*c5 + s5*x128;
-    const lwr_real x134 = c5*x130 + s5*x127;
-    const lwr_real x135 = -c5*x127 + s5*x130;
-    const lwr_real x136 = -LWR_K(0.39)*x133 + x134;
-    const lwr_real x137 = LWR_K(0.39)*x132 + x135;
-    /* link 6: velocities and accelerations */
-    const lwr_real x138 = c6*x132 + s6*x129;
-    const lwr_real x139 = c6*x129 - s6*x132;
-    const lwr_real x140 = c6*x136 + s6*x131;
-    const lwr_real x141 = c6*x131 - s6*x136;
-    /* link 7: velocities and accelerations */
-    const lwr_real x142 = c7*x138 - s7*x133;
-    const lwr_real x143 = -c7*x133 - s7*x138;
-    const lwr_real x144 = c7*x140 - s7*x137;
-    const lwr_real x145 = -c7*x137 - s7*x140;
-    /* link 3: link wrench */
-    const lwr_real x146 = -s[26]*c3 - s3*x10;
-    const lwr_real x147 = x126*x9 - x127*x7;
-    const lwr_real x148 = -s[26]*s3;
-    /* link 4: link wrench */
-    const lwr_real x149 = -c3*x14;
-    const lwr_real x150 = s[31]*x129 - x128*x14;
-    const lwr_real x151 = c3*s[31];
-    const lwr_real x152 = -s[35]*c3 + s[36]*x129 - x127*x14 + x128*x17;
-    const lwr_real x153 = s[35]*x128 + s[38]*x129 - c3*x18 - s[31]*x131 + x14*x130;
-    const lwr_real x154 = s[36]*x128 - s[38]*c3 + s[31]*x127;
-    /* link 5: link wrench */
-    const lwr_real x155 = x129*x19;
-    const lwr_real x156 = s[41]*x133 - x132*x19;
-    const lwr_real x157 = -s[41]*x129;
-    const lwr_real x158 = s[45]*x129 + s[46]*x133 - x131*x19 + x132*x20;
-    const lwr_real x159 = s[45]*x132 + s[48]*x133 - s[41]*x137 + x129*x21 + x136*x19;
-    const lwr_real x160 = s[46]*x132 + s[48]*x129 + s[41]*x131;
-    /* link 6: link wrench */
-    const lwr_real x161 = -x133*x22;
-    const lwr_real x162 = s[51]*x139 - x138*x22;
-    const lwr_real x163 = s[51]*x133;
-    const lwr_real x164 = -s[55]*x133 + s[56]*x139 + x137*x22 + x138*x23;
-    const lwr_real x165 = s[55]*x138 + s[58]*x139 - s[51]*x141 - x133*x24 + x140*x22;
-    const lwr_real x166 = s[56]*x138 - s[58]*x133 - s[51]*x137;
-    /* link 7: link wrench */
-    const lwr_real x167 = -s[62]*x139;
-    const lwr_real x168 = s[61]*x139;
-    const lwr_real x169 = -s[61]*x143 + s[62]*x142;
-    const lwr_real x170 = s[65]*x143 + s[66]*x139 + s[62]*x141 + x142*x25;
-    const lwr_real x171 = s[65]*x142 + s[68]*x139 - s[61]*x141;
-    const lwr_real x172 = s[66]*x142 + s[68]*x143 + s[69]*x139 + s[61]*x145 - s[62]*x144;
-    /* link 7: forces */
-    const lwr_real x173 = c7*x167 - s7*x168;
-    const lwr_real x174 = c7*x168 + s7*x167;
-    const lwr_real x175 = c7*x170 - s7*x171;
-    const lwr_real x176 = c7*x171 + s7*x170;
-    /* link 6: forces */
-    const lwr_real x177 = x161 + x173;
-    const lwr_real x178 = x162 + x174;
-    const lwr_real x179 = x163 + x169;
-    const lwr_real x180 = x164 + x175;
-    const lwr_real x181 = x165 + x176;
-    const lwr_real x182 = x166 + x172;
-    const lwr_real x183 = c6*x177 - s6*x179;
-    const lwr_real x184 = c6*x179 + s6*x177;
-    const lwr_real x185 = c6*x180 - s6*x182;
-    const lwr_real x186 = c6*x182 + s6*x180;
-    /* link 5: forces */
-    const lwr_real x187 = x155 + x183;
-    const lwr_real x188 = x156 + x184;
-    const lwr_real x189 = x157 - x178;
-    const lwr_real x190 = x158 + x185;
-    const lwr_real x191 = x159 + x186;
-    const lwr_real x192 = x160 - x181;
-    const lwr_real x193 = LWR_K(0.39)*x189 + x190;
-    const lwr_real x194 = -LWR_K(0.39)*x187 + x192;
-    const lwr_real x195 = c5*x187 + s5*x189;
-    const lwr_real x196 = -c5*x189 + s5*x187;
-    const lwr_real x197 = c5*x193 + s5*x194;
-    const lwr_real x198 = -c5*x194 + s5*x193;
-    /* link 4: forces */
-    const lwr_real x199 = x149 + x195;
-    const lwr_real x200 = x150 + x196;
-    const lwr_real x201 = x151 + x188;
-    const lwr_real x202 = x152 + x197;
-    const lwr_real x203 = x153 + x198;
-    const lwr_real x204 = x154 + x191;
-    const lwr_real x205 = c4*x199 + s4*x201;
-    const lwr_real x206 = c4*x202 + s4*x204;
-    const lwr_real x207 = -c4*x204 + s4*x202;
-    /* link 3: forces */
-    const lwr_real x208 = x146 + x206;
-    const lwr_real x209 = x147 + x207;
-    const lwr_real x210 = x148 + x203;
-    const lwr_real x211 = -LWR_K(0.4)*x200 + x208;
-    const lwr_real x212 = LWR_K(0.4)*x205 + x210;
-    const lwr_real x213 = c3*x211 - s3*x212;
-    const lwr_real x214 = c3*x212 + s3*x211;
-    /* link 2: forces */
-    const lwr_real x215 = -s[15] + x213;
-    const lwr_real x216 = x214 - x5;
-    const lwr_real x217 = -s[18] - x209;
-    const lwr_real x218 = c2*x217 + s2*x215;
-    /* link 5: velocities and accelerations */
-    const lwr_real x219 = -c5*s4;
-    const lwr_real x220 = -s4*s5;
-    const lwr_real x221 = -LWR_K(0.39)*x220;
-    const lwr_real x222 = LWR_K(0.39)*x219;
-    /* link 6: velocities and accelerations */
-    const lwr_real x223 = c4*s6 + c6*x219;
-    const lwr_real x224 = c4*c6 - s6*x219;
-    const lwr_real x225 = c6*x221;
-    const lwr_real x226 = -s6*x221;
-    /* link 7: velocities and accelerations */
-    const lwr_real x227 = c7*x223 - s7*x220;
-    const lwr_real x228 = -c7*x220 - s7*x223;
-    const lwr_real x229 = c7*x225 - s7*x222;
-    const lwr_real x230 = -c7*x222 - s7*x225;
-    /* link 4: link wrench */
-    const lwr_real x231 = c4*s[31] + s4*x14;
-    const lwr_real x232 = s[36]*c4 - s4*x17;
-    const lwr_real x233 = -s[35]*s4 + s[38]*c4;
-    const lwr_real x234 = -s[36]*s4;
-    /* link 5: link wrench */
-    const lwr_real x235 = c4*x19;
-    const lwr_real x236 = s[41]*x220 - x19*x219;
-    const lwr_real x237 = -c4*s[41];
-    const lwr_real x238 = s[45]*c4 + s[46]*x220 + x20*x219;
-    const lwr_real x239 = s[45]*x219 + s[48]*x220 + c4*x21 - s[41]*x222 + x19*x221;
-    const lwr_real x240 = s[46]*x219 + s[48]*c4;
-    /* link 6: link wrench */
-    const lwr_real x241 = -x22*x220;
-    const lwr_real x242 = s[51]*x224 - x22*x223;
-    const lwr_real x243 = s[51]*x220;
-    const lwr_real x244 = -s[55]*x220 + s[56]*x224 + x22*x222 + x23*x223;
-    const lwr_real x245 = s[55]*x223 + s[58]*x224 - s[51]*x226 + x22*x225 - x220*x24;
-    const lwr_real x246 = s[56]*x223 - s[58]*x220 - s[51]*x222;
-    /* link 7: link wrench */
-    const lwr_real x247 = -s[62]*x224;
-    const lwr_real x248 = s[61]*x224;
-    const lwr_real x249 = -s[61]*x228 + s[62]*x227;
-    const lwr_real x250 = s[65]*x228 + s[66]*x224 + s[62]*x226 + x227*x25;
-    const lwr_real x251 = s[65]*x227 + s[68]*x224 - s[61]*x226;
-    const lwr_real x252 = s[66]*x227 + s[68]*x228 + s[69]*x224 + s[61]*x230 - s[62]*x229;
-    /* link 7: forces */
-    const lwr_real x253 = c7*x247 - s7*x248;
-    const lwr_real x254 = c7*x248 + s7*x247;
-    const lwr_real x255 = c7*x250 - s7*x251;
-    const lwr_real x256 = c7*x251 + s7*x250;
-    /* link 6: forces */
-    const lwr_real x257 = x241 + x253;
-    const lwr_real x258 = x242 + x254;
-    const lwr_real x259 = x243 + x249;
-    const lwr_real x260 = x244 + x255;
-    const lwr_real x261 = x245 + x256;
-    const lwr_real x262 = x246 + x252;
-    const lwr_real x263 = c6*x257 - s6*x259;
-    const lwr_real x264 = c6*x259 + s6*x257;
-    const lwr_real x265 = c6*x260 - s6*x262;
-    const lwr_real x266 = c6*x262 + s6*x260;
-    /* link 5: forces */
-    const lwr_real x267 = x235 + x263;
-    const lwr_real x268 = x236 + x264;
-    const lwr_real x269 = x237 - x258;
-    const lwr_real x270 = x238 + x265;
-    const lwr_real x271 = x239 + x266;
-    const lwr_real x272 = x240 - x261;
-    const lwr_real x273 = LWR_K(0.39)*x269 + x270;
-    const lwr_real x274 = -LWR_K(0.39)*x267 + x272;
-    const lwr_real x275 = c5*x267 + s5*x269;
-    const lwr_real x276 = -c5*x269 + s5*x267;
-    const lwr_real x277 = c5*x273 + s5*x274;
-    const lwr_real x278 = -c5*x274 + s5*x273;
-    /* link 4: forces */
-    const lwr_real x279 = x231 + x276;
-    const lwr_real x280 = x232 + x277;
-    const lwr_real x281 = x233 + x278;
-    const lwr_real x282 = x234 + x271;
-    const lwr_real x283 = c4*x275 + s4*x268;
-    const lwr_real x284 = c4*x280 + s4*x282;
-    const lwr_real x285 = -c4*x282 + s4*x280;
-    /* link 3: forces */
-    const lwr_real x286 = x283 - x9;
-    const lwr_real x287 = x279 + x7;
-    const lwr_real x288 = -x11 + x285;
-    const lwr_real x289 = x284 - LWR_K(0.4)*x287;
-    const lwr_real x290 = x281 + LWR_K(0.4)*x286;
-    const lwr_real x291 = c3*x289 - s3*x290;
-    const lwr_real x292 = c3*x290 + s3*x289;
-    /* link 2: forces */
-    const lwr_real x293 = -c2*x288 + s2*x291;
-    /* link 5: velocities and accelerations */
-    const lwr_real x294 = LWR_K(0.39)*c5;
-    const lwr_real x295 = LWR_K(0.39)*s5;
-    /* link 6: velocities and accelerations */
-    const lwr_real x296 = c6*s5;
-    const lwr_real x297 = -s5*s6;
-    const lwr_real x298 = c6*x294;
-    const lwr_real x299 = -s6*x294;
-    /* link 7: velocities and accelerations */
-    const lwr_real x300 = c5*s7 + c7*x296;
-    const lwr_real x301 = c5*c7 - s7*x296;
-    const lwr_real x302 = c7*x298 - s7*x295;
-    const lwr_real x303 = -c7*x295 - s7*x298;
-    /* link 5: link wrench */
-    const lwr_real x304 = -c5*s[41] - s5*x19;
-    const lwr_real x305 = -s[46]*c5 + s5*x20;
-    const lwr_real x306 = s[45]*s5 - s[48]*c5 - s[41]*x295 + x19*x294;
-    const lwr_real x307 = s[46]*s5;
-    /* link 6: link wrench */
-    const lwr_real x308 = c5*x22;
-    const lwr_real x309 = s[51]*x297 - x22*x296;
-    const lwr_real x310 = -c5*s[51];
-    const lwr_real x311 = s[55]*c5 + s[56]*x297 + x22*x295 + x23*x296;
-    const lwr_real x312 = s[55]*x296 + s[58]*x297 + c5*x24 - s[51]*x299 + x22*x298;
-    const lwr_real x313 = s[56]*x296 + s[58]*c5 - s[51]*x295;
-    /* link 7: link wrench */
-    const lwr_real x314 = -s[62]*x297;
-    const lwr_real x315 = s[61]*x297;
-    const lwr_real x316 = -s[61]*x301 + s[62]*x300;
-    const lwr_real x317 = s[65]*x301 + s[66]*x297 + s[62]*x299 + x25*x300;
-    const lwr_real x318 = s[65]*x300 + s[68]*x297 - s[61]*x299;
-    const lwr_real x319 = s[66]*x300 + s[68]*x301 + s[69]*x297 + s[61]*x303 - s[62]*x302;
-    /* link 7: forces */
-    const lwr_real x320 = c7*x314 - s7*x315;
-    const lwr_real x321 = c7*x315 + s7*x314;
-    const lwr_real x322 = c7*x317 - s7*x318;
-    const lwr_real x323 = c7*x318 + s7*x317;
-    /* link 6: forces */
-    const lwr_real x324 = x308 + x320;
-    const lwr_real x325 = x309 + x321;
-    const lwr_real x326 = x310 + x316;
-    const lwr_real x327 = x311 + x322;
-    const lwr_real x328 = x312 + x323;
-    const lwr_real x329 = x313 + x319;
-    const lwr_real x330 = c6*x324 - s6*x326;
-    const lwr_real x331 = c6*x326 + s6*x324;
-    const lwr_real x332 = c6*x327 - s6*x329;
-    const lwr_real x333 = c6*x329 + s6*x327;
-    /* link 5: forces */
-    const lwr_real x334 = x304 + x331;
-    const lwr_real x335 = x305 + x332;
-    const lwr_real x336 = x306 + x333;
-    const lwr_real x337 = x307 - x328;
-    const lwr_real x338 = -LWR_K(0.39)*x325 + x335;
-    const lwr_real x339 = -LWR_K(0.39)*x330 + x337;
-    const lwr_real x340 = c5*x330 - s5*x325;
-    const lwr_real x341 = c5*x325 + s5*x330;
-    const lwr_real x342 = c5*x338 + s5*x339;
-    const lwr_real x343 = -c5*x339 + s5*x338;
-    /* link 4: forces */
-    const lwr_real x344 = x14 + x340;
-    const lwr_real x345 = -s[31] + x334;
-    const lwr_real x346 = s[35] + x342;
-    const lwr_real x347 = x18 + x343;
-    const lwr_real x348 = s[38] + x336;
-    const lwr_real x349 = c4*x344 + s4*x345;
-    const lwr_real x350 = c4*x346 + s4*x348;
-    const lwr_real x351 = -c4*x348 + s4*x346;
-    /* link 3: forces */
-    const lwr_real x352 = -LWR_K(0.4)*x341 + x350;
-    const lwr_real x353 = x347 + LWR_K(0.4)*x349;
-    const lwr_real x354 = c3*x352 - s3*x353;
-    const lwr_real x355 = c3*x353 + s3*x352;
-    /* link 2: forces */
-    const lwr_real x356 = -c2*x351 + s2*x354;
-    /* link 7: velocities and accelerations */
-    const lwr_real x357 = c7*s6;
-    const lwr_real x358 = -s6*s7;
-    /* link 6: link wrench */
-    const lwr_real x359 = c6*s[51] - s6*x22;
-    const lwr_real x360 = s[56]*c6 + s6*x23;
-    const lwr_real x361 = s[55]*s6 + s[58]*c6;
-    const lwr_real x362 = s[56]*s6;
-    /* link 7: link wrench */
-    const lwr_real x363 = -c6*s[62];
-    const lwr_real x364 = c6*s[61];
-    const lwr_real x365 = -s[61]*x358 + s[62]*x357;
-    const lwr_real x366 = s[65]*x358 + s[66]*c6 + x25*x357;
-    const lwr_real x367 = s[65]*x357 + s[68]*c6;
-    const lwr_real x368 = s[66]*x357 + s[68]*x358 + s[69]*c6;
-    /* link 7: forces */
-    const lwr_real x369 = c7*x363 - s7*x364;
-    const lwr_real x370 = c7*x364 + s7*x363;
-    const lwr_real x371 = c7*x366 - s7*x367;
-    const lwr_real x372 = c7*x367 + s7*x366;
-    /* link 6: forces */
-    const lwr_real x373 = x359 + x370;
-    const lwr_real x374 = x360 + x371;
-    const lwr_real x375 = x361 + x372;
-    const lwr_real x376 = x362 + x368;
-    const lwr_real x377 = c6*x369 - s6*x365;
-    const lwr_real x378 = c6*x365 + s6*x369;
-    const lwr_real x379 = c6*x374 - s6*x376;
-    const lwr_real x380 = c6*x376 + s6*x374;
-    /* link 5: forces */
-    const lwr_real x381 = x19 + x377;
-    const lwr_real x382 = -s[41] - x373;
-    const lwr_real x383 = s[45] + x379;
-    const lwr_real x384 = x21 + x380;
-    const lwr_real x385 = s[48] - x375;
-    const lwr_real x386 = LWR_K(0.39)*x382 + x383;
-    const lwr_real x387 = -LWR_K(0.39)*x381 + x385;
-    const lwr_real x388 = c5*x381 + s5*x382;
-    const lwr_real x389 = -c5*x382 + s5*x381;
-    const lwr_real x390 = c5*x386 + s5*x387;
-    const lwr_real x391 = -c5*x387 + s5*x386;
-    /* link 4: forces */
-    const lwr_real x392 = c4*x388 + s4*x378;
-    const lwr_real x393 = c4*x390 + s4*x384;
-    const lwr_real x394 = -c4*x384 + s4*x390;
-    /* link 3: forces */
-    const lwr_real x395 = -LWR_K(0.4)*x389 + x393;
-    const lwr_real x396 = x391 + LWR_K(0.4)*x392;
-    const lwr_real x397 = c3*x395 - s3*x396;
-    const lwr_real x398 = c3*x396 + s3*x395;
-    /* link 2: forces */
-    const lwr_real x399 = -c2*x394 + s2*x397;
-    /* link 7: link wrench */
-    const lwr_real x400 = c7*s[61] - s[62]*s7;
-    const lwr_real x401 = -s[65]*c7 - s7*x25;
-    const lwr_real x402 = -s[65]*s7;
-    const lwr_real x403 = -s[66]*s7 - s[68]*c7;
-    /* link 7: forces */
-    const lwr_real x404 = c7*x401 - s7*x402;
-    const lwr_real x405 = c7*x402 + s7*x401;
-    /* link 6: forces */
-    const lwr_real x406 = s[51] + x400;
-    const lwr_real x407 = -s[55] + x404;
-    const lwr_real x408 = -x24 + x405;
-    const lwr_real x409 = -s[58] + x403;
-    const lwr_real x410 = -c6*x22 - s6*x406;
-    const lwr_real x411 = c6*x406 - s6*x22;
-    const lwr_real x412 = c6*x407 - s6*x409;
-    const lwr_real x413 = c6*x409 + s6*x407;
-    /* link 5: forces */
-    const lwr_real x414 = -x408 - LWR_K(0.39)*x410;
-    const lwr_real x415 = c5*x410;
-    const lwr_real x416 = s5*x410;
-    const lwr_real x417 = c5*x412 + s5*x414;
-    const lwr_real x418 = -c5*x414 + s5*x412;
-    /* link 4: forces */
-    const lwr_real x419 = c4*x415 + s4*x411;
-    const lwr_real x420 = c4*x417 + s4*x413;
-    const lwr_real x421 = -c4*x413 + s4*x417;
-    /* link 3: forces */
-    const lwr_real x422 = -LWR_K(0.4)*x416 + x420;
-    const lwr_real x423 = x418 + LWR_K(0.4)*x419;
-    const lwr_real x424 = c3*x422 - s3*x423;
-    const lwr_real x425 = c3*x423 + s3*x422;
-    /* link 2: forces */
-    const lwr_real x426 = -c2*x421 + s2*x424;
-    /* link 7: forces */
-    const lwr_real x427 = -c7*s[62] - s[61]*s7;
-    const lwr_real x428 = s[66]*c7 - s[68]*s7;
-    /* link 6: forces */
-    const lwr_real x429 = c6*x427;
-    const lwr_real x430 = s6*x427;
-    const lwr_real x431 = -s[69]*s6 + c6*x428;
-    const lwr_real x432 = s[69]*c6 + s6*x428;
-    /* link 5: forces */
-    const lwr_real x433 = -LWR_K(0.39)*x400 + x431;
-    const lwr_real x434 = x403 - LWR_K(0.39)*x429;
-    const lwr_real x435 = c5*x429 - s5*x400;
-    const lwr_real x436 = c5*x400 + s5*x429;
-    const lwr_real x437 = c5*x433 + s5*x434;
-    const lwr_real x438 = -c5*x434 + s5*x433;
-    /* link 4: forces */
-    const lwr_real x439 = c4*x435 + s4*x430;
-    const lwr_real x440 = c4*x437 + s4*x432;
-    const lwr_real x441 = -c4*x432 + s4*x437;
-    /* link 3: forces */
-    const lwr_real x442 = -LWR_K(0.4)*x436 + x440;
-    const lwr_real x443 = x438 + LWR_K(0.4)*x439;
-    const lwr_real x444 = c3*x442 - s3*x443;
-    const lwr_real x445 = c3*x443 + s3*x442;
-    /* link 2: forces */
-    const lwr_real x446 = -c2*x441 + s2*x444;
+    /* link 6: composite body */
+    const lwr_real x26 = c7*s[61] - s[62]*s7;
+    const lwr_real x27 = c7*s[62] + s[61]*s7;
+    const lwr_real x28 = s[51] + x26;
+    const lwr_real x29 = c7*(-2*s[65]*s7 + c7*x25) + x23;
+    const lwr_real x30 = s[55] + s[65]*c7*c7 + s7*(-s[65]*s7 + c7*x25);
+    const lwr_real x31 = s[56] + s[66]*c7 - s[68]*s7;
+    const lwr_real x32 = s7*(2*s[65]*c7 + s7*x25) + x24;
+    const lwr_real x33 = s[66]*s7 + s[58] + s[68]*c7;
+    /* link 5: composite body */
+    const lwr_real x34 = c6*x28 - s6*x22;
+    const lwr_real x35 = c6*x22 + s6*x28;
+    const lwr_real x36 = s[41] + x34;
+    const lwr_real x37 = x19 - x27;
+    const lwr_real x38 = c6*(c6*x29 - s6*x31) - s6*(-s[69]*s6 + c6*x31) + x20;
+    const lwr_real x39 = s[45] + c6*(-s[69]*s6 + c6*x31) + s6*(c6*x29 - s6*x31);
+    const lwr_real x40 = s[46] - c6*x30 + s6*x33;
+    const lwr_real x41 = c6*(s[69]*c6 + s6*x31) + s6*(c6*x31 + s6*x29) + x21;
+    const lwr_real x42 = s[48] - c6*x33 - s6*x30;
+    /* link 4: composite body */
+    const lwr_real x43 = c5*x36 + s5*x37;
+    const lwr_real x44 = -c5*x37 + s5*x36;
+    const lwr_real x45 = s[31] + x43;
+    const lwr_real x46 = x14 + x35;
+    const lwr_real x47 = c5*(c5*x38 + s5*x40) + s5*(c5*x40 + s5*x32) + x17 + LWR_K(0.78)*x35;
+    const lwr_real x48 = s[35] - c5*(c5*x40 + s5*x32) + s5*(c5*x38 + s5*x40);
+    const lwr_real x49 = s[36] + c5*x39 + s5*x42 - LWR_K(0.39)*x43;
+    const lwr_real x50 = -c5*(-c5*x32 + s5*x40) + s5*(-c5*x40 + s5*x38) + x18 + LWR_K(0.78)*x35;
+    const lwr_real x51 = s[38] - c5*x42 + s5*x39 - LWR_K(0.39)*x44;
+    /* link 3: composite body */
+    const lwr_real x52 = c4*x45 + s4*x46;
+    const lwr_real x53 = -c4*x46 + s4*x45;
+    const lwr_real x54 = x52 + x7;
+    const lwr_real x55 = x44 + x9;
+    const lwr_real x56 = c4*(c4*x47 + s4*x49) + s4*(c4*x49 + s4*x41) + x10;
+    const lwr_real x57 = -c4*(c4*x49 + s4*x41) + s4*(c4*x47 + s4*x49);
+    const lwr_real x58 = s[26] + c4*x48 + s4*x51;
+    const lwr_real x59 = -c4*(-c4*x41 + s4*x49) + s4*(-c4*x49 + s4*x47) + x11;
+    const lwr_real x60 = -c4*x51 + s4*x48;
+    /* link 2: composite body */
+    const lwr_real x61 = c3*x54 - s3*x55;
+    const lwr_real x62 = c3*x55 + s3*x54;
+    const lwr_real x63 = c3*(c3*x56 - s3*x58) - s3*(c3*x58 - s3*x50) + x4 - LWR_K(0.8)*x53;
+    const lwr_real x64 = s[15] + c3*(c3*x58 - s3*x50) + s3*(c3*x56 - s3*x58);
+    const lwr_real x65 = s[16] - c3*x57 + s3*x60 - LWR_K(0.4)*x61;
+    const lwr_real x66 = c3*(c3*x50 + s3*x58) + s3*(c3*x58 + s3*x56) + x5 - LWR_K(0.8)*x53;
+    const lwr_real x67 = s[18] - c3*x60 - s3*x57 - LWR_K(0.4)*x62;
+    /* link 1: composite body */
+    const lwr_real x68 = c2*(c2*x59 + s2*x65) + s2*(c2*x65 + s2*x63) + x0;
+    const lwr_real x69 = -c2*x67 - s2*x64;
+    /* column 3: composite wrench */
+    const lwr_real x70 = -LWR_K(0.4)*x54 - x57;
+    const lwr_real x71 = -LWR_K(0.4)*x55 - x60;
+    /* column 3: to joint 2 */
+    const lwr_real x72 = c3*x70 - s3*x71;
+    const lwr_real x73 = c3*x71 + s3*x70;
+    /* column 3: to joint 1 */
+    const lwr_real x74 = c2*x59 + s2*x72;
+    /* column 4: to joint 3 */
+    const lwr_real x75 = c4*x48 + s4*x51;
+    const lwr_real x76 = x50 - LWR_K(0.4)*x53;
+    /* column 4: to joint 2 */
+    const lwr_real x77 = c3*x75 - s3*x76;
+    const lwr_real x78 = c3*x76 + s3*x75;
+    /* column 4: to joint 1 */
+    const lwr_real x79 = -c2*x60 + s2*x77;
+    /* column 5: composite wrench */
+    const lwr_real x80 = -LWR_K(0.39)*x36 + x39;
+    const lwr_real x81 = -LWR_K(0.39)*x37 + x42;
+    /* column 5: to joint 4 */
+    const lwr_real x82 = c5*x80 + s5*x81;
+    const lwr_real x83 = -c5*x81 + s5*x80;
+    /* column 5: to joint 3 */
+    const lwr_real x84 = -c4*x44;
+    const lwr_real x85 = c4*x82 + s4*x41;
+    const lwr_real x86 = -c4*x41 + s4*x82;
+    const lwr_real x87 = -LWR_K(0.4)*x43 + x85;
+    const lwr_real x88 = x83 + LWR_K(0.4)*x84;
+    /* column 5: to joint 2 */
+    const lwr_real x89 = c3*x87 - s3*x88;
+    const lwr_real x90 = c3*x88 + s3*x87;
+    /* column 5: to joint 1 */
+    const lwr_real x91 = -c2*x86 + s2*x89;
+    /* column 6: to joint 5 */
+    const lwr_real x92 = -c6*x30 + s6*x33;
+    const lwr_real x93 = -c6*x33 - s6*x30;
+    const lwr_real x94 = x32 + LWR_K(0.39)*x35;
+    /* column 6: to joint 4 */
+    const lwr_real x95 = -c5*x35;
+    const lwr_real x96 = -s5*x35;
+    const lwr_real x97 = c5*x92 + s5*x94;
+    const lwr_real x98 = -c5*x94 + s5*x92;
+    /* column 6: to joint 3 */
+    const lwr_real x99 = c4*x95 + s4*x34;
+    const lwr_real x100 = c4*x97 + s4*x93;
+    const lwr_real x101 = -c4*x93 + s4*x97;
+    const lwr_real x102 = -LWR_K(0.4)*x96 + x100;
+    const lwr_real x103 = x98 + LWR_K(0.4)*x99;
+    /* column 6: to joint 2 */
+    const lwr_real x104 = c3*x102 - s3*x103;
+    const lwr_real x105 = c3*x103 + s3*x102;
+    /* column 6: to joint 1 */
+    const lwr_real x106 = -c2*x101 + s2*x104;
+    /* column 7: to joint 6 */
+    const lwr_real x107 = s[66]*c7 - s[68]*s7;
+    const lwr_real x108 = s[66]*s7 + s[68]*c7;
+    /* column 7: to joint 5 */
+    const lwr_real x109 = -c6*x27;
+    const lwr_real x110 = -s6*x27;
+    const lwr_real x111 = -s[69]*s6 + c6*x107;
+    const lwr_real x112 = s[69]*c6 + s6*x107;
+    const lwr_real x113 = x111 - LWR_K(0.39)*x26;
+    const lwr_real x114 = -x108 - LWR_K(0.39)*x109;
+    /* column 7: to joint 4 */
+    const lwr_real x115 = c5*x109 - s5*x26;
+    const lwr_real x116 = c5*x26 + s5*x109;
+    const lwr_real x117 = c5*x113 + s5*x114;
+    const lwr_real x118 = -c5*x114 + s5*x113;
+    /* column 7: to joint 3 */
+    const lwr_real x119 = c4*x115 + s4*x110;
+    const lwr_real x120 = c4*x117 + s4*x112;
+    const lwr_real x121 = -c4*x112 + s4*x117;
+    const lwr_real x122 = -LWR_K(0.4)*x116 + x120;
+    const lwr_real x123 = x118 + LWR_K(0.4)*x119;
+    /* column 7: to joint 2 */
+    const lwr_real x124 = c3*x122 - s3*x123;
+    const lwr_real x125 = c3*x123 + s3*x122;
+    /* column 7: to joint 1 */
+    const lwr_real x126 = -c2*x121 + s2*x124;
     /* M */
-    M[0] = x125;
-    M[1] = x218;
-    M[2] = x293;
-    M[3] = x356;
-    M[4] = x399;
-    M[5] = x426;
-    M[6] = x446;
-    M[7] = x218;
-    M[8] = -x216;
-    M[9] = -x292;
-    M[10] = -x355;
-    M[11] = -x398;
-    M[12] = -x425;
-    M[13] = -x445;
-    M[14] = x293;
-    M[15] = -x292;
-    M[16] = -x288;
-    M[17] = -x351;
-    M[18] = -x394;
-    M[19] = -x421;
-    M[20] = -x441;
-    M[21] = x356;
-    M[22] = -x355;
-    M[23] = -x351;
-    M[24] = x347;
-    M[25] = x391;
-    M[26] = x418;
-    M[27] = x438;
-    M[28] = x399;
-    M[29] = -x398;
-    M[30] = -x394;
-    M[31] = x391;
-    M[32] = x384;
-    M[33] = x413;
-    M[34] = x432;
-    M[35] = x426;
-    M[36] = -x425;
-    M[37] = -x421;
-    M[38] = x418;
-    M[39] = x413;
-    M[40] = -x408;
-    M[41] = x403;
-    M[42] = x446;
-    M[43] = -x445;
-    M[44] = -x441;
-    M[45] = x438;
-    M[46] = x432;
-    M[47] = x403;
+    M[0] = x68;
+    M[1] = x69;
+    M[2] = x74;
+    M[3] = x79;
+    M[4] = x91;
+    M[5] = x106;
+    M[6] = x126;
+    M[7] = x69;
+    M[8] = x66;
+    M[9] = -x73;
+    M[10] = -x78;
+    M[11] = -x90;
+    M[12] = -x105;
+    M[13] = -x125;
+    M[14] = x74;
+    M[15] = -x73;
+    M[16] = x59;
+    M[17] = -x60;
+    M[18] = -x86;
+    M[19] = -x101;
+    M[20] = -x121;
+    M[21] = x79;
+    M[22] = -x78;
+    M[23] = -x60;
+    M[24] = x50;
+    M[25] = x83;
+    M[26] = x98;
+    M[27] = x118;
+    M[28] = x91;
+    M[29] = -x90;
+    M[30] = -x86;
+    M[31] = x83;
+    M[32] = x41;
+    M[33] = x93;
+    M[34] = x112;
+    M[35] = x106;
+    M[36] = -x105;
+    M[37] = -x101;
+    M[38] = x98;
+    M[39] = x93;
+    M[40] = x32;
+    M[41] = -x108;
+    M[42] = x126;
+    M[43] = -x125;
+    M[44] = -x121;
+    M[45] = x118;
+    M[46] = x112;
+    M[47] = -x108;
     M[48] = s[69];
 }
 

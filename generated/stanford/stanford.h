@@ -31,7 +31,7 @@
  *   stanford_regressor           402 mul, 259 add, 0 div, 4 sin/cos
  *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix         340 mul, 268 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
  *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
@@ -207,7 +207,7 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
  *   q        [6]  joint positions [rad or m]
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [6 x 6]  row-major, symmetric (written)
- * 340 mul, 268 add, 0 div, 4 sin/cos
+ * 154 mul, 135 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
 

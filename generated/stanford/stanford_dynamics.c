@@ -5,7 +5,7 @@
  *
  *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix         340 mul, 268 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
  *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
  */
 #include "stanford.h"
@@ -359,333 +359,133 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x21 = s[44] + s[57] - s[49] + x19 + x20;
     const stanford_real x22 = s[47] + s[57] + x19 + x20;
     const stanford_real x23 = s[54] - s[57];
-    /* link 2: velocities and accelerations */
-    const stanford_real x24 = -STANFORD_K(0.154)*c2;
-    const stanford_real x25 = -STANFORD_K(0.154)*s2;
-    /* link 3: velocities and accelerations */
-    const stanford_real x26 = -q[2]*s2;
-    /* link 4: velocities and accelerations */
-    const stanford_real x27 = -s2*s4;
-    const stanford_real x28 = -c4*s2;
-    const stanford_real x29 = c4*x26 + s4*x24;
-    const stanford_real x30 = c4*x24 - s4*x26;
-    /* link 5: velocities and accelerations */
-    const stanford_real x31 = -c2*s5 + c5*x27;
-    const stanford_real x32 = c2*c5 + s5*x27;
-    const stanford_real x33 = c5*x29 - s5*x25;
-    const stanford_real x34 = c5*x25 + s5*x29;
-    /* link 6: velocities and accelerations */
-    const stanford_real x35 = c6*x31 + s6*x28;
-    const stanford_real x36 = c6*x28 - s6*x31;
-    const stanford_real x37 = c6*x33 + s6*x30;
-    const stanford_real x38 = c6*x30 - s6*x33;
-    const stanford_real x39 = STANFORD_K(0.263)*x36 + x37;
-    const stanford_real x40 = -STANFORD_K(0.263)*x35 + x38;
-    /* link 2: link wrench */
-    const stanford_real x41 = c2*x10 - s2*x9;
-    const stanford_real x42 = -s2*x10;
-    /* link 3: link wrench */
-    const stanford_real x43 = -c2*s[22] - s2*x13 + x12*x26;
-    const stanford_real x44 = c2*s[21] + x12*x24;
-    const stanford_real x45 = s[21]*s2 + x12*x25;
-    const stanford_real x46 = -s[21]*x25 + x13*x26;
-    const stanford_real x47 = s[21]*x24 - s[22]*x26;
-    /* link 4: link wrench */
-    const stanford_real x48 = -c2*x14;
-    const stanford_real x49 = s[31]*x28 - x14*x27;
-    const stanford_real x50 = c2*s[31];
-    const stanford_real x51 = -s[35]*c2 + s[36]*x28 + x14*x25 + x15*x27;
-    const stanford_real x52 = s[35]*x27 + s[38]*x28 - c2*x16 - s[31]*x30 + x14*x29;
-    const stanford_real x53 = s[36]*x27 - s[38]*c2 - s[31]*x25;
-    /* link 5: link wrench */
-    const stanford_real x54 = x18*x28;
-    const stanford_real x55 = s[41]*x32 - x18*x31;
-    const stanford_real x56 = -s[41]*x28;
-    const stanford_real x57 = s[45]*x28 + s[46]*x32 - x18*x30 + x21*x31;
-    const stanford_real x58 = s[45]*x31 + s[48]*x32 - s[41]*x34 + x18*x33 + x22*x28;
-    const stanford_real x59 = s[46]*x31 + s[48]*x28 + s[41]*x30;
-    /* link 6: link wrench */
-    const stanford_real x60 = -s[52]*x32;
-    const stanford_real x61 = s[51]*x32;
-    const stanford_real x62 = -s[51]*x36 + s[52]*x35;
-    const stanford_real x63 = s[55]*x36 + s[56]*x32 + s[52]*x34 + x23*x35;
-    const stanford_real x64 = s[55]*x35 + s[58]*x32 - s[51]*x34;
-    const stanford_real x65 = s[56]*x35 + s[58]*x36 + s[59]*x32 + s[51]*x40 - s[52]*x39;
-    /* link 6: forces */
-    const stanford_real x66 = -STANFORD_K(0.263)*x61 + x63;
-    const stanford_real x67 = STANFORD_K(0.263)*x60 + x64;
-    const stanford_real x68 = c6*x60 - s6*x61;
-    const stanford_real x69 = c6*x61 + s6*x60;
-    const stanford_real x70 = c6*x66 - s6*x67;
-    const stanford_real x71 = c6*x67 + s6*x66;
-    /* link 5: forces */
-    const stanford_real x72 = x54 + x68;
-    const stanford_real x73 = x55 + x69;
-    const stanford_real x74 = x56 + x62;
-    const stanford_real x75 = x57 + x70;
-    const stanford_real x76 = x58 + x71;
-    const stanford_real x77 = x59 + x65;
-    const stanford_real x78 = c5*x72 + s5*x74;
-    const stanford_real x79 = -c5*x74 + s5*x72;
-    const stanford_real x80 = c5*x75 + s5*x77;
-    const stanford_real x81 = -c5*x77 + s5*x75;
-    /* link 4: forces */
-    const stanford_real x82 = x48 + x78;
-    const stanford_real x83 = x49 + x79;
-    const stanford_real x84 = x50 + x73;
-    const stanford_real x85 = x51 + x80;
-    const stanford_real x86 = x52 + x81;
-    const stanford_real x87 = x53 + x76;
-    const stanford_real x88 = c4*x82 - s4*x84;
-    const stanford_real x89 = c4*x84 + s4*x82;
-    const stanford_real x90 = c4*x87 + s4*x85;
-    /* link 3: forces */
-    const stanford_real x91 = x43 + x88;
-    const stanford_real x92 = x44 + x89;
-    const stanford_real x93 = x45 - x83;
-    const stanford_real x94 = x46 + x90;
-    const stanford_real x95 = x47 - x86;
-    const stanford_real x96 = q[2]*x91 + x94;
-    /* link 2: forces */
-    const stanford_real x97 = x96 + x41;
-    const stanford_real x98 = x95 + x42;
-    const stanford_real x99 = x97 + STANFORD_K(0.154)*x93;
-    const stanford_real x100 = x98 - STANFORD_K(0.154)*x92;
-    const stanford_real x101 = -c2*x100 + s2*x99;
-    /* link 1: forces */
-    const stanford_real x102 = x101 - x2;
-    /* link 4: velocities and accelerations */
-    const stanford_real x103 = q[2]*s4;
-    const stanford_real x104 = c4*q[2];
-    /* link 5: velocities and accelerations */
-    const stanford_real x105 = -c4*c5;
-    const stanford_real x106 = -c4*s5;
-    const stanford_real x107 = c5*x103;
-    const stanford_real x108 = s5*x103;
-    /* link 6: velocities and accelerations */
-    const stanford_real x109 = c6*x105 + s4*s6;
-    const stanford_real x110 = c6*s4 - s6*x105;
-    const stanford_real x111 = c6*x107 + s6*x104;
-    const stanford_real x112 = c6*x104 - s6*x107;
-    const stanford_real x113 = STANFORD_K(0.263)*x110 + x111;
-    const stanford_real x114 = -STANFORD_K(0.263)*x109 + x112;
-    /* link 3: link wrench */
-    const stanford_real x115 = q[2]*x12 + x13;
-    const stanford_real x116 = -q[2]*x13;
-    const stanford_real x117 = s[21]*q[2];
-    /* link 4: link wrench */
-    const stanford_real x118 = c4*x14 + s[31]*s4;
-    const stanford_real x119 = s[36]*s4 - c4*x15;
-    const stanford_real x120 = -s[35]*c4 + s[38]*s4 - s[31]*x104 + x103*x14;
-    const stanford_real x121 = -s[36]*c4;
-    /* link 5: link wrench */
-    const stanford_real x122 = s4*x18;
-    const stanford_real x123 = s[41]*x106 - x105*x18;
-    const stanford_real x124 = -s[41]*s4;
-    const stanford_real x125 = s[45]*s4 + s[46]*x106 - x104*x18 + x105*x21;
-    const stanford_real x126 = s[45]*x105 + s[48]*x106 - s[41]*x108 + s4*x22 + x107*x18;
-    const stanford_real x127 = s[46]*x105 + s[48]*s4 + s[41]*x104;
-    /* link 6: link wrench */
-    const stanford_real x128 = -s[52]*x106;
-    const stanford_real x129 = s[51]*x106;
-    const stanford_real x130 = -s[51]*x110 + s[52]*x109;
-    const stanford_real x131 = s[55]*x110 + s[56]*x106 + s[52]*x108 + x109*x23;
-    const stanford_real x132 = s[55]*x109 + s[58]*x106 - s[51]*x108;
-    const stanford_real x133 = s[56]*x109 + s[58]*x110 + s[59]*x106 + s[51]*x114 - s[52]*x113;
-    /* link 6: forces */
-    const stanford_real x134 = -STANFORD_K(0.263)*x129 + x131;
-    const stanford_real x135 = STANFORD_K(0.263)*x128 + x132;
-    const stanford_real x136 = c6*x128 - s6*x129;
-    const stanford_real x137 = c6*x129 + s6*x128;
-    const stanford_real x138 = c6*x134 - s6*x135;
-    const stanford_real x139 = c6*x135 + s6*x134;
-    /* link 5: forces */
-    const stanford_real x140 = x122 + x136;
-    const stanford_real x141 = x123 + x137;
-    const stanford_real x142 = x124 + x130;
-    const stanford_real x143 = x125 + x138;
-    const stanford_real x144 = x126 + x139;
-    const stanford_real x145 = x127 + x133;
-    const stanford_real x146 = c5*x140 + s5*x142;
-    const stanford_real x147 = -c5*x142 + s5*x140;
-    const stanford_real x148 = c5*x143 + s5*x145;
-    const stanford_real x149 = -c5*x145 + s5*x143;
-    /* link 4: forces */
-    const stanford_real x150 = x118 + x147;
-    const stanford_real x151 = x119 + x148;
-    const stanford_real x152 = x120 + x149;
-    const stanford_real x153 = x121 + x144;
-    const stanford_real x154 = c4*x146 - s4*x141;
-    const stanford_real x155 = c4*x141 + s4*x146;
-    const stanford_real x156 = c4*x151 - s4*x153;
-    const stanford_real x157 = c4*x153 + s4*x151;
-    /* link 3: forces */
-    const stanford_real x158 = x115 + x155;
-    const stanford_real x159 = -s[22] - x150;
-    const stanford_real x160 = x116 + x156;
-    const stanford_real x161 = x117 - x152;
-    const stanford_real x162 = -q[2]*x158 + x160;
-    const stanford_real x163 = q[2]*x154 + x157;
-    /* link 2: forces */
-    const stanford_real x164 = x158 + x8;
-    const stanford_real x165 = x159 - x5;
-    const stanford_real x166 = x11 - x162;
-    const stanford_real x167 = x163 + STANFORD_K(0.154)*x165;
-    const stanford_real x168 = x161 - STANFORD_K(0.154)*x164;
-    const stanford_real x169 = -c2*x168 + s2*x167;
-    /* link 6: velocities and accelerations */
-    const stanford_real x170 = -c6*s5;
-    const stanford_real x171 = s5*s6;
-    /* link 5: link wrench */
-    const stanford_real x172 = -c5*s[41] - s5*x18;
-    /* link 6: link wrench */
-    const stanford_real x173 = c5*s[52];
-    const stanford_real x174 = -c5*s[51];
-    const stanford_real x175 = s[51]*x171 - s[52]*x170;
-    /* link 6: forces */
-    const stanford_real x176 = c6*x173 - s6*x174;
-    const stanford_real x177 = c6*x174 + s6*x173;
-    /* link 5: forces */
-    const stanford_real x178 = x172 + x177;
-    const stanford_real x179 = c5*x176 + s5*x175;
-    const stanford_real x180 = -c5*x175 + s5*x176;
-    /* link 4: forces */
-    const stanford_real x181 = x14 + x179;
-    const stanford_real x182 = -s[31] + x178;
-    const stanford_real x183 = c4*x181 - s4*x182;
-    const stanford_real x184 = c4*x182 + s4*x181;
-    /* link 3: forces */
-    const stanford_real x185 = s[22] + x183;
-    const stanford_real x186 = -s[21] + x184;
-    /* link 2: forces */
-    const stanford_real x187 = STANFORD_K(0.154)*x12 + x186;
-    const stanford_real x188 = c2*x180 + s2*x187;
-    /* link 6: velocities and accelerations */
-    const stanford_real x189 = STANFORD_K(0.263)*x171;
-    const stanford_real x190 = -STANFORD_K(0.263)*x170;
-    /* link 5: link wrench */
-    const stanford_real x191 = s[46]*c5 - s5*x21;
-    const stanford_real x192 = -s[45]*s5 + s[48]*c5;
-    const stanford_real x193 = -s[46]*s5;
-    /* link 6: link wrench */
-    const stanford_real x194 = s[55]*x171 + s[56]*c5 + x170*x23;
-    const stanford_real x195 = s[55]*x170 + s[58]*c5;
-    const stanford_real x196 = s[56]*x170 + s[58]*x171 + s[59]*c5 + s[51]*x190 - s[52]*x189;
-    /* link 6: forces */
-    const stanford_real x197 = STANFORD_K(0.263)*x174 + x194;
-    const stanford_real x198 = -STANFORD_K(0.263)*x173 + x195;
-    const stanford_real x199 = c6*x197 - s6*x198;
-    const stanford_real x200 = c6*x198 + s6*x197;
-    /* link 5: forces */
-    const stanford_real x201 = x191 + x199;
-    const stanford_real x202 = x192 + x200;
-    const stanford_real x203 = x193 + x196;
-    const stanford_real x204 = c5*x201 + s5*x203;
-    const stanford_real x205 = -c5*x203 + s5*x201;
-    /* link 4: forces */
-    const stanford_real x206 = -s[35] + x204;
-    const stanford_real x207 = -x16 + x205;
-    const stanford_real x208 = -s[38] + x202;
-    const stanford_real x209 = c4*x206 - s4*x208;
-    const stanford_real x210 = c4*x208 + s4*x206;
-    /* link 3: forces */
-    const stanford_real x211 = q[2]*x184 + x209;
-    const stanford_real x212 = -q[2]*x183 + x210;
-    /* link 2: forces */
-    const stanford_real x213 = STANFORD_K(0.154)*x180 + x212;
-    const stanford_real x214 = STANFORD_K(0.154)*x184 - x207;
-    const stanford_real x215 = -c2*x214 + s2*x213;
-    /* link 6: velocities and accelerations */
-    const stanford_real x216 = STANFORD_K(0.263)*c6;
-    const stanford_real x217 = -STANFORD_K(0.263)*s6;
-    /* link 6: link wrench */
-    const stanford_real x218 = -c6*s[51] + s[52]*s6;
-    const stanford_real x219 = s[55]*c6 + s6*x23;
-    const stanford_real x220 = s[55]*s6;
-    const stanford_real x221 = s[56]*s6 + s[58]*c6 + s[51]*x217 - s[52]*x216;
-    /* link 6: forces */
-    const stanford_real x222 = c6*x219 - s6*x220;
-    const stanford_real x223 = c6*x220 + s6*x219;
-    /* link 5: forces */
-    const stanford_real x224 = -s[41] + x218;
-    const stanford_real x225 = s[45] + x222;
-    const stanford_real x226 = x22 + x223;
-    const stanford_real x227 = s[48] + x221;
-    const stanford_real x228 = c5*x18 + s5*x224;
-    const stanford_real x229 = -c5*x224 + s5*x18;
-    const stanford_real x230 = c5*x225 + s5*x227;
-    const stanford_real x231 = -c5*x227 + s5*x225;
-    /* link 4: forces */
-    const stanford_real x232 = c4*x228;
-    const stanford_real x233 = s4*x228;
-    const stanford_real x234 = c4*x230 - s4*x226;
-    const stanford_real x235 = c4*x226 + s4*x230;
-    /* link 3: forces */
-    const stanford_real x236 = -q[2]*x233 + x234;
-    const stanford_real x237 = q[2]*x232 + x235;
-    /* link 2: forces */
-    const stanford_real x238 = -STANFORD_K(0.154)*x229 + x237;
-    const stanford_real x239 = -x231 - STANFORD_K(0.154)*x233;
-    const stanford_real x240 = -c2*x239 + s2*x238;
-    /* link 6: forces */
-    const stanford_real x241 = s[56] - STANFORD_K(0.263)*s[51];
-    const stanford_real x242 = s[58] - STANFORD_K(0.263)*s[52];
-    const stanford_real x243 = -c6*s[52] - s[51]*s6;
-    const stanford_real x244 = c6*x241 - s6*x242;
-    const stanford_real x245 = c6*x242 + s6*x241;
-    /* link 5: forces */
-    const stanford_real x246 = c5*x243;
-    const stanford_real x247 = s5*x243;
-    const stanford_real x248 = s[59]*s5 + c5*x244;
-    const stanford_real x249 = -s[59]*c5 + s5*x244;
-    /* link 4: forces */
-    const stanford_real x250 = c4*x246 + s4*x218;
-    const stanford_real x251 = -c4*x218 + s4*x246;
-    const stanford_real x252 = c4*x248 - s4*x245;
-    const stanford_real x253 = c4*x245 + s4*x248;
-    /* link 3: forces */
-    const stanford_real x254 = -q[2]*x251 + x252;
-    const stanford_real x255 = q[2]*x250 + x253;
-    /* link 2: forces */
-    const stanford_real x256 = -STANFORD_K(0.154)*x247 + x255;
-    const stanford_real x257 = -x249 - STANFORD_K(0.154)*x251;
-    const stanford_real x258 = -c2*x257 + s2*x256;
+    /* link 5: composite body */
+    const stanford_real x24 = c6*s[51] - s[52]*s6;
+    const stanford_real x25 = c6*s[52] + s[51]*s6;
+    const stanford_real x26 = s[41] + x24;
+    const stanford_real x27 = c6*(-2*s[55]*s6 + c6*x23) + x21;
+    const stanford_real x28 = s[45] + s[55]*c6*c6 + s6*(-s[55]*s6 + c6*x23);
+    const stanford_real x29 = s[46] + s[56]*c6 - s[58]*s6 - STANFORD_K(0.263)*x24;
+    const stanford_real x30 = s6*(2*s[55]*c6 + s6*x23) + x22;
+    const stanford_real x31 = s[56]*s6 + s[48] + s[58]*c6 - STANFORD_K(0.263)*x25;
+    /* link 4: composite body */
+    const stanford_real x32 = c5*x26 + s5*x18;
+    const stanford_real x33 = -c5*x18 + s5*x26;
+    const stanford_real x34 = s[31] + x32;
+    const stanford_real x35 = x14 + x25;
+    const stanford_real x36 = c5*(c5*x27 + s5*x29) + s5*(s[59]*s5 + c5*x29) + x15;
+    const stanford_real x37 = s[35] - c5*(s[59]*s5 + c5*x29) + s5*(c5*x27 + s5*x29);
+    const stanford_real x38 = s[36] + c5*x28 + s5*x31;
+    const stanford_real x39 = -c5*(-s[59]*c5 + s5*x29) + s5*(-c5*x29 + s5*x27) + x16;
+    const stanford_real x40 = s[38] - c5*x31 + s5*x28;
+    /* link 3: composite body */
+    const stanford_real x41 = c4*x34 - s4*x35;
+    const stanford_real x42 = c4*x35 + s4*x34;
+    const stanford_real x43 = s[21] + x41;
+    const stanford_real x44 = s[22] + x42;
+    const stanford_real x45 = x13 - x33;
+    const stanford_real x46 = c4*(c4*x36 - s4*x38) - s4*(c4*x38 - s4*x30);
+    const stanford_real x47 = c4*(c4*x38 - s4*x30) + s4*(c4*x36 - s4*x38);
+    const stanford_real x48 = -c4*x37 + s4*x40;
+    const stanford_real x49 = c4*(c4*x30 + s4*x38) + s4*(c4*x38 + s4*x36);
+    const stanford_real x50 = -c4*x40 - s4*x37;
+    /* link 2: composite body */
+    const stanford_real x51 = x44 + x5;
+    const stanford_real x52 = q[2]*x12 + x45 + x8;
+    const stanford_real x53 = q[2]*q[2]*x12 + 2*q[2]*x45 + x49 + x9;
+    const stanford_real x54 = -q[2]*x44 + x10 + x50;
+    const stanford_real x55 = q[2]*q[2]*x12 + 2*q[2]*x45 + x11 + x46;
+    const stanford_real x56 = q[2]*x43 - x48;
+    /* link 1: composite body */
+    const stanford_real x57 = STANFORD_K(0.154)*x12 - x43;
+    const stanford_real x58 = -c2*(-c2*x39 + s2*x54) + s2*(-c2*x54 + s2*x53) + STANFORD_K(0.023716)*x12 + x2 - STANFORD_K(0.308)*x43;
+    /* column 2: composite wrench */
+    const stanford_real x59 = -x47 - STANFORD_K(0.154)*x51;
+    const stanford_real x60 = -STANFORD_K(0.154)*x52 + x56;
+    /* column 2: to joint 1 */
+    const stanford_real x61 = -c2*x60 + s2*x59;
+    /* column 3: to joint 1 */
+    const stanford_real x62 = s2*x57;
+    /* column 4: to joint 2 */
+    const stanford_real x63 = -q[2]*x41 + x48;
+    const stanford_real x64 = -q[2]*x42 + x50;
+    const stanford_real x65 = x39 - STANFORD_K(0.154)*x41;
+    /* column 4: to joint 1 */
+    const stanford_real x66 = -c2*x65 + s2*x64;
+    /* column 5: to joint 4 */
+    const stanford_real x67 = c5*x28 + s5*x31;
+    const stanford_real x68 = -c5*x31 + s5*x28;
+    /* column 5: to joint 3 */
+    const stanford_real x69 = -c4*x33;
+    const stanford_real x70 = -s4*x33;
+    const stanford_real x71 = c4*x67 - s4*x30;
+    const stanford_real x72 = c4*x30 + s4*x67;
+    /* column 5: to joint 2 */
+    const stanford_real x73 = -q[2]*x70 + x71;
+    const stanford_real x74 = q[2]*x69 + x72;
+    const stanford_real x75 = -STANFORD_K(0.154)*x32 + x74;
+    const stanford_real x76 = -x68 - STANFORD_K(0.154)*x70;
+    /* column 5: to joint 1 */
+    const stanford_real x77 = -c2*x76 + s2*x75;
+    /* column 6: composite wrench */
+    const stanford_real x78 = s[56] - STANFORD_K(0.263)*s[51];
+    const stanford_real x79 = s[58] - STANFORD_K(0.263)*s[52];
+    /* column 6: to joint 5 */
+    const stanford_real x80 = c6*x78 - s6*x79;
+    const stanford_real x81 = c6*x79 + s6*x78;
+    /* column 6: to joint 4 */
+    const stanford_real x82 = -c5*x25;
+    const stanford_real x83 = -s5*x25;
+    const stanford_real x84 = s[59]*s5 + c5*x80;
+    const stanford_real x85 = -s[59]*c5 + s5*x80;
+    /* column 6: to joint 3 */
+    const stanford_real x86 = c4*x82 - s4*x24;
+    const stanford_real x87 = c4*x24 + s4*x82;
+    const stanford_real x88 = c4*x84 - s4*x81;
+    const stanford_real x89 = c4*x81 + s4*x84;
+    /* column 6: to joint 2 */
+    const stanford_real x90 = -q[2]*x87 + x88;
+    const stanford_real x91 = q[2]*x86 + x89;
+    const stanford_real x92 = -STANFORD_K(0.154)*x83 + x91;
+    const stanford_real x93 = -x85 - STANFORD_K(0.154)*x87;
+    /* column 6: to joint 1 */
+    const stanford_real x94 = -c2*x93 + s2*x92;
     /* M */
-    M[0] = -x102;
-    M[1] = -x169;
-    M[2] = -x188;
-    M[3] = -x215;
-    M[4] = -x240;
-    M[5] = -x258;
-    M[6] = -x169;
-    M[7] = x166;
-    M[8] = -x185;
-    M[9] = -x211;
-    M[10] = -x236;
-    M[11] = -x254;
-    M[12] = -x188;
-    M[13] = -x185;
+    M[0] = x58;
+    M[1] = -x61;
+    M[2] = -x62;
+    M[3] = -x66;
+    M[4] = -x77;
+    M[5] = -x94;
+    M[6] = -x61;
+    M[7] = x55;
+    M[8] = -x44;
+    M[9] = -x63;
+    M[10] = -x73;
+    M[11] = -x90;
+    M[12] = -x62;
+    M[13] = -x44;
     M[14] = x12;
-    M[15] = x180;
-    M[16] = -x229;
-    M[17] = -x247;
-    M[18] = -x215;
-    M[19] = -x211;
-    M[20] = x180;
-    M[21] = -x207;
-    M[22] = -x231;
-    M[23] = -x249;
-    M[24] = -x240;
-    M[25] = -x236;
-    M[26] = -x229;
-    M[27] = -x231;
-    M[28] = x226;
-    M[29] = x245;
-    M[30] = -x258;
-    M[31] = -x254;
-    M[32] = -x247;
-    M[33] = -x249;
-    M[34] = x245;
+    M[15] = 0;
+    M[16] = -x32;
+    M[17] = -x83;
+    M[18] = -x66;
+    M[19] = -x63;
+    M[20] = 0;
+    M[21] = x39;
+    M[22] = -x68;
+    M[23] = -x85;
+    M[24] = -x77;
+    M[25] = -x73;
+    M[26] = -x32;
+    M[27] = -x68;
+    M[28] = x30;
+    M[29] = x81;
+    M[30] = -x94;
+    M[31] = -x90;
+    M[32] = -x83;
+    M[33] = -x85;
+    M[34] = x81;
     M[35] = s[59];
 }
 

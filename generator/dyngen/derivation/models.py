@@ -15,6 +15,7 @@ import sympy as sp
 from ..catalogue import ARGUMENTS
 from ..description import Robot
 from ..parameters import PER_LINK, dynamic_symbols, standard_from_dynamic_link, standard_symbols
+from .composite import mass_matrix_columns
 from .newton_euler import Chain, joint_symbols, link_wrench
 from .program import Program
 
@@ -105,13 +106,7 @@ class Derivation:
 
     def mass_matrix(self, base=None) -> Model:
         program, sym, chain = self._start()
-        params = self._grouped(program, base)
-        M = sp.zeros(self.n, self.n)
-        for k in range(self.n):
-            unit = [int(j == k) for j in range(self.n)]
-            column = self._tau(program, chain, chain.forward([0] * self.n, unit, [0, 0, 0]), params)
-            for j in range(k + 1):
-                M[j, k] = M[k, j] = column[j]
+        M = mass_matrix_columns(chain, self._grouped(program, base))  # composite bodies (derivation/composite.py)
         return Model("mass_matrix", self._joint_inputs(sym, "q") + [self._params_input()], list(M),
                      (self.n, self.n), "inertia matrix M(q), row-major", program, sym.trig)
 
