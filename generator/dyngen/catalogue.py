@@ -55,11 +55,14 @@ class Output:
 class Check:
     """How the self-test checks a function: its output (times the output of `times`, for a
     regressor) against the values embedded for function `expected` (its own when empty);
-    `stacked`: compared with the upper triangle of a square expected matrix, row by row."""
+    `stacked`: compared with the upper triangle of a square expected matrix, row by row;
+    `size`: a regressor whose |Y| |pi| (with its coefficients) sizes the error instead of the
+    expected values (a sum over base coefficients can cancel in float)."""
 
     expected: str = ""
     times: str = ""
     stacked: bool = False
+    size: str = ""
 
 
 @dataclass(frozen=True)
@@ -126,7 +129,7 @@ INVERSE_DYNAMICS = Function(
     "inverse_dynamics", "dynamics", "inverse_dynamics", ("q", "qd", "qdd", "pi_full", "gravity"),
     Output("tau", ("dof",), "joint torques/forces", "Joints"),
     "Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the "
-    "grouped parameters (for controllers that hold identified coefficients).", Check("rnea"))
+    "grouped parameters (for controllers that hold identified coefficients).", Check("rnea", size="regressor"))
 FRICTION = Function(
     "friction", "friction", "template", ("qd", "f"),
     Output("tau", ("dof",), "friction torques", "Joints"),

@@ -127,6 +127,12 @@ def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
                  "call": f"{prefix}_{fn.name}({', '.join(args)})", "expected": f"{BY_NAME[fn.expected].name}_expected",
                  "label": fn.name, "times": None, "stacked": fn.check.stacked,
                  "own": not fn.check.expected}  # whether its expected values are its own (declared once)
+        check["size"] = None
+        if fn.check.size:  # |Y| |pi| of that regressor, computed at the same state before this check
+            regressor = BY_NAME[fn.check.size]
+            rows, cols = (dims[d] for d in regressor.output.shape)
+            check["size"] = {"Y": f"{regressor.name}_out", "pi": f"{regressor.check.times}_out", "rows": rows,
+                             "cols": cols}
         if fn.check.times:
             rows, cols = (dims[d] for d in fn.output.shape)
             check["times"] = {"out": f"{fn.check.times}_out", "rows": rows, "cols": cols}
