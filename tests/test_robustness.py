@@ -172,7 +172,8 @@ def driver_source(manifest: dict, robot) -> str:
         size = math.prod(f["output"]["shape"])
         outputs.append(f"    real *{out} = block({size});")
         frees.append(f"    free({out});")
-        args = [i["name"] for i in f["inputs"]] + [out]
+        feeds = {"pi_full": f"out_{prefix}_pi_full"}  # an input that another function's output gives
+        args = [feeds.get(i["name"], i["name"]) for i in f["inputs"]] + [out]
         if f["name"] == f"{prefix}_standard_from_dynamic":  # its output s feeds the dynamics functions
             args[-1] = "s"
         call = f"{f['name']}({', '.join(args)})"
