@@ -3,8 +3,12 @@
 divisions and sin/cos, as dyngen's emitter counts them in the C it writes (manifest.json;
 the rule: generator/dyngen/emission/opcount.py). Each arm is generated afresh into a
 temporary folder, so the table describes the current generator, not a committed folder.
+Beside each count: the float32 build's error against the double build (<ROBOT>_USE_FLOAT,
+dyngen.runtime), the worst normwise relative error max_k |f_k - d_k| / max_k |d_k| over
+--states random states (float-representable inputs, so the difference is the float
+computation alone; 10 random consistent parameter sets, one per tenth of the states).
 
-    python bench/bench_opcounts.py [--arms lwr panda ...]
+    python bench/bench_opcounts.py [--arms lwr panda ...] [--states 100000]
 
 Writes bench/results/opcounts.md and opcounts.json.
 """
@@ -20,21 +24,76 @@ ROOT = BENCH.parent
 from common import arguments, log  # noqa: E402  (bench/ is sys.path[0])
 
 
-def arm_counts(yaml_path: Path, tmp: Path) -> dict:
-    """{"name", "dof", "functions": {short name: ops}} of one freshly generated arm."""
+def arm_counts(yaml_path: Path, tmp: Path, states: int) -> dict:
+    """{"name", "dof", "functions": {short name: ops}, "float_error": {short name: error}} of one
+    freshly generated arm."""
     from dyngen.generate import generate
 
-    manifest = json.loads((generate(yaml_path, tmp).folder / "manifest.json").read_text())
+    folder = generate(yaml_path, tmp).folder
+    manifest = json.loads((folder / "manifest.json").read_text())
     prefix = manifest["robot"] + "_"
     return {"name": manifest["robot"], "dof": manifest["dof"],
-            "functions": {f["name"][len(prefix):]: f["ops"] for f in manifest["functions"]}}
+            "functions": {f["name"][len(prefix):]: f["ops"] for f in manifest["functions"]},
+            "float_error": float_errors(folder, manifest, states, tmp) if states else {}}
 
 
-def cell(ops: dict | None) -> str:
+PARAMETER_SETS = 10
+CHUNK = 2000  # states per batch call (the inertia regressor's output is large)
+
+
+def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
+    """Worst normwise relative error of the float build against the double build, per function."""
+    import numpy as np
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from oracles.random_params import random_parameters
+
+    from dyngen.runtime import load
+
+    double = load(folder, cache_dir=tmp / "double")
+    single = load(folder, cache_dir=tmp / "float", real="float")
+    n, prefix = manifest["dof"], manifest["robot"] + "_"
+    revolute = np.array([t == "revolute" for t in manifest["joint_types"]])
+    n_gravity = len(manifest["gravity_symbols"])
+    rng = np.random.default_rng(7)
+    worst: dict = {}
+
+    def f32(a):
+        return np.asarray(a, dtype=np.float32).astype(np.float64)
+
+    def compare(name, inputs):
+        d = double.batch(name, *inputs).reshape(len(inputs[0]) if inputs[0].ndim == 2 else 1, -1)
+        f = single.batch(name, *inputs).astype(np.float64).reshape(d.shape)
+        scale = np.max(np.abs(d), axis=1)
+        err = np.max(np.abs(f - d), axis=1) / np.where(scale > 0, scale, 1.0)
+        worst[name] = max(worst.get(name, 0.0), float(err.max()))
+
+    per_set = max(1, states // PARAMETER_SETS)
+    for _ in range(PARAMETER_SETS):
+        p = f32(random_parameters(n, seed=rng))
+        values = {"p": p, "s": f32(double("standard_from_dynamic", p)), "pi_full": f32(double("pi_full", p))}
+        for done in range(0, per_set, CHUNK):
+            T = min(CHUNK, per_set - done)
+            q = np.where(revolute, rng.uniform(-np.pi, np.pi, (T, n)), rng.uniform(0.2, 1.0, (T, n)))
+            values |= {"q": f32(q), "qd": f32(rng.uniform(-2, 2, (T, n))), "qdd": f32(rng.uniform(-5, 5, (T, n))),
+                       "gravity": f32(9.81 * rng.standard_normal((T, n_gravity))),
+                       "f": f32(np.column_stack([rng.uniform(0, 2, (T * n)), rng.uniform(0, 1, T * n),
+                                                 rng.uniform(0, 1, T * n), rng.uniform(0.01, 0.5, T * n),
+                                                 rng.uniform(1e-3, 0.05, T * n)]).reshape(T, -1))}
+            for fn in manifest["functions"]:
+                names = [i["name"] for i in fn["inputs"]]
+                if set(names) <= {"p"} and done:
+                    continue  # a function of p alone: once per parameter set
+                compare(fn["name"][len(prefix):], [values[x] for x in names])
+    return worst
+
+
+def cell(ops: dict | None, error: float | None = None) -> str:
+    suffix = f"; f32 {error:.0e}" if error is not None else ""
     if ops is None:  # the friction routine: a loop with branches, no straight-line count
-        return "loop, not counted"
+        return "loop, not counted" + suffix
     text = f"{ops['mul']} / {ops['add']} / {ops['sin_cos']}"
-    return text + (f" (+{ops['div']} div)" if ops["div"] else "")
+    return text + (f" (+{ops['div']} div)" if ops["div"] else "") + suffix
 
 
 def table(arms: list) -> str:
@@ -44,8 +103,8 @@ def table(arms: list) -> str:
     lines = ["| function | " + " | ".join(f"{a['name']} ({a['dof']})" for a in arms) + " |",
              "|---|" + "---:|" * len(arms)]
     for f in functions:
-        lines.append(f"| `<arm>_{f}` | " + " | ".join(cell(a["functions"][f]) if f in a["functions"] else "-"
-                                                       for a in arms) + " |")
+        lines.append(f"| `<arm>_{f}` | " + " | ".join(cell(a["functions"][f], a["float_error"].get(f))
+                                                       if f in a["functions"] else "-" for a in arms) + " |")
     return "\n".join(lines)
 
 
@@ -56,17 +115,24 @@ def main(argv=None) -> int:
     ap.add_argument("--arms", nargs="+", help="example names or YAML paths; default: all examples")
     ap.add_argument("--output", default=str(BENCH / "results" / "opcounts.md"),
                     help="markdown results (default bench/results/opcounts.md; the .json next to it); '' to skip")
+    ap.add_argument("--states", type=int, default=100_000,
+                    help="random states for the float32 error (default 100000; 0: no float build)")
     args = ap.parse_args(argv)
     names = args.arms or example_arms()
     with tempfile.TemporaryDirectory(prefix="dyngen-bench-ops-") as tmp:
         arms = []
         for name in names:
             log(f"generating {name} ...")
-            arms.append(arm_counts(arm_yaml(name), Path(tmp)))
+            arms.append(arm_counts(arm_yaml(name), Path(tmp) / name, args.states))
     text = ("# Operation counts of the generated functions\n\n"
             "Written by `python bench/bench_opcounts.py`. Each cell: multiplications / additions (subtractions "
             "included) / sin and cos calls, counted in the emitted C (divisions noted where there are any); "
-            "the column head gives the number of joints. Straight-line code is counted as printed; "
+            "the column head gives the number of joints; `f32`: the float32 build's worst normwise relative "
+            f"error against the double build over {args.states} random states (max_k |f_k - d_k| / max_k |d_k|; "
+            "for `inverse_dynamics` the base coefficients' own size matters: a coefficient like m + MY/0.0203 "
+            "(PUMA 560) makes the sum Y pi cancel, tests/test_float_build.py). The sin/cos column counts "
+            "calls: one per angle whose sine and cosine are both needed (a polynomial sincos in the emitted "
+            "C, emission/c_code.py). Straight-line code is counted as printed; "
             "`<arm>_regressor_inertia` (Y_m) is straight-line link motions plus a loop over its base columns, "
             "counted as the motions' operations plus each column's loop trips times its loop body "
             "(generator/dyngen/emission/inertia_regressor.py; index arithmetic not counted).\n\n"

@@ -8,9 +8,13 @@
 //   harness time      MODELS_DIR STATES BATCHES WARMUP
 //       verify on every state, then per arm and function print
 //       TIME <arm> <function> <dyngen ns/call> <pinocchio ns/call>   (medians over batches)
+//       TIME <arm> <function> <dyngen> <pinocchio> <casadi> <casadi baked>   (ns/call, nan: no such side)
 //   harness callgrind MODELS_DIR STATES ARM FUNCTION SIDE CALLS
 //       the same set-up (model, states, a short verification that calls every function),
 //       then CALLS calls of one function on one side (CALLS = 0: the baseline run).
+// SIDE: dyngen, pinocchio, casadi (CasADi-generated C of a plain Newton-Euler over SX with the
+// body parameters as an input, bench/casadi_side.py) or casadi_baked (the same, parameters
+// baked in as numbers); the CasADi sides exist for rnea, gravity and mass_matrix only.
 //
 // The compared pairs (FUNCTION):
 //   rnea         <arm>_rnea                                vs pinocchio::rnea
@@ -42,6 +46,9 @@ volatile double g_sink;  // every call's result feeds this, so no call can be dr
 const double kTolerance = 1e-9;  // |dyngen - pinocchio| / max(1, |pinocchio|)
 
 enum Fn { RNEA, GRAVITY, YG_PIG, MASS_MATRIX, YM_PIM, REGRESSOR, N_FN };
+enum Side { DYNGEN, PINOCCHIO, CASADI, CASADI_BAKED, N_SIDE };
+const char *const kSideNames[N_SIDE] = {"dyngen", "pinocchio", "casadi", "casadi_baked"};
+constexpr bool has_side(int f, int side) { return side < CASADI || f == RNEA || f == GRAVITY || f == MASS_MATRIX; }
 const char *const kFnNames[N_FN] = {"rnea", "gravity", "yg_pig", "mass_matrix", "ym_pim", "regressor"};
 
 int fn_from_name(const std::string &name) {
@@ -156,6 +163,32 @@ inline double dyngen_call(Setup<A> &S, int k) {
   return acc;
 }
 
+// The CasADi functions (casadi_side.py): the same outputs as dyngen's (M full, row-major);
+// the parameter variant reads Pinocchio's body parameters (the same model as Pinocchio's).
+template <class A, int F, bool Baked>
+inline double casadi_call(Setup<A> &S, int k) {
+  const int n = A::n;
+  double acc = 0.0;
+  if constexpr (F == RNEA) {
+    if constexpr (Baked) A::casb_rnea(S.Q(k), S.QD(k), S.QDD(k), S.out.data());
+    else A::cas_rnea(S.Q(k), S.QD(k), S.QDD(k), S.pin_params.data(), S.out.data());
+    for (int i = 0; i < n; ++i) acc += S.out[i];
+  } else if constexpr (F == GRAVITY) {
+    if constexpr (Baked) A::casb_gravity(S.Q(k), S.out.data());
+    else A::cas_gravity(S.Q(k), S.pin_params.data(), S.out.data());
+    for (int i = 0; i < n; ++i) acc += S.out[i];
+  } else if constexpr (F == MASS_MATRIX) {
+    if constexpr (Baked) A::casb_mass_matrix(S.Q(k), S.out.data());
+    else A::cas_mass_matrix(S.Q(k), S.pin_params.data(), S.out.data());
+    for (int i = 0; i < n; ++i)
+      for (int j = i; j < n; ++j) acc += S.out[(size_t)i * n + j];
+  }
+  return acc;
+}
+
+template <class A, int F>
+inline double side_call(Setup<A> &S, int side, int k);
+
 template <class A, int F>
 inline double pinocchio_call(Setup<A> &S, int k) {
   const int n = A::n;
@@ -187,6 +220,7 @@ template <class A>
 bool verify(Setup<A> &S, int count, bool print) {
   const int n = A::n;
   double err[N_FN + 1] = {0.0};  // the last: Pinocchio's regressor times its parameters vs rnea
+  double cas_err[2][N_FN] = {{0.0}};  // CasADi with parameters, baked
   std::vector<double> v((size_t)n * n), tau(n);
   auto upper = [&](const double *M_colmajor, int i, int j) { return M_colmajor[i + (size_t)j * n]; };
   for (int k = 0; k < count; ++k) {
@@ -221,7 +255,37 @@ bool verify(Setup<A> &S, int count, bool print) {
     for (int i = 0, r = 0; i < n; ++i)
       for (int j = i; j < n; ++j, ++r) err[YM_PIM] = std::max(err[YM_PIM], rel_err(v[r], upper(M, i, j)));
   }
+  for (int k = 0; k < count; ++k) {  // the CasADi sides against Pinocchio
+    const double *t = pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k));
+    std::copy(t, t + n, tau.begin());
+    A::cas_rnea(S.Q(k), S.QD(k), S.QDD(k), S.pin_params.data(), v.data());
+    for (int i = 0; i < n; ++i) cas_err[0][RNEA] = std::max(cas_err[0][RNEA], rel_err(v[i], tau[i]));
+    A::casb_rnea(S.Q(k), S.QD(k), S.QDD(k), v.data());
+    for (int i = 0; i < n; ++i) cas_err[1][RNEA] = std::max(cas_err[1][RNEA], rel_err(v[i], tau[i]));
+    const double *g = pin_gravity(S.pin, S.Q(k));
+    std::copy(g, g + n, tau.begin());
+    A::cas_gravity(S.Q(k), S.pin_params.data(), v.data());
+    for (int i = 0; i < n; ++i) cas_err[0][GRAVITY] = std::max(cas_err[0][GRAVITY], rel_err(v[i], tau[i]));
+    A::casb_gravity(S.Q(k), v.data());
+    for (int i = 0; i < n; ++i) cas_err[1][GRAVITY] = std::max(cas_err[1][GRAVITY], rel_err(v[i], tau[i]));
+    const double *M = pin_crba(S.pin, S.Q(k));
+    for (int b = 0; b < 2; ++b) {
+      if (b == 0) A::cas_mass_matrix(S.Q(k), S.pin_params.data(), v.data());
+      else A::casb_mass_matrix(S.Q(k), v.data());
+      for (int i = 0; i < n; ++i)
+        for (int j = i; j < n; ++j)
+          cas_err[b][MASS_MATRIX] = std::max(cas_err[b][MASS_MATRIX], rel_err(v[(size_t)i * n + j], upper(M, i, j)));
+    }
+  }
   bool ok = true;
+  for (int b = 0; b < 2; ++b)
+    for (int f : {RNEA, GRAVITY, MASS_MATRIX}) {
+      if (print) std::printf("VERIFY %s %s_%s %.3e\n", A::name, b ? "casadi_baked" : "casadi", kFnNames[f], cas_err[b][f]);
+      if (!(cas_err[b][f] <= kTolerance)) {
+        std::fprintf(stderr, "%s: CasADi %s disagrees (%.3e)\n", A::name, kFnNames[f], cas_err[b][f]);
+        ok = false;
+      }
+    }
   for (int f = 0; f <= N_FN; ++f) {
     const char *what = f < N_FN ? kFnNames[f] : "pinocchio_regressor";
     if (print) std::printf("VERIFY %s %s %.3e\n", A::name, what, err[f]);
@@ -254,34 +318,50 @@ double median(std::vector<double> v) {
 
 // Interleaved batches (the order alternates), medians of the per-batch ns/call.
 template <class A, int F>
-void time_pair(const Config &cfg, Setup<A> &S) {
-  auto dyn = [&](int k) { return dyngen_call<A, F>(S, k); };
-  auto pin = [&](int k) { return pinocchio_call<A, F>(S, k); };
-  std::vector<double> td, tp;
-  for (int b = 0; b < cfg.warmup + cfg.batches; ++b) {
-    double d, p;
-    if (b % 2 == 0) {
-      d = batch_ns(dyn, S.count);
-      p = batch_ns(pin, S.count);
-    } else {
-      p = batch_ns(pin, S.count);
-      d = batch_ns(dyn, S.count);
-    }
-    if (b >= cfg.warmup) {
-      td.push_back(d);
-      tp.push_back(p);
-    }
+inline double side_call(Setup<A> &S, int side, int k) {
+  switch (side) {
+    case DYNGEN: return dyngen_call<A, F>(S, k);
+    case PINOCCHIO: return pinocchio_call<A, F>(S, k);
+    case CASADI: return casadi_call<A, F, false>(S, k);
+    default: return casadi_call<A, F, true>(S, k);
   }
-  std::printf("TIME %s %s %.3f %.3f\n", A::name, kFnNames[F], median(td), median(tp));
+}
+
+template <class A, int F>
+double batch_of(Setup<A> &S, int side) {
+  switch (side) {
+    case DYNGEN: return batch_ns([&](int k) { return dyngen_call<A, F>(S, k); }, S.count);
+    case PINOCCHIO: return batch_ns([&](int k) { return pinocchio_call<A, F>(S, k); }, S.count);
+    case CASADI: return batch_ns([&](int k) { return casadi_call<A, F, false>(S, k); }, S.count);
+    default: return batch_ns([&](int k) { return casadi_call<A, F, true>(S, k); }, S.count);
+  }
+}
+
+// Interleaved batches (the order of the sides rotates), medians of the per-batch ns/call.
+template <class A, int F>
+void time_pair(const Config &cfg, Setup<A> &S) {
+  std::vector<double> t[N_SIDE];
+  int sides[N_SIDE], count = 0;
+  for (int s = 0; s < N_SIDE; ++s)
+    if (has_side(F, s)) sides[count++] = s;
+  for (int b = 0; b < cfg.warmup + cfg.batches; ++b)
+    for (int r = 0; r < count; ++r) {
+      const int side = sides[(b + r) % count];
+      const double ns = batch_of<A, F>(S, side);
+      if (b >= cfg.warmup) t[side].push_back(ns);
+    }
+  std::printf("TIME %s %s", A::name, kFnNames[F]);
+  for (int s = 0; s < N_SIDE; ++s) std::printf(" %.3f", t[s].empty() ? NAN : median(t[s]));
+  std::printf("\n");
   std::fflush(stdout);
 }
 
 template <class A, int F>
-double call_many(Setup<A> &S, bool dyngen, long calls) {
+double call_many(Setup<A> &S, int side, long calls) {
   double acc = 0.0;
   for (long c = 0; c < calls; ++c) {
     const int k = (int)(c % S.count);
-    acc += dyngen ? dyngen_call<A, F>(S, k) : pinocchio_call<A, F>(S, k);
+    acc += side_call<A, F>(S, side, k);
   }
   return acc;
 }
@@ -300,7 +380,8 @@ int run(const Config &cfg) {
     time_pair<A, YM_PIM>(cfg, S);
     time_pair<A, REGRESSOR>(cfg, S);
   } else {
-    const bool dyn = cfg.side == "dyngen";
+    int dyn = 0;
+    while (dyn < N_SIDE && cfg.side != kSideNames[dyn]) ++dyn;
     switch (cfg.function) {
       case RNEA: g_sink = call_many<A, RNEA>(S, dyn, cfg.calls); break;
       case GRAVITY: g_sink = call_many<A, GRAVITY>(S, dyn, cfg.calls); break;
@@ -318,7 +399,7 @@ int usage() {
   std::fprintf(stderr,
                "usage: harness time MODELS_DIR STATES BATCHES WARMUP\n"
                "       harness callgrind MODELS_DIR STATES ARM "
-               "{rnea|gravity|yg_pig|mass_matrix|ym_pim|regressor} {dyngen|pinocchio} CALLS\n");
+               "{rnea|gravity|yg_pig|mass_matrix|ym_pim|regressor} {dyngen|pinocchio|casadi|casadi_baked} CALLS\n");
   return 1;
 }
 
@@ -340,7 +421,9 @@ int main(int argc, char **argv) {
     cfg.side = argv[6];
     cfg.calls = std::atol(argv[7]);
     if (cfg.function < 0) return usage();
-    if (cfg.side != "dyngen" && cfg.side != "pinocchio") return usage();
+    bool known = false;
+    for (int s = 0; s < N_SIDE; ++s) known = known || cfg.side == kSideNames[s];
+    if (!known) return usage();
   } else {
     return usage();
   }

@@ -84,7 +84,7 @@ def part_command(part: str, args) -> list | None:
     if part == "opcounts":
         return [*py, BENCH / "bench_opcounts.py", *arms]
     if part == "dynamics":
-        quick = ["--batches", "30"] if args.quick else ["--callgrind"]
+        quick = ["--batches", "30"] if args.quick else ["--callgrind", "--native"]
         if not args.quick and not shutil.which("valgrind"):
             log("warning: valgrind is not installed (DYNGEN_BENCH=1 bash scripts/setup.sh): no instruction counts")
             quick = []
@@ -209,6 +209,16 @@ def summary() -> list:
                   if a["pairs"][pair]["dyngen_ir"]]
             lines.append(f"| {pair} | {min(t):.2f}x - {max(t):.2f}x | "
                          + (f"{min(ir):.2f}x - {max(ir):.2f}x |" if ir else "not measured |"))
+        casadi = [pair for pair in pairs if pairs[pair].get("casadi_ir") is not None]
+        if casadi:
+            lines += ["", "| dyngen vs CasADi (better of parameters as input / baked in) | time ratio | "
+                      "instruction ratio (goal 1.5x) |", "|---|---:|---:|"]
+            for pair in casadi:
+                t = [min(a["pairs"][pair]["casadi_ns"], a["pairs"][pair]["casadi_baked_ns"])
+                     / a["pairs"][pair]["dyngen_ns"] for a in doc["arms"].values()]
+                ir = [min(a["pairs"][pair]["casadi_ir"], a["pairs"][pair]["casadi_baked_ir"])
+                      / a["pairs"][pair]["dyngen_ir"] for a in doc["arms"].values()]
+                lines.append(f"| {pair} | {min(t):.2f}x - {max(t):.2f}x | {min(ir):.2f}x - {max(ir):.2f}x |")
         lines += ["", f"Arms: {', '.join(doc['arms'])}. Above 1: the generated C is faster. yg_pig = Y_g(q) pi_g, "
                   "ym_pim = Y_m(q) pi_m (regressor then product); regressor = dyngen's base regressor vs "
                   "Pinocchio's n x 10n joint-torque regressor.", ""]

@@ -26,10 +26,12 @@ if [ ${#need_apt[@]} -gt 0 ]; then
 fi
 
 PY=${PYTHON:-python3}
-echo "setup: installing the dyngen Python package (editable, with test extras)"
-if ! $PY -m pip install -q --disable-pip-version-check -e ".[test]" 2>/tmp/dyngen-pip.err; then
+EXTRAS="test"
+[ "${DYNGEN_BENCH:-0}" = 1 ] && EXTRAS="test,bench"  # the benchmarks' CasADi (bench/bench_dynamics.py)
+echo "setup: installing the dyngen Python package (editable, with the $EXTRAS extras)"
+if ! $PY -m pip install -q --disable-pip-version-check -e ".[$EXTRAS]" 2>/tmp/dyngen-pip.err; then
   if grep -q externally-managed /tmp/dyngen-pip.err; then  # Debian's system Python (PEP 668)
-    $PY -m pip install -q --disable-pip-version-check --break-system-packages -e ".[test]"
+    $PY -m pip install -q --disable-pip-version-check --break-system-packages -e ".[$EXTRAS]"
   else
     cat /tmp/dyngen-pip.err >&2; exit 1
   fi

@@ -62,6 +62,14 @@ def test_float_build_agrees_with_double(built, tmp_path_factory):
             compare("regressor_gravity", q, *g)
             compare("regressor_inertia", q)
             compare("regressor", q, qd, qdd, *g)
+            (pi,) = float_inputs(single("pi_full", p))
+            # over the base coefficients the float error is that of the sum Y pi, whose terms can
+            # be far larger than tau (a coefficient like m + MY/0.0203 on the PUMA 560): relative
+            # to max (|Y| |pi|), the bound of a float dot product
+            size = np.abs(double("regressor", q, qd, qdd, *g)) @ np.abs(pi)
+            err = float(np.max(np.abs(single("inverse_dynamics", q, qd, qdd, pi, *g).astype(np.float64)
+                                      - double("inverse_dynamics", q, qd, qdd, pi, *g)))) / float(np.max(size))
+            worst["inverse_dynamics"] = max(worst.get("inverse_dynamics", 0.0), err)
             # friction: per joint its terms' fields (terms/friction.py): values and velocity scales
             (f,) = float_inputs(np.column_stack([rng.uniform(0, 2, n) if field.kind == "value" else
                                                  rng.uniform(1e-3, 0.5, n) for field in FRICTION_FIELDS]).ravel())

@@ -85,6 +85,47 @@ def test_rnea_matches_pinocchio(built):
     assert worst < TOL
 
 
+def test_inverse_dynamics_over_base_coefficients(built):
+    """ID(q, qd, qdd, pi_full(p)) = rnea(q, qd, qdd, s(p)) = Pinocchio's rnea, and for coefficients
+    no parameters give (identified ones need not be consistent) ID(pi) = Y(q, qd, qdd) pi."""
+    rng = np.random.default_rng(6)
+    n = built.robot.dof
+    worst = {}
+    for label, p in parameter_sets(built).items():
+        s = built.c("standard_from_dynamic", p)
+        pi = built.c("pi_full", p)
+        arbitrary = rng.normal(size=pi.shape) * np.abs(pi).max()
+        for _ in range(N_STATES):
+            q, qd, qdd = random_state(built, rng)
+            tau = built.c("inverse_dynamics", q, qd, qdd, pi)
+            checks = {"rnea": (tau, built.c("rnea", q, qd, qdd, s)),
+                      "pinocchio": (tau, pin_arm.rnea(built.arm, p, q, qd, qdd)),
+                      "Y pi, any pi": (built.c("inverse_dynamics", q, qd, qdd, arbitrary),
+                                       built.c("regressor", q, qd, qdd) @ arbitrary),
+                      "gravity": (built.c("inverse_dynamics", q, np.zeros(n), np.zeros(n), pi), lag.gravity(built.arm, q, p))}
+            for name, (got, want) in checks.items():
+                worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+    assert all(err < TOL for err in worst.values()), worst
+
+
+def test_joint_angles_far_from_zero_and_on_quadrant_edges(lwr):
+    """The generated sincos (reduction by pi/2, then polynomials, libm's beyond |q| = 1e5) at
+    angles of every size and next to the edges between its quadrants, against numpy's sin and
+    cos in the Lagrangian oracle at the same double angles."""
+    rng = np.random.default_rng(8)
+    p, n = lwr.nominal, lwr.robot.dof
+    s = lwr.c("standard_from_dynamic", p)
+    edges = [k * np.pi / 4 + d for k in range(-9, 10) for d in (-1e-12, 0.0, 1e-12)]
+    sizes = [x * m for m in (1.0, 10.0, 1e3, 9.9e4, 1.01e5, 1e7) for x in (-1.0, 1.0)]
+    worst = 0.0
+    for angle in edges + sizes + list(rng.uniform(-2e5, 2e5, 50)):
+        q = rng.uniform(-np.pi, np.pi, n)
+        q[rng.integers(n)] = angle
+        q[1 + rng.integers(n - 1)] = angle  # joint 1 alone would not show in g (vertical axis)
+        worst = max(worst, rel_err(lwr.c("gravity", q, s), lag.gravity(lwr.arm, q, p)))
+    assert worst < TOL
+
+
 @pytest.mark.parametrize("kind", ["gravity", "inertia", "full"])
 def test_base_count_is_numerical_rank_of_pinocchio_regressor(built, kind):
     """Minimal means minimal: the count equals the numerical rank, not just full column rank."""

@@ -177,9 +177,10 @@ def driver_source(manifest: dict, robot) -> str:
         for out, size in zip(outs, sizes):
             outputs.append(f"    real *{out} = block({size});")
             frees.append(f"    free({out});")
+        feeds = {"pi_full": f"out_{prefix}_pi_full_pi"}  # an input that another function's output gives
         if f["name"] == f"{prefix}_standard_from_dynamic":  # its output s feeds the dynamics functions
             outs = ["s"]
-        args = [i["name"] for i in f["inputs"]] + outs
+        args = [feeds.get(i["name"], i["name"]) for i in f["inputs"]] + outs
         call = f"{f['name']}({', '.join(args)})"
         finite = " && ".join(f"finite_all({out}, {size})" for out, size in zip(outs, sizes))
         calls.append(f"        {call}; ++calls;\n"

@@ -20,25 +20,26 @@
  *
  * Operation counts (multiplications, additions, divisions, sin/cos):
  *   lwr_standard_from_dynamic    126 mul, 63 add, 0 div, 0 sin/cos
- *   lwr_pi_gravity               25 mul, 13 add, 0 div, 0 sin/cos
+ *   lwr_pi_gravity               19 mul, 13 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity_jacobian      0 mul, 2 add, 0 div, 0 sin/cos
- *   lwr_pi_inertia               133 mul, 102 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia               119 mul, 102 add, 0 div, 0 sin/cos
  *   lwr_pi_inertia_jacobian      123 mul, 35 add, 0 div, 0 sin/cos
- *   lwr_pi_full                  138 mul, 106 add, 0 div, 0 sin/cos
+ *   lwr_pi_full                  120 mul, 106 add, 0 div, 0 sin/cos
  *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
- *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 12 sin/cos
- *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 12 sin/cos
- *   lwr_regressor                696 mul, 420 add, 0 div, 12 sin/cos
- *   lwr_rnea                     375 mul, 368 add, 0 div, 12 sin/cos
- *   lwr_gravity                  108 mul, 72 add, 0 div, 12 sin/cos
- *   lwr_mass_matrix              781 mul, 584 add, 0 div, 12 sin/cos
- *   lwr_link_poses               68 mul, 31 add, 0 div, 14 sin/cos
- *   lwr_flange_pose              68 mul, 31 add, 0 div, 14 sin/cos
- *   lwr_jacobian                 72 mul, 44 add, 0 div, 12 sin/cos
- *   lwr_link_jacobians           82 mul, 48 add, 0 div, 12 sin/cos
- *   lwr_jacobian_dot_qd          164 mul, 93 add, 0 div, 12 sin/cos
- *   lwr_control                  1242 mul, 998 add, 0 div, 12 sin/cos
- *   lwr_control_with_jacobian    1416 mul, 1108 add, 0 div, 14 sin/cos
+ *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 6 sin/cos
+ *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 6 sin/cos
+ *   lwr_regressor                696 mul, 420 add, 0 div, 6 sin/cos
+ *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
+ *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
+ *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
+ *   lwr_link_poses               68 mul, 31 add, 0 div, 7 sin/cos
+ *   lwr_flange_pose              68 mul, 31 add, 0 div, 7 sin/cos
+ *   lwr_jacobian                 72 mul, 44 add, 0 div, 6 sin/cos
+ *   lwr_link_jacobians           82 mul, 48 add, 0 div, 6 sin/cos
+ *   lwr_jacobian_dot_qd          149 mul, 93 add, 0 div, 6 sin/cos
+ *   lwr_control                  586 mul, 511 add, 0 div, 6 sin/cos
+ *   lwr_control_with_jacobian    757 mul, 626 add, 0 div, 7 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -60,6 +61,51 @@ typedef double lwr_real;
 #define LWR_SIN sin
 #define LWR_COS cos
 #endif
+/* LWR_SINCOS(x, &s, &c): sin and cos of one joint angle at once. x = k pi/2 + r, |r| <= pi/4
+ * (Cody-Waite, pi/2 in three parts, exact products for |k| < 2^20), Cephes' minimax polynomials
+ * for sin r and cos r, then the quadrant k mod 4: absolute error at most 2.3e-16 in double, 8e-8
+ * in float (2e6 random angles against libm). Beyond |x| = 1e5 (double) or 8192 (float), and for
+ * NaN, libm's sin and cos. A statement macro, so the library has no function of its own. */
+#ifdef LWR_USE_FLOAT
+#define LWR_SINCOS(x, s, c) do { \
+    const float x_ = (x); \
+    if (!(x_ >= -8192.0f && x_ <= 8192.0f)) { *(s) = sinf(x_); *(c) = cosf(x_); break; } \
+    const int k_ = (int)(x_ * 0.63661977236758134f + (x_ >= 0.0f ? 0.5f : -0.5f)); \
+    const float kf_ = (float)k_; \
+    const float r_ = ((x_ - kf_ * 1.5703125f) - kf_ * 4.837512969970703125e-4f) - kf_ * 7.54978995489188216e-8f; \
+    const float z_ = r_ * r_; \
+    const float s_ = ((-1.9515295891e-4f * z_ + 8.3321608736e-3f) * z_ - 1.6666654611e-1f) * z_ * r_ + r_; \
+    const float c_ = ((2.443315711809948e-5f * z_ - 1.388731625493765e-3f) * z_ + 4.166664568298827e-2f) \
+                     * z_ * z_ - 0.5f * z_ + 1.0f; \
+    LWR_QUADRANT(k_, s_, c_, s, c); \
+} while (0)
+#else
+#define LWR_SINCOS(x, s, c) do { \
+    const double x_ = (x); \
+    if (!(x_ >= -1e5 && x_ <= 1e5)) { *(s) = sin(x_); *(c) = cos(x_); break; } \
+    const int k_ = (int)(x_ * 0.63661977236758134 + (x_ >= 0.0 ? 0.5 : -0.5)); \
+    const double kd_ = (double)k_; \
+    const double r_ = ((x_ - kd_ * 1.57079625129699707031) - kd_ * 7.54978941586159635336e-8) \
+                      - kd_ * 5.39030285815811905290e-15; \
+    const double z_ = r_ * r_; \
+    const double s_ = r_ + r_ * z_ * (((((1.58962301576546568060e-10 * z_ - 2.50507477628578072866e-8) * z_ \
+                      + 2.75573136213857245213e-6) * z_ - 1.98412698295895385996e-4) * z_ \
+                      + 8.33333333332211858878e-3) * z_ - 1.66666666666666307295e-1); \
+    const double c_ = 1.0 - 0.5 * z_ + z_ * z_ * (((((-1.13585365213876817300e-11 * z_ \
+                      + 2.08757008419747316778e-9) * z_ - 2.75573141792967388112e-7) * z_ \
+                      + 2.48015872888517045348e-5) * z_ - 1.38888888888730564116e-3) * z_ \
+                      + 4.16666666666665929218e-2); \
+    LWR_QUADRANT(k_, s_, c_, s, c); \
+} while (0)
+#endif
+#define LWR_QUADRANT(k, sr, cr, s, c) do { \
+    switch ((k) & 3) { \
+    case 0: *(s) = (sr); *(c) = (cr); break; \
+    case 1: *(s) = (cr); *(c) = -(sr); break; \
+    case 2: *(s) = -(sr); *(c) = -(cr); break; \
+    default: *(s) = -(cr); *(c) = (sr); break; \
+    } \
+} while (0)
 /* A constant in the working precision (folded by the compiler). */
 #define LWR_K(x) ((lwr_real)(x))
 
@@ -84,7 +130,7 @@ void lwr_standard_from_dynamic(const lwr_real *p, lwr_real *s);
 /* Base coefficients pi_gravity(p) of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [12]  pi_gravity (written)
- * 25 mul, 13 add, 0 div, 0 sin/cos
+ * 19 mul, 13 add, 0 div, 0 sin/cos
  */
 void lwr_pi_gravity(const lwr_real *p, lwr_real *pi);
 
@@ -98,7 +144,7 @@ void lwr_pi_gravity_jacobian(const lwr_real *p, lwr_real *J);
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [39]  pi_inertia (written)
- * 133 mul, 102 add, 0 div, 0 sin/cos
+ * 119 mul, 102 add, 0 div, 0 sin/cos
  */
 void lwr_pi_inertia(const lwr_real *p, lwr_real *pi);
 
@@ -112,7 +158,7 @@ void lwr_pi_inertia_jacobian(const lwr_real *p, lwr_real *J);
 /* Base coefficients pi_full(p) of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [43]  pi_full (written)
- * 138 mul, 106 add, 0 div, 0 sin/cos
+ * 120 mul, 106 add, 0 div, 0 sin/cos
  */
 void lwr_pi_full(const lwr_real *p, lwr_real *pi);
 
@@ -126,14 +172,14 @@ void lwr_pi_full_jacobian(const lwr_real *p, lwr_real *J);
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   q        [7]  joint positions [rad or m]
  *   Y        [7 x 12]  row-major (written)
- * 130 mul, 58 add, 0 div, 12 sin/cos
+ * 130 mul, 58 add, 0 div, 6 sin/cos
  */
 void lwr_regressor_gravity(const lwr_real *q, lwr_real *Y);
 
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body).
  *   q        [7]  joint positions [rad or m]
  *   Y        [28 x 39]  row-major (written)
- * 1383 mul, 757 add, 0 div, 12 sin/cos
+ * 1383 mul, 757 add, 0 div, 6 sin/cos
  */
 void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y);
 
@@ -142,7 +188,7 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y);
  *   qd       [7]  joint velocities
  *   qdd      [7]  joint accelerations
  *   Y        [7 x 43]  row-major (written)
- * 696 mul, 420 add, 0 div, 12 sin/cos
+ * 696 mul, 420 add, 0 div, 6 sin/cos
  */
 void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *Y);
 
@@ -152,7 +198,7 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
  *   qdd      [7]  joint accelerations
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   tau      [7]  joint torques/forces (written)
- * 375 mul, 368 add, 0 div, 12 sin/cos
+ * 299 mul, 339 add, 0 div, 6 sin/cos
  */
 void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *tau);
 
@@ -160,7 +206,7 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
  *   q        [7]  joint positions [rad or m]
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   g        [7]  gravity torques (written)
- * 108 mul, 72 add, 0 div, 12 sin/cos
+ * 66 mul, 51 add, 0 div, 6 sin/cos
  */
 void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
 
@@ -168,35 +214,45 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
  *   q        [7]  joint positions [rad or m]
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [7 x 7]  row-major, symmetric (written)
- * 781 mul, 584 add, 0 div, 12 sin/cos
+ * 243 mul, 193 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
+
+/* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qdd      [7]  joint accelerations
+ *   pi_full  [43]  base coefficients pi_full (e.g. identified; from p: pi_full())
+ *   tau      [7]  joint torques/forces (written)
+ * 293 mul, 301 add, 0 div, 6 sin/cos
+ */
+void lwr_inverse_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *pi_full, lwr_real *tau);
 
 /* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.
  *   q        [7]  joint positions [rad or m]
  *   T        [28 x 4]  row-major 4x4 pose of link frame i in rows 4(i-1)..4i-1 (written)
- * 68 mul, 31 add, 0 div, 14 sin/cos
+ * 68 mul, 31 add, 0 div, 7 sin/cos
  */
 void lwr_link_poses(const lwr_real *q, lwr_real *T);
 
 /* Pose of the flange frame (last link frame times the description's tool offset) in the base frame.
  *   q        [7]  joint positions [rad or m]
  *   T        [4 x 4]  row-major 4x4 [R p; 0 0 0 1] (written)
- * 68 mul, 31 add, 0 div, 14 sin/cos
+ * 68 mul, 31 add, 0 div, 7 sin/cos
  */
 void lwr_flange_pose(const lwr_real *q, lwr_real *T);
 
 /* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).
  *   q        [7]  joint positions [rad or m]
  *   J        [6 x 7]  row-major, rows [v; w] (written)
- * 72 mul, 44 add, 0 div, 12 sin/cos
+ * 72 mul, 44 add, 0 div, 6 sin/cos
  */
 void lwr_jacobian(const lwr_real *q, lwr_real *J);
 
 /* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero).
  *   q        [7]  joint positions [rad or m]
  *   J        [42 x 7]  row-major, rows 6(i-1)..6i-1: link i's [v; w] (written)
- * 82 mul, 48 add, 0 div, 12 sin/cos
+ * 82 mul, 48 add, 0 div, 6 sin/cos
  */
 void lwr_link_jacobians(const lwr_real *q, lwr_real *J);
 
@@ -204,7 +260,7 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J);
  *   q        [7]  joint positions [rad or m]
  *   qd       [7]  joint velocities
  *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
- * 164 mul, 93 add, 0 div, 12 sin/cos
+ * 149 mul, 93 add, 0 div, 6 sin/cos
  */
 void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_qd);
 
@@ -215,7 +271,7 @@ void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_q
  *   g        [7]  gravity torques (written)
  *   M        [7 x 7]  inertia matrix, row-major, symmetric (written)
  *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
- * 1242 mul, 998 add, 0 div, 12 sin/cos
+ * 586 mul, 511 add, 0 div, 6 sin/cos
  */
 void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c);
 
@@ -228,7 +284,7 @@ void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_r
  *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
  *   J        [6 x 7]  flange Jacobian, row-major, rows [v; w] (written)
  *   jdot_qd  [6]  Jdot qd of the flange (written)
- * 1416 mul, 1108 add, 0 div, 14 sin/cos
+ * 757 mul, 626 add, 0 div, 7 sin/cos
  */
 void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c, lwr_real *J, lwr_real *jdot_qd);
 

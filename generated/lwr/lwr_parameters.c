@@ -4,11 +4,11 @@
  * Conventions, shapes and parameter orders: lwr.h.
  *
  *   lwr_standard_from_dynamic    126 mul, 63 add, 0 div, 0 sin/cos
- *   lwr_pi_gravity               25 mul, 13 add, 0 div, 0 sin/cos
+ *   lwr_pi_gravity               19 mul, 13 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity_jacobian      0 mul, 2 add, 0 div, 0 sin/cos
- *   lwr_pi_inertia               133 mul, 102 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia               119 mul, 102 add, 0 div, 0 sin/cos
  *   lwr_pi_inertia_jacobian      123 mul, 35 add, 0 div, 0 sin/cos
- *   lwr_pi_full                  138 mul, 106 add, 0 div, 0 sin/cos
+ *   lwr_pi_full                  120 mul, 106 add, 0 div, 0 sin/cos
  *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
  */
 #include "lwr.h"
@@ -186,9 +186,9 @@ void lwr_pi_gravity(const lwr_real *p, lwr_real *pi)
     const lwr_real x15 = p[62]*p[60];
     const lwr_real x16 = p[63]*p[60];
     /* coefficients */
-    const lwr_real x17 = LWR_K(0.4)*p[20] + LWR_K(0.4)*p[30] + LWR_K(0.4)*p[40] + LWR_K(0.4)*p[50] + LWR_K(0.4)*p[60] + x1 - x3;
+    const lwr_real x17 = (x1 - x3) + LWR_K(0.4)*(p[20] + p[30] + p[40] + p[50] + p[60]);
     const lwr_real x18 = x4 + x6;
-    const lwr_real x19 = LWR_K(0.39)*p[40] + LWR_K(0.39)*p[50] + LWR_K(0.39)*p[60] + x7 + x9;
+    const lwr_real x19 = (x7 + x9) + LWR_K(0.39)*(p[40] + p[50] + p[60]);
     const lwr_real x20 = x10 - x12;
     const lwr_real x21 = x13 + x16;
     /* pi */
@@ -321,15 +321,15 @@ void lwr_pi_inertia(const lwr_real *p, lwr_real *pi)
     const lwr_real x51 = p[69] + p[60]*(p[61]*p[61] + p[62]*p[62]);
     /* coefficients */
     const lwr_real x52 = x6 + x0;
-    const lwr_real x53 = LWR_K(0.16)*p[20] + LWR_K(0.16)*p[30] + LWR_K(0.16)*p[40] + LWR_K(0.16)*p[50] + LWR_K(0.16)*p[60] + x1 - x6 - LWR_K(0.8)*x8 + x15;
-    const lwr_real x54 = LWR_K(0.16)*p[20] + LWR_K(0.16)*p[30] + LWR_K(0.16)*p[40] + LWR_K(0.16)*p[50] + LWR_K(0.16)*p[60] + x4 - LWR_K(0.8)*x8 + x15;
+    const lwr_real x53 = (x1 - x6 - LWR_K(0.8)*x8 + x15) + LWR_K(0.16)*(p[20] + p[30] + p[40] + p[50] + p[60]);
+    const lwr_real x54 = (x4 - LWR_K(0.8)*x8 + x15) + LWR_K(0.16)*(p[20] + p[30] + p[40] + p[50] + p[60]);
     const lwr_real x55 = x7 + LWR_K(2.5)*x11;
     const lwr_real x56 = x9 + LWR_K(2.5)*x14 + x17;
     const lwr_real x57 = x10 - x15 + x24;
     const lwr_real x58 = x13 + x24;
-    const lwr_real x59 = LWR_K(0.39)*p[40] + LWR_K(0.39)*p[50] + LWR_K(0.39)*p[60] + x18 + x26;
-    const lwr_real x60 = LWR_K(0.1521)*p[40] + LWR_K(0.1521)*p[50] + LWR_K(0.1521)*p[60] + x19 - x24 + LWR_K(0.78)*x26 + x33;
-    const lwr_real x61 = LWR_K(0.1521)*p[40] + LWR_K(0.1521)*p[50] + LWR_K(0.1521)*p[60] + x22 + LWR_K(0.78)*x26 + x33;
+    const lwr_real x59 = (x18 + x26) + LWR_K(0.39)*(p[40] + p[50] + p[60]);
+    const lwr_real x60 = LWR_K(0.1521)*(p[40] + p[50] + p[60]) + (x19 - x24 + LWR_K(0.78)*x26 + x33);
+    const lwr_real x61 = LWR_K(0.1521)*(p[40] + p[50] + p[60]) + (x22 + LWR_K(0.78)*x26 + x33);
     const lwr_real x62 = x27 - x35;
     const lwr_real x63 = x28 - x33 + x42;
     const lwr_real x64 = x31 + x42;
@@ -762,15 +762,15 @@ void lwr_pi_full(const lwr_real *p, lwr_real *pi)
     const lwr_real x53 = p[69] + p[60]*(p[61]*p[61] + p[62]*p[62]);
     /* coefficients */
     const lwr_real x54 = x8 + x0;
-    const lwr_real x55 = LWR_K(0.4)*p[20] + LWR_K(0.4)*p[30] + LWR_K(0.4)*p[40] + LWR_K(0.4)*p[50] + LWR_K(0.4)*p[60] + x2 - x10;
-    const lwr_real x56 = LWR_K(0.16)*p[20] + LWR_K(0.16)*p[30] + LWR_K(0.16)*p[40] + LWR_K(0.16)*p[50] + LWR_K(0.16)*p[60] + x3 - x8 - LWR_K(0.8)*x10 + x17;
-    const lwr_real x57 = LWR_K(0.16)*p[20] + LWR_K(0.16)*p[30] + LWR_K(0.16)*p[40] + LWR_K(0.16)*p[50] + LWR_K(0.16)*p[60] + x6 - LWR_K(0.8)*x10 + x17;
+    const lwr_real x55 = (x2 - x10) + LWR_K(0.4)*(p[20] + p[30] + p[40] + p[50] + p[60]);
+    const lwr_real x56 = (x3 - x8 - LWR_K(0.8)*x10 + x17) + LWR_K(0.16)*(p[20] + p[30] + p[40] + p[50] + p[60]);
+    const lwr_real x57 = (x6 - LWR_K(0.8)*x10 + x17) + LWR_K(0.16)*(p[20] + p[30] + p[40] + p[50] + p[60]);
     const lwr_real x58 = x11 + x19;
     const lwr_real x59 = x12 - x17 + x26;
     const lwr_real x60 = x15 + x26;
-    const lwr_real x61 = LWR_K(0.39)*p[40] + LWR_K(0.39)*p[50] + LWR_K(0.39)*p[60] + x20 + x28;
-    const lwr_real x62 = LWR_K(0.1521)*p[40] + LWR_K(0.1521)*p[50] + LWR_K(0.1521)*p[60] + x21 - x26 + LWR_K(0.78)*x28 + x35;
-    const lwr_real x63 = LWR_K(0.1521)*p[40] + LWR_K(0.1521)*p[50] + LWR_K(0.1521)*p[60] + x24 + LWR_K(0.78)*x28 + x35;
+    const lwr_real x61 = (x20 + x28) + LWR_K(0.39)*(p[40] + p[50] + p[60]);
+    const lwr_real x62 = LWR_K(0.1521)*(p[40] + p[50] + p[60]) + (x21 - x26 + LWR_K(0.78)*x28 + x35);
+    const lwr_real x63 = LWR_K(0.1521)*(p[40] + p[50] + p[60]) + (x24 + LWR_K(0.78)*x28 + x35);
     const lwr_real x64 = x29 - x37;
     const lwr_real x65 = x30 - x35 + x44;
     const lwr_real x66 = x33 + x44;

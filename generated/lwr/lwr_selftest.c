@@ -757,9 +757,9 @@ static const double rnea_expected[N_STATES][7] = {
     { 1.7386532234570373, 27.346167648335772, 0.15553532125572447, -3.4038309868602843, 0.19518528148367612, -0.011334215939752118, -0.00197068511341263 },
 };
 static const double gravity_expected[N_STATES][7] = {
-    { 4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0 },
-    { 1.0331493317774011e-40, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0 },
-    { -1.463628220017985e-40, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0 },
+    { -4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0 },
+    { 0.0, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0 },
+    { -2.0089014784560578e-41, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0 },
 };
 static const double mass_matrix_expected[N_STATES][49] = {
     { 0.2930101972874403, -0.3853840413056096, 0.12285593020697558, 0.15891672479242305, 0.006270240597101434, -0.002434154876322384, 1.124143495952837e-05,
@@ -1004,7 +1004,7 @@ static const double jacobian_dot_qd_expected[N_STATES][6] = {
     { -0.3510917988813979, -0.17120300000427122, -0.5911645036035859, 1.0007593060307038, -0.6604665131246918, -0.4174455810685165 },
 };
 static const double control_expected[N_STATES][63] = {
-    { 4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0,
+    { -4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0,
       0.2930101972874403, -0.3853840413056096, 0.12285593020697558, 0.15891672479242305, 0.006270240597101434, -0.002434154876322384, 1.124143495952837e-05,
       -0.3853840413056096, 2.155302423300882, -0.3138287631564987, -0.624405757914958, 0.0169972314944433, 0.008416783038809324, 4.510302655362857e-05,
       0.12285593020697558, -0.3138287631564987, 0.48351190923549414, -0.0025889274559497094, 0.004991229619259618, -0.0015701547636712218, -6.273232092350135e-05,
@@ -1013,7 +1013,7 @@ static const double control_expected[N_STATES][63] = {
       -0.002434154876322384, 0.008416783038809324, -0.0015701547636712218, -0.010049827842955042, 0.0007600417108303137, 0.007138411368999838, 0.0,
       1.124143495952837e-05, 4.510302655362857e-05, -6.273232092350135e-05, 2.6712596276960852e-05, 0.00011589951682961323, 0.0, 0.0001584,
       -0.513930947348551, 1.3285904160380893, 0.1394716233961647, -0.5647895022231387, 0.01195883064330845, -0.004946413168544617, 0.0006197933728498569 },
-    { 1.0331493317774011e-40, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0,
+    { 0.0, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0,
       2.6547137655261, 0.00791372115618599, 0.6990821076147488, -0.2199107717338148, 0.015330630857232855, 0.013576143717828813, -6.273232092350135e-05,
       0.00791372115618599, 2.710847197894463, -0.14977823993773462, -0.9136815936591834, 0.005839000914549035, 0.003879446501189614, 2.6712596276960852e-05,
       0.6990821076147488, -0.14977823993773462, 0.27047622430182366, 0.001135673419265552, 0.01147490068299932, 0.006870268621481818, 0.00011589951682961323,
@@ -1022,7 +1022,7 @@ static const double control_expected[N_STATES][63] = {
       0.013576143717828813, 0.003879446501189614, 0.006870268621481818, -0.00520574551821377, 0.00012085370880000002, 0.007138411368999838, 0.0,
       -6.273232092350135e-05, 2.6712596276960852e-05, 0.00011589951682961323, 0.0, 0.0001584, 0.0, 0.0001584,
       -0.29356844603511045, 0.11334787625712624, -0.05571157993739788, -0.3969359704710856, -0.0002114805779093589, 0.0034737579825652354, 0.003133402149817551 },
-    { -1.463628220017985e-40, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0,
+    { -2.0089014784560578e-41, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0,
       1.433055814958263, -0.0034559142157589238, 0.011254096077967528, 0.6312400345944789, 0.002593999056700059, 0.00012085370880000002, 0.0001584,
       -0.0034559142157589238, 3.0340409243040027, 0.02244571224142092, -0.5964778947786169, 0.021984115184938664, 0.01150360838174832, 0.0,
       0.011254096077967528, 0.02244571224142092, 0.029191649063610072, -0.004811337314543585, 0.01169551546361007, 0.0004476683749386652, 0.00011589951682961323,
@@ -1033,7 +1033,7 @@ static const double control_expected[N_STATES][63] = {
       -0.17037010198183017, -0.3621145165634664, 0.0001653073865344425, 0.00259292734060603, -0.0077728781005046545, 0.004118046437141757, -0.00197068511341263 },
 };
 static const double control_with_jacobian_expected[N_STATES][111] = {
-    { 4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0,
+    { -4.591774807899561e-41, -8.532439075464204, 2.958124939160758, -9.970586787095833, 0.24105070865602332, 0.09289556670760649, 0.0,
       0.2930101972874403, -0.3853840413056096, 0.12285593020697558, 0.15891672479242305, 0.006270240597101434, -0.002434154876322384, 1.124143495952837e-05,
       -0.3853840413056096, 2.155302423300882, -0.3138287631564987, -0.624405757914958, 0.0169972314944433, 0.008416783038809324, 4.510302655362857e-05,
       0.12285593020697558, -0.3138287631564987, 0.48351190923549414, -0.0025889274559497094, 0.004991229619259618, -0.0015701547636712218, -6.273232092350135e-05,
@@ -1049,7 +1049,7 @@ static const double control_with_jacobian_expected[N_STATES][111] = {
       0.0, -0.3153223623952687, 0.45496746226165646, -0.12255010449618157, -0.693576416056655, -0.056887433585325595, -0.9969897011789219,
       1.0, 0.0, 0.8775825618903728, 0.22984884706593015, 0.6759929177205104, -0.3959220589860491, 0.07096865504752758,
       0.2506984551704738, 0.8610771999111188, -0.2034724170051419, 0.6855637125265674, 0.5607338603642312, 0.3192873006049988 },
-    { 1.0331493317774011e-40, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0,
+    { 0.0, -46.32274886253281, 2.2014773538024635, 12.590851854382521, -0.0824197948842932, -0.027099270241742076, 0.0,
       2.6547137655261, 0.00791372115618599, 0.6990821076147488, -0.2199107717338148, 0.015330630857232855, 0.013576143717828813, -6.273232092350135e-05,
       0.00791372115618599, 2.710847197894463, -0.14977823993773462, -0.9136815936591834, 0.005839000914549035, 0.003879446501189614, 2.6712596276960852e-05,
       0.6990821076147488, -0.14977823993773462, 0.27047622430182366, 0.001135673419265552, 0.01147490068299932, 0.006870268621481818, 0.00011589951682961323,
@@ -1065,7 +1065,7 @@ static const double control_with_jacobian_expected[N_STATES][111] = {
       0.0, -0.8775825618903728, 0.45496746226165646, 0.8877015908403859, 0.2847413292527056, -0.17517252381276197, 0.2847413292527056,
       1.0, 0.0, 0.3153223623952687, -0.2347825521002184, -0.396037379567559, 0.873836948566432, -0.396037379567559,
       0.5746442350090207, -0.20326893178552413, -0.03625525601721142, 0.49365662017832196, 0.0647498029516569, 0.4528516932923541 },
-    { -1.463628220017985e-40, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0,
+    { -2.0089014784560578e-41, 33.75842627942124, 0.20201130645397067, -5.427597073173113, 0.24272692048435351, -0.004065264000000001, 0.0,
       1.433055814958263, -0.0034559142157589238, 0.011254096077967528, 0.6312400345944789, 0.002593999056700059, 0.00012085370880000002, 0.0001584,
       -0.0034559142157589238, 3.0340409243040027, 0.02244571224142092, -0.5964778947786169, 0.021984115184938664, 0.01150360838174832, 0.0,
       0.011254096077967528, 0.02244571224142092, 0.029191649063610072, -0.004811337314543585, 0.01169551546361007, 0.0004476683749386652, 0.00011589951682961323,
@@ -1099,6 +1099,7 @@ static lwr_real regressor_out[301];
 static lwr_real rnea_out[7];
 static lwr_real gravity_out[7];
 static lwr_real mass_matrix_out[49];
+static lwr_real inverse_dynamics_out[7];
 static lwr_real friction_out[7];
 static lwr_real link_poses_out[112];
 static lwr_real flange_pose_out[16];
@@ -1139,10 +1140,23 @@ static void times(const lwr_real *Y, const lwr_real *x, int rows, int cols, doub
     }
 }
 
-/* Normwise relative error of one output; remembers the worst. Returns 1 when within tolerance. */
-static int check(const char *name, int state, const double *a, const double *b, int n)
+/* max_r sum_c |Y[r][c]| |x[c]|: the size of the terms of Y x, before they cancel. */
+static double size_of(const lwr_real *Y, const lwr_real *x, int rows, int cols)
 {
-    double diff = 0.0, scale = 0.0;
+    double size = 0.0;
+    for (int r = 0; r < rows; ++r) {
+        double sum = 0.0;
+        for (int c = 0; c < cols; ++c) sum += fabs((double)Y[r * cols + c]) * fabs((double)x[c]);
+        size = sum > size ? sum : size;
+    }
+    return size;
+}
+
+/* Normwise relative error of one output, relative to max_k |b_k| or to size when that is larger;
+ * remembers the worst. Returns 1 when within tolerance. */
+static int check(const char *name, int state, const double *a, const double *b, int n, double size)
+{
+    double diff = 0.0, scale = size;
     for (int k = 0; k < n; ++k) {
         double d = fabs(a[k] - b[k]);
         diff = (d > diff || d != d) ? d : diff; /* d != d: NaN counts as a failure */
@@ -1158,10 +1172,10 @@ static int check(const char *name, int state, const double *a, const double *b, 
 }
 
 /* One check: the output (times the coefficients, for a regressor) against the expected values. */
-static int compare(const char *name, int state, const lwr_real *out, const double *expected, int n)
+static int compare(const char *name, int state, const lwr_real *out, const double *expected, int n, double size)
 {
     widen(out, got, n);
-    return check(name, state, got, expected, n);
+    return check(name, state, got, expected, n, size);
 }
 
 int main(void)
@@ -1170,25 +1184,25 @@ int main(void)
     load(p_data, p, LWR_N_PARAMETERS);
     load(f_data, f, 8 * LWR_DOF);
     lwr_standard_from_dynamic(p, standard_from_dynamic_out);
-    failures += !compare("standard_from_dynamic", 0, standard_from_dynamic_out, standard_from_dynamic_expected, 70);
+    failures += !compare("standard_from_dynamic", 0, standard_from_dynamic_out, standard_from_dynamic_expected, 70, 0.0);
     ++checks;
     lwr_pi_gravity(p, pi_gravity_out);
-    failures += !compare("pi_gravity", 0, pi_gravity_out, pi_gravity_expected, 12);
+    failures += !compare("pi_gravity", 0, pi_gravity_out, pi_gravity_expected, 12, 0.0);
     ++checks;
     lwr_pi_gravity_jacobian(p, pi_gravity_jacobian_out);
-    failures += !compare("pi_gravity_jacobian", 0, pi_gravity_jacobian_out, pi_gravity_jacobian_expected, 840);
+    failures += !compare("pi_gravity_jacobian", 0, pi_gravity_jacobian_out, pi_gravity_jacobian_expected, 840, 0.0);
     ++checks;
     lwr_pi_inertia(p, pi_inertia_out);
-    failures += !compare("pi_inertia", 0, pi_inertia_out, pi_inertia_expected, 39);
+    failures += !compare("pi_inertia", 0, pi_inertia_out, pi_inertia_expected, 39, 0.0);
     ++checks;
     lwr_pi_inertia_jacobian(p, pi_inertia_jacobian_out);
-    failures += !compare("pi_inertia_jacobian", 0, pi_inertia_jacobian_out, pi_inertia_jacobian_expected, 2730);
+    failures += !compare("pi_inertia_jacobian", 0, pi_inertia_jacobian_out, pi_inertia_jacobian_expected, 2730, 0.0);
     ++checks;
     lwr_pi_full(p, pi_full_out);
-    failures += !compare("pi_full", 0, pi_full_out, pi_full_expected, 43);
+    failures += !compare("pi_full", 0, pi_full_out, pi_full_expected, 43, 0.0);
     ++checks;
     lwr_pi_full_jacobian(p, pi_full_jacobian_out);
-    failures += !compare("pi_full_jacobian", 0, pi_full_jacobian_out, pi_full_jacobian_expected, 3010);
+    failures += !compare("pi_full_jacobian", 0, pi_full_jacobian_out, pi_full_jacobian_expected, 3010, 0.0);
     ++checks;
     for (int k = 0; k < N_STATES; ++k) {
         load(q_data[k], q, LWR_DOF);
@@ -1197,55 +1211,69 @@ int main(void)
 
         lwr_regressor_gravity(q, regressor_gravity_out);
         times(regressor_gravity_out, pi_gravity_out, 7, 12, got);
-        failures += !check("regressor_gravity * pi_gravity", k, got, gravity_expected[k], 7);
+        failures += !check("regressor_gravity * pi_gravity", k, got, gravity_expected[k], 7, 0.0);
         ++checks;
 
         lwr_regressor_inertia(q, regressor_inertia_out);
         times(regressor_inertia_out, pi_inertia_out, 28, 39, got);
         for (int r = 0, i = 0; r < LWR_DOF; ++r) /* stacked: upper triangle row by row */
             for (int c = r; c < LWR_DOF; ++c) want[i++] = mass_matrix_expected[k][r * LWR_DOF + c];
-        failures += !check("regressor_inertia * pi_inertia", k, got, want, 28);
+        failures += !check("regressor_inertia * pi_inertia", k, got, want, 28, 0.0);
         ++checks;
 
         lwr_regressor(q, qd, qdd, regressor_out);
         times(regressor_out, pi_full_out, 7, 43, got);
-        failures += !check("regressor * pi_full", k, got, rnea_expected[k], 7);
+        failures += !check("regressor * pi_full", k, got, rnea_expected[k], 7, 0.0);
         ++checks;
 
         lwr_rnea(q, qd, qdd, standard_from_dynamic_out, rnea_out);
-        failures += !compare("rnea", k, rnea_out, rnea_expected[k], 7);
+        failures += !compare("rnea", k, rnea_out, rnea_expected[k], 7,
+0.0);
         ++checks;
 
         lwr_gravity(q, standard_from_dynamic_out, gravity_out);
-        failures += !compare("gravity", k, gravity_out, gravity_expected[k], 7);
+        failures += !compare("gravity", k, gravity_out, gravity_expected[k], 7,
+0.0);
         ++checks;
 
         lwr_mass_matrix(q, standard_from_dynamic_out, mass_matrix_out);
-        failures += !compare("mass_matrix", k, mass_matrix_out, mass_matrix_expected[k], 49);
+        failures += !compare("mass_matrix", k, mass_matrix_out, mass_matrix_expected[k], 49,
+0.0);
+        ++checks;
+
+        lwr_inverse_dynamics(q, qd, qdd, pi_full_out, inverse_dynamics_out);
+        failures += !compare("inverse_dynamics", k, inverse_dynamics_out, rnea_expected[k], 7,
+size_of(regressor_out, pi_full_out, 7, 43));
         ++checks;
 
         lwr_friction(qd, f, friction_out);
-        failures += !compare("friction", k, friction_out, friction_expected[k], 7);
+        failures += !compare("friction", k, friction_out, friction_expected[k], 7,
+0.0);
         ++checks;
 
         lwr_link_poses(q, link_poses_out);
-        failures += !compare("link_poses", k, link_poses_out, link_poses_expected[k], 112);
+        failures += !compare("link_poses", k, link_poses_out, link_poses_expected[k], 112,
+0.0);
         ++checks;
 
         lwr_flange_pose(q, flange_pose_out);
-        failures += !compare("flange_pose", k, flange_pose_out, flange_pose_expected[k], 16);
+        failures += !compare("flange_pose", k, flange_pose_out, flange_pose_expected[k], 16,
+0.0);
         ++checks;
 
         lwr_jacobian(q, jacobian_out);
-        failures += !compare("jacobian", k, jacobian_out, jacobian_expected[k], 42);
+        failures += !compare("jacobian", k, jacobian_out, jacobian_expected[k], 42,
+0.0);
         ++checks;
 
         lwr_link_jacobians(q, link_jacobians_out);
-        failures += !compare("link_jacobians", k, link_jacobians_out, link_jacobians_expected[k], 294);
+        failures += !compare("link_jacobians", k, link_jacobians_out, link_jacobians_expected[k], 294,
+0.0);
         ++checks;
 
         lwr_jacobian_dot_qd(q, qd, jacobian_dot_qd_out);
-        failures += !compare("jacobian_dot_qd", k, jacobian_dot_qd_out, jacobian_dot_qd_expected[k], 6);
+        failures += !compare("jacobian_dot_qd", k, jacobian_dot_qd_out, jacobian_dot_qd_expected[k], 6,
+0.0);
         ++checks;
 
         lwr_control(q, qd, standard_from_dynamic_out, control_g_out, control_M_out, control_c_out);

@@ -22,23 +22,24 @@
  *   stanford_standard_from_dynamic 108 mul, 54 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity          14 mul, 9 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity_jacobian 0 mul, 1 add, 0 div, 0 sin/cos
- *   stanford_pi_inertia          104 mul, 80 add, 0 div, 0 sin/cos
+ *   stanford_pi_inertia          102 mul, 80 add, 0 div, 0 sin/cos
  *   stanford_pi_inertia_jacobian 110 mul, 31 add, 0 div, 0 sin/cos
  *   stanford_pi_full             100 mul, 78 add, 0 div, 0 sin/cos
  *   stanford_pi_full_jacobian    100 mul, 28 add, 0 div, 0 sin/cos
- *   stanford_regressor_gravity   59 mul, 23 add, 0 div, 8 sin/cos
- *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 8 sin/cos
- *   stanford_regressor           402 mul, 259 add, 0 div, 8 sin/cos
- *   stanford_rnea                311 mul, 314 add, 0 div, 8 sin/cos
- *   stanford_gravity             83 mul, 56 add, 0 div, 8 sin/cos
- *   stanford_mass_matrix         454 mul, 347 add, 0 div, 8 sin/cos
- *   stanford_link_poses          46 mul, 22 add, 0 div, 10 sin/cos
- *   stanford_flange_pose         46 mul, 22 add, 0 div, 10 sin/cos
- *   stanford_jacobian            50 mul, 43 add, 0 div, 8 sin/cos
- *   stanford_link_jacobians      56 mul, 47 add, 0 div, 8 sin/cos
- *   stanford_jacobian_dot_qd     143 mul, 85 add, 0 div, 8 sin/cos
- *   stanford_control             815 mul, 670 add, 0 div, 8 sin/cos
- *   stanford_control_with_jacobian 976 mul, 784 add, 0 div, 10 sin/cos
+ *   stanford_regressor_gravity   59 mul, 23 add, 0 div, 4 sin/cos
+ *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 4 sin/cos
+ *   stanford_regressor           402 mul, 259 add, 0 div, 4 sin/cos
+ *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
+ *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
+ *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
+ *   stanford_link_poses          46 mul, 22 add, 0 div, 5 sin/cos
+ *   stanford_flange_pose         46 mul, 22 add, 0 div, 5 sin/cos
+ *   stanford_jacobian            50 mul, 43 add, 0 div, 4 sin/cos
+ *   stanford_link_jacobians      56 mul, 47 add, 0 div, 4 sin/cos
+ *   stanford_jacobian_dot_qd     128 mul, 85 add, 0 div, 4 sin/cos
+ *   stanford_control             416 mul, 370 add, 0 div, 4 sin/cos
+ *   stanford_control_with_jacobian 566 mul, 485 add, 0 div, 5 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -60,6 +61,51 @@ typedef double stanford_real;
 #define STANFORD_SIN sin
 #define STANFORD_COS cos
 #endif
+/* STANFORD_SINCOS(x, &s, &c): sin and cos of one joint angle at once. x = k pi/2 + r, |r| <= pi/4
+ * (Cody-Waite, pi/2 in three parts, exact products for |k| < 2^20), Cephes' minimax polynomials
+ * for sin r and cos r, then the quadrant k mod 4: absolute error at most 2.3e-16 in double, 8e-8
+ * in float (2e6 random angles against libm). Beyond |x| = 1e5 (double) or 8192 (float), and for
+ * NaN, libm's sin and cos. A statement macro, so the library has no function of its own. */
+#ifdef STANFORD_USE_FLOAT
+#define STANFORD_SINCOS(x, s, c) do { \
+    const float x_ = (x); \
+    if (!(x_ >= -8192.0f && x_ <= 8192.0f)) { *(s) = sinf(x_); *(c) = cosf(x_); break; } \
+    const int k_ = (int)(x_ * 0.63661977236758134f + (x_ >= 0.0f ? 0.5f : -0.5f)); \
+    const float kf_ = (float)k_; \
+    const float r_ = ((x_ - kf_ * 1.5703125f) - kf_ * 4.837512969970703125e-4f) - kf_ * 7.54978995489188216e-8f; \
+    const float z_ = r_ * r_; \
+    const float s_ = ((-1.9515295891e-4f * z_ + 8.3321608736e-3f) * z_ - 1.6666654611e-1f) * z_ * r_ + r_; \
+    const float c_ = ((2.443315711809948e-5f * z_ - 1.388731625493765e-3f) * z_ + 4.166664568298827e-2f) \
+                     * z_ * z_ - 0.5f * z_ + 1.0f; \
+    STANFORD_QUADRANT(k_, s_, c_, s, c); \
+} while (0)
+#else
+#define STANFORD_SINCOS(x, s, c) do { \
+    const double x_ = (x); \
+    if (!(x_ >= -1e5 && x_ <= 1e5)) { *(s) = sin(x_); *(c) = cos(x_); break; } \
+    const int k_ = (int)(x_ * 0.63661977236758134 + (x_ >= 0.0 ? 0.5 : -0.5)); \
+    const double kd_ = (double)k_; \
+    const double r_ = ((x_ - kd_ * 1.57079625129699707031) - kd_ * 7.54978941586159635336e-8) \
+                      - kd_ * 5.39030285815811905290e-15; \
+    const double z_ = r_ * r_; \
+    const double s_ = r_ + r_ * z_ * (((((1.58962301576546568060e-10 * z_ - 2.50507477628578072866e-8) * z_ \
+                      + 2.75573136213857245213e-6) * z_ - 1.98412698295895385996e-4) * z_ \
+                      + 8.33333333332211858878e-3) * z_ - 1.66666666666666307295e-1); \
+    const double c_ = 1.0 - 0.5 * z_ + z_ * z_ * (((((-1.13585365213876817300e-11 * z_ \
+                      + 2.08757008419747316778e-9) * z_ - 2.75573141792967388112e-7) * z_ \
+                      + 2.48015872888517045348e-5) * z_ - 1.38888888888730564116e-3) * z_ \
+                      + 4.16666666666665929218e-2); \
+    STANFORD_QUADRANT(k_, s_, c_, s, c); \
+} while (0)
+#endif
+#define STANFORD_QUADRANT(k, sr, cr, s, c) do { \
+    switch ((k) & 3) { \
+    case 0: *(s) = (sr); *(c) = (cr); break; \
+    case 1: *(s) = (cr); *(c) = -(sr); break; \
+    case 2: *(s) = -(sr); *(c) = -(cr); break; \
+    default: *(s) = -(cr); *(c) = (sr); break; \
+    } \
+} while (0)
 /* A constant in the working precision (folded by the compiler). */
 #define STANFORD_K(x) ((stanford_real)(x))
 
@@ -98,7 +144,7 @@ void stanford_pi_gravity_jacobian(const stanford_real *p, stanford_real *J);
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [60]  dynamic parameters, 10 per link
  *   pi       [31]  pi_inertia (written)
- * 104 mul, 80 add, 0 div, 0 sin/cos
+ * 102 mul, 80 add, 0 div, 0 sin/cos
  */
 void stanford_pi_inertia(const stanford_real *p, stanford_real *pi);
 
@@ -126,14 +172,14 @@ void stanford_pi_full_jacobian(const stanford_real *p, stanford_real *J);
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity.
  *   q        [6]  joint positions [rad or m]
  *   Y        [6 x 9]  row-major (written)
- * 59 mul, 23 add, 0 div, 8 sin/cos
+ * 59 mul, 23 add, 0 div, 4 sin/cos
  */
 void stanford_regressor_gravity(const stanford_real *q, stanford_real *Y);
 
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body).
  *   q        [6]  joint positions [rad or m]
  *   Y        [21 x 31]  row-major (written)
- * 912 mul, 519 add, 0 div, 8 sin/cos
+ * 912 mul, 519 add, 0 div, 4 sin/cos
  */
 void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y);
 
@@ -142,7 +188,7 @@ void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y);
  *   qd       [6]  joint velocities
  *   qdd      [6]  joint accelerations
  *   Y        [6 x 33]  row-major (written)
- * 402 mul, 259 add, 0 div, 8 sin/cos
+ * 402 mul, 259 add, 0 div, 4 sin/cos
  */
 void stanford_regressor(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *Y);
 
@@ -152,7 +198,7 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
  *   qdd      [6]  joint accelerations
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   tau      [6]  joint torques/forces (written)
- * 311 mul, 314 add, 0 div, 8 sin/cos
+ * 237 mul, 270 add, 0 div, 4 sin/cos
  */
 void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *tau);
 
@@ -160,7 +206,7 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
  *   q        [6]  joint positions [rad or m]
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   g        [6]  gravity torques (written)
- * 83 mul, 56 add, 0 div, 8 sin/cos
+ * 46 mul, 34 add, 0 div, 4 sin/cos
  */
 void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_real *g);
 
@@ -168,35 +214,45 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
  *   q        [6]  joint positions [rad or m]
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [6 x 6]  row-major, symmetric (written)
- * 454 mul, 347 add, 0 div, 8 sin/cos
+ * 154 mul, 135 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
+
+/* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qdd      [6]  joint accelerations
+ *   pi_full  [33]  base coefficients pi_full (e.g. identified; from p: pi_full())
+ *   tau      [6]  joint torques/forces (written)
+ * 232 mul, 239 add, 0 div, 4 sin/cos
+ */
+void stanford_inverse_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *pi_full, stanford_real *tau);
 
 /* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first.
  *   q        [6]  joint positions [rad or m]
  *   T        [24 x 4]  row-major 4x4 pose of link frame i in rows 4(i-1)..4i-1 (written)
- * 46 mul, 22 add, 0 div, 10 sin/cos
+ * 46 mul, 22 add, 0 div, 5 sin/cos
  */
 void stanford_link_poses(const stanford_real *q, stanford_real *T);
 
 /* Pose of the flange frame (last link frame times the description's tool offset) in the base frame.
  *   q        [6]  joint positions [rad or m]
  *   T        [4 x 4]  row-major 4x4 [R p; 0 0 0 1] (written)
- * 46 mul, 22 add, 0 div, 10 sin/cos
+ * 46 mul, 22 add, 0 div, 5 sin/cos
  */
 void stanford_flange_pose(const stanford_real *q, stanford_real *T);
 
 /* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED).
  *   q        [6]  joint positions [rad or m]
  *   J        [6 x 6]  row-major, rows [v; w] (written)
- * 50 mul, 43 add, 0 div, 8 sin/cos
+ * 50 mul, 43 add, 0 div, 4 sin/cos
  */
 void stanford_jacobian(const stanford_real *q, stanford_real *J);
 
 /* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero).
  *   q        [6]  joint positions [rad or m]
  *   J        [36 x 6]  row-major, rows 6(i-1)..6i-1: link i's [v; w] (written)
- * 56 mul, 47 add, 0 div, 8 sin/cos
+ * 56 mul, 47 add, 0 div, 4 sin/cos
  */
 void stanford_link_jacobians(const stanford_real *q, stanford_real *J);
 
@@ -204,7 +260,7 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J);
  *   q        [6]  joint positions [rad or m]
  *   qd       [6]  joint velocities
  *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
- * 143 mul, 85 add, 0 div, 8 sin/cos
+ * 128 mul, 85 add, 0 div, 4 sin/cos
  */
 void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *jdot_qd);
 
@@ -215,7 +271,7 @@ void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, s
  *   g        [6]  gravity torques (written)
  *   M        [6 x 6]  inertia matrix, row-major, symmetric (written)
  *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
- * 815 mul, 670 add, 0 div, 8 sin/cos
+ * 416 mul, 370 add, 0 div, 4 sin/cos
  */
 void stanford_control(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c);
 
@@ -228,7 +284,7 @@ void stanford_control(const stanford_real *q, const stanford_real *qd, const sta
  *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
  *   J        [6 x 6]  flange Jacobian, row-major, rows [v; w] (written)
  *   jdot_qd  [6]  Jdot qd of the flange (written)
- * 976 mul, 784 add, 0 div, 10 sin/cos
+ * 566 mul, 485 add, 0 div, 5 sin/cos
  */
 void stanford_control_with_jacobian(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c, stanford_real *J, stanford_real *jdot_qd);
 

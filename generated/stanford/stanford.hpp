@@ -310,6 +310,22 @@ inline MassMatrix mass_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::Matri
     return M;
 }
 
+/* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients).
+ * stanford_inverse_dynamics(q: Joints, qd: Joints, qdd: Joints, pi_full: PiFull, tau: Joints written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out0>
+inline void inverse_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &pi_full, const Eigen::MatrixBase<Out0> &tau)
+{
+    stanford_inverse_dynamics(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qdd), detail::in<PiFull>(pi_full), detail::out<Joints>(tau));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Joints inverse_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &pi_full)
+{
+    Joints tau;
+    inverse_dynamics(q, qd, qdd, pi_full, tau);
+    return tau;
+}
+
 /* Joint friction (Coulomb, viscous, Stribeck, direction), the terms of terms/friction.py.
  * stanford_friction(qd: Joints, f: Friction, tau: Joints written) */
 template <typename A0, typename A1, typename Out0>

@@ -6,7 +6,7 @@
  *   stanford_standard_from_dynamic 108 mul, 54 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity          14 mul, 9 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity_jacobian 0 mul, 1 add, 0 div, 0 sin/cos
- *   stanford_pi_inertia          104 mul, 80 add, 0 div, 0 sin/cos
+ *   stanford_pi_inertia          102 mul, 80 add, 0 div, 0 sin/cos
  *   stanford_pi_inertia_jacobian 110 mul, 31 add, 0 div, 0 sin/cos
  *   stanford_pi_full             100 mul, 78 add, 0 div, 0 sin/cos
  *   stanford_pi_full_jacobian    100 mul, 28 add, 0 div, 0 sin/cos
@@ -274,8 +274,8 @@ void stanford_pi_inertia(const stanford_real *p, stanford_real *pi)
     const stanford_real x45 = p[59] + p[50]*(p[51]*p[51] + p[52]*p[52]);
     /* coefficients */
     const stanford_real x46 = STANFORD_K(0.023716)*p[10] + STANFORD_K(0.308)*x2 + x9 + x18 + x0;
-    const stanford_real x47 = -STANFORD_K(500.0/77.0)*x5 + STANFORD_K(500.0/77.0)*x14 + x1;
-    const stanford_real x48 = x3 - STANFORD_K(500.0/77.0)*x8 + STANFORD_K(500.0/77.0)*x15;
+    const stanford_real x47 = x1 + STANFORD_K(500.0/77.0)*(-x5 + x14);
+    const stanford_real x48 = x3 + STANFORD_K(500.0/77.0)*(-x8 + x15);
     const stanford_real x49 = x4 - x9 + x16 - x18 + x27;
     const stanford_real x50 = x6 + x17;
     const stanford_real x51 = x7 + x13 + x27;

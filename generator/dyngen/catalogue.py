@@ -41,6 +41,7 @@ ARGUMENTS = {
     "s": Argument(("parameters",), "standard parameters, 10 per link (docs/conventions.md)", "Parameters"),
     "gravity": Argument(("gravity_symbols",), "gravity symbols", "GravitySymbols"),  # only when gravity has symbols
     "f": Argument(("friction",), "per joint " + ", ".join(FRICTION_NAMES), "Friction"),
+    "pi_full": Argument(("pi_full",), "base coefficients pi_full (e.g. identified; from p: pi_full())", "PiFull"),
 }
 
 
@@ -56,11 +57,14 @@ class Output:
 class Check:
     """How the self-test checks a function: its output (times the output of `times`, for a
     regressor) against the values embedded for function `expected` (its own when empty);
-    `stacked`: compared with the upper triangle of a square expected matrix, row by row."""
+    `stacked`: compared with the upper triangle of a square expected matrix, row by row;
+    `size`: a regressor whose |Y| |pi| (with its coefficients) sizes the error instead of the
+    expected values (a sum over base coefficients can cancel in float)."""
 
     expected: str = ""
     times: str = ""
     stacked: bool = False
+    size: str = ""
 
 
 @dataclass(frozen=True)
@@ -128,6 +132,11 @@ GRAVITY = Function(
 MASS_MATRIX = Function(
     "mass_matrix", "dynamics", "mass_matrix", ("q", "s"),
     Output("M", ("dof", "dof"), "row-major, symmetric", "MassMatrix"), "Inertia matrix M(q).", Check())
+INVERSE_DYNAMICS = Function(
+    "inverse_dynamics", "dynamics", "inverse_dynamics", ("q", "qd", "qdd", "pi_full", "gravity"),
+    Output("tau", ("dof",), "joint torques/forces", "Joints"),
+    "Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the "
+    "grouped parameters (for controllers that hold identified coefficients).", Check("rnea", size="regressor"))
 FRICTION = Function(
     "friction", "friction", "template", ("qd", "f"),
     Output("tau", ("dof",), "friction torques", "Joints"),
@@ -176,7 +185,7 @@ CONTROL_WITH_JACOBIAN = Function(
 
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
-             FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD,
+             INVERSE_DYNAMICS, FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD,
              CONTROL, CONTROL_WITH_JACOBIAN)
 KINEMATICS = (LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD)
 BY_NAME = {f.name: f for f in FUNCTIONS}

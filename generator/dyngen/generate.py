@@ -55,9 +55,6 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
         # rather than from Y_m (O(n^3)): reduction/base.py says why they agree.
         regressors = {kind: derivation.regressor(kind) for kind in ("gravity", "full")}
         reduced = {**regressors, "inertia": derivation.regressor("full_without_gravity")}
-        models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix(),
-                  "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),
-                  "control": control_model(robot), "control_with_jacobian": control_model(robot, with_jacobian=True)}
     with progress.step("reduce to base coefficients (exact rank)"):
         try:
             bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
@@ -68,6 +65,14 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
             raise InputError(robot.source, "gravity", "no joint of this arm moves against gravity (the gravity "
                              "vector is identically zero, e.g. a horizontal SCARA); dyngen needs at least one "
                              "gravity coefficient: tilt the base slightly or give gravity a symbol")
+    with progress.step("derive the dynamics over the base coefficients"):
+        # each function over its own kind's coefficients (Derivation.rnea says why that is exact)
+        models = {"rnea": derivation.rnea(bases["full"]), "gravity": derivation.gravity(bases["gravity"]),
+                  "mass_matrix": derivation.mass_matrix(bases["inertia"]),
+                  "inverse_dynamics": derivation.inverse_dynamics(bases["full"]),
+                  "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),
+                  "control": control_model(robot, bases),
+                  "control_with_jacobian": control_model(robot, bases, with_jacobian=True)}
     with progress.step("emit C"):
         emitted = emit(robot, derivation, regressors, bases, models)
     return bases, emitted

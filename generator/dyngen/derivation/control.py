@@ -27,15 +27,19 @@ class _SharedProgram(Derivation):
     def _start(self):
         return self.shared
 
-    def coriolis_vector(self) -> list:
+    def coriolis_vector(self, base=None) -> list:
         program, sym, chain = self.shared
-        return self._tau(program, chain, chain.forward(sym.qd, [0] * self.n, [0, 0, 0]))
+        motions = chain.forward(sym.qd, [0] * self.n, [0, 0, 0])
+        return self._tau(program, chain, motions, self._grouped(program, base))
 
 
-def control_model(robot, with_jacobian: bool = False) -> Model:
+def control_model(robot, bases=None, with_jacobian: bool = False) -> Model:
+    """bases: kind -> BaseSet, to run each part over its grouped parameters as the separate
+    functions do (Derivation.rnea); None: over the standard parameters."""
+    bases = bases or {}
     derivation = _SharedProgram(robot)
-    g, M = derivation.gravity(), derivation.mass_matrix()
-    c = derivation.coriolis_vector()
+    g, M = derivation.gravity(bases.get("gravity")), derivation.mass_matrix(bases.get("inertia"))
+    c = derivation.coriolis_vector(bases.get("full"))
     program, sym, _ = derivation.shared
     outputs = list(g.outputs) + list(M.outputs) + c
     inputs = M.inputs[:1] + derivation._joint_inputs(sym, "qd") + g.inputs[1:]  # q, qd, s[, gravity]

@@ -15,6 +15,7 @@ import sympy as sp
 from ..catalogue import ARGUMENTS
 from ..description import Robot
 from ..parameters import PER_LINK, dynamic_symbols, standard_from_dynamic_link, standard_symbols
+from .composite import mass_matrix_columns
 from .newton_euler import Chain, joint_symbols, link_wrench
 from .program import Program
 
@@ -39,6 +40,9 @@ class Model:
     @property
     def assignments(self):
         return self.program.pruned(self.outputs)
+
+
+GROUPING_LIMIT = 10  # largest |K| entry for which rnea, gravity and M run over the base coefficients
 
 
 class Derivation:
@@ -68,38 +72,67 @@ class Derivation:
         return program, sym, Chain(self.robot, program, sym)
 
     # ---- inverse dynamics and its conveniences ------------------------------------------
+    # With a BaseSet, each function first forms its base coefficients pi = K s (a few products
+    # with the link lengths) and runs the recursion on s* = (pi on the base columns, 0 on the
+    # others): Y s = Y_b K s = Y s*, and every product with a zero parameter drops out
+    # (Khalil and Kleinfinger's customised Newton-Euler in the grouped parameters).
 
-    def rnea(self) -> Model:
+    def rnea(self, base=None) -> Model:
         program, sym, chain = self._start()
+        params = self._grouped(program, base)
         motions = chain.forward(sym.qd, sym.qdd, self.robot.gravity)
-        tau = self._tau(program, chain, motions)
+        tau = self._tau(program, chain, motions, params)
         return Model("rnea", self._joint_inputs(sym, "q", "qd", "qdd") + [self._params_input()] + self._gravity_inputs(),
                      tau, (self.n,), "inverse dynamics tau = M(q) qdd + c(q, qd) + g(q) (Newton-Euler)",
                      program, sym.trig)
 
-    def gravity(self) -> Model:
+    def inverse_dynamics(self, base) -> Model:
+        """tau = Y_b(q, qd, qdd) pi_full from the base coefficients themselves (full kind)."""
         program, sym, chain = self._start()
+        pi = [sp.Symbol(f"pi{k}", real=True) for k in range(base.rank)]
+        motions = chain.forward(sym.qd, sym.qdd, self.robot.gravity)
+        tau = self._tau(program, chain, motions, self._placed(base, pi))
+        return Model("inverse_dynamics", self._joint_inputs(sym, "q", "qd", "qdd")
+                     + [Input("pi_full", pi, ARGUMENTS["pi_full"].meaning)] + self._gravity_inputs(),
+                     tau, (self.n,), "inverse dynamics over the base coefficients (Newton-Euler)", program, sym.trig)
+
+    def gravity(self, base=None) -> Model:
+        program, sym, chain = self._start()
+        params = self._grouped(program, base)
         zero = [0] * self.n
-        g = self._tau(program, chain, chain.forward(zero, zero, self.robot.gravity))
+        g = self._tau(program, chain, chain.forward(zero, zero, self.robot.gravity), params)
         return Model("gravity", self._joint_inputs(sym, "q") + [self._params_input()] + self._gravity_inputs(),
                      g, (self.n,), "gravity vector g(q)", program, sym.trig)
 
-    def mass_matrix(self) -> Model:
+    def mass_matrix(self, base=None) -> Model:
         program, sym, chain = self._start()
-        M = sp.zeros(self.n, self.n)
-        for k in range(self.n):
-            unit = [int(j == k) for j in range(self.n)]
-            column = self._tau(program, chain, chain.forward([0] * self.n, unit, [0, 0, 0]))
-            for j in range(k + 1):
-                M[j, k] = M[k, j] = column[j]
+        M = mass_matrix_columns(chain, self._grouped(program, base))  # composite bodies (derivation/composite.py)
         return Model("mass_matrix", self._joint_inputs(sym, "q") + [self._params_input()], list(M),
                      (self.n, self.n), "inertia matrix M(q), row-major", program, sym.trig)
 
-    def _tau(self, program, chain, motions):
+    def _grouped(self, program, base) -> list:
+        """The parameters the recursion reads: s itself, or s* from pi = K s (see above). Only
+        where no entry of K exceeds GROUPING_LIMIT in size: an entry like 1/0.0203 (a regrouping
+        that divides by a short length, PUMA 560) makes pi and the products with it cancel in
+        float (2e-4 of the torques instead of 2e-6); there the standard parameters stay. The
+        other example arms' largest entries (1/0.4 on the LWR, 6.5 on the UR5) cost nothing in
+        float (bench/bench_opcounts.py)."""
+        if base is None or any(abs(k) > GROUPING_LIMIT for row in base.K for k in row):
+            return self.s
+        program.section = f"base coefficients pi_{base.kind} = K s"
+        return self._placed(base, [_linear_form(program, row, self.s) for row in base.K])
+
+    def _placed(self, base, pi) -> list:
+        params = [sp.Integer(0)] * len(self.s)
+        for value, column in zip(pi, base.pivots):
+            params[column] = value
+        return params
+
+    def _tau(self, program, chain, motions, params):
         wrenches = []
         for i, motion in enumerate(motions):
             program.section = f"link {i + 1}: link wrench"
-            wrenches.append(link_wrench(program, motion, self.s[PER_LINK * i: PER_LINK * (i + 1)]))
+            wrenches.append(link_wrench(program, motion, params[PER_LINK * i: PER_LINK * (i + 1)]))
         return chain.backward(wrenches)
 
     # ---- regressors (all 10N columns) ---------------------------------------------------
@@ -145,6 +178,21 @@ class Derivation:
             out += program.let_vector(standard_from_dynamic_link(self.p[PER_LINK * i: PER_LINK * (i + 1)]))
         return Model("standard_from_dynamic", [Input("p", self.p, ARGUMENTS["p"].meaning)], out,
                      (PER_LINK * self.n,), "standard parameters s from dynamic parameters p", program)
+
+
+def _linear_form(program: Program, row, s) -> sp.Expr:
+    """sum_j row_j s_j with one product per distinct |row_j| != 1: the standard parameters that
+    share a factor are summed first (the masses of the links beyond a length, say), and those
+    sums and their products are variables that the other rows reuse."""
+    groups: dict = {}
+    for k, x in zip(row, s):
+        if k != 0:
+            groups.setdefault(abs(k), []).append(x if k > 0 else -x)
+    terms = []
+    for k in sorted(groups):
+        total = sp.Add(*groups[k])
+        terms.append(total if k == 1 else program.let(k * program.let(total)))
+    return program.let(sp.Add(*terms))
 
 
 def coefficient_model(derivation: Derivation, base, kind: str) -> Model:

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
+from .factoring import factored
 from .opcount import OpCount, count_all
 
 
@@ -131,20 +132,29 @@ def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
                        key=lambda s: (model.trig[s][0], model.trig[s][1]))
     if trig_used:
         body.append("/* joint angles */")
+    per_joint = {}
     for s in trig_used:
         joint, fn = model.trig[s]
+        per_joint.setdefault(joint, {})[fn] = s
+    for joint, fns in per_joint.items():
         angle = f"q[{joint}]"
         offset = joint_models[joint].offset
         if offset != 0:
             angle = f"q[{joint}] + {macro}_K({float(offset)!r})"
-        body.append(f"const {real} {s.name} = {macro}_{fn.upper()}({angle});")
+        if len(fns) == 2:  # one call for both (sincos where the C library has it)
+            body.append(f"{real} {fns['sin'].name}, {fns['cos'].name};")
+            body.append(f"{macro}_SINCOS({angle}, &{fns['sin'].name}, &{fns['cos'].name});")
+        else:
+            for fn, s in fns.items():
+                body.append(f"const {real} {s.name} = {macro}_{fn.upper()}({angle});")
     section = None
-    for a in pruned:
+    written = [factored(a.expr) for a in pruned]
+    for a, expr in zip(pruned, written):
         if a.section != section:
             section = a.section
             body.append(f"/* {section} */")
-        body.append(f"const {real} {names[a.symbol]} = {printer.doprint(a.expr)};")
-    ops = count_all([a.expr for a in pruned]) + OpCount(trig=len(trig_used))
+        body.append(f"const {real} {names[a.symbol]} = {printer.doprint(expr)};")
+    ops = count_all(written) + OpCount(trig=len(per_joint))  # a sin/cos pair counts once
     free = set().union(*(a.expr.free_symbols for a in pruned), *(sp.sympify(o).free_symbols for o in outputs))
     used = {inp.name for inp in model.inputs if free & set(inp.symbols)}
     if trig_used:

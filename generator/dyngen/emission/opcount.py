@@ -1,7 +1,9 @@
 """Operation counts of emitted code, counted as the C printer writes it.
 
 x*y*z is 2 multiplications, 2*x one, -x none (a sign flip); x**2 is one (printed x*x);
-a+b-c is 2 additions; x/y one division; sin and cos are counted apiece.
+a+b-c is 2 additions; x/y one division; sin and cos are counted apiece inside expressions. The
+emitted functions count their joint angles per library call: the sin and cos of one angle are
+one call (sincos, emission/c_code.py).
 """
 
 from __future__ import annotations

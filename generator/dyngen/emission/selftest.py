@@ -114,7 +114,7 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
 def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
     """What the self-test calls and compares, one entry per catalogue function, in catalogue
     order (the functions of p alone first: their outputs feed the others)."""
-    arrays = {"s": "standard_from_dynamic_out"}  # an argument computed by another function
+    arrays = {"s": "standard_from_dynamic_out", "pi_full": "pi_full_out"}  # arguments computed by another function
 
     def size(shape):
         return math.prod(dims[d] for d in shape)
@@ -131,7 +131,14 @@ def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
         check = {"name": fn.name, "state": fn.state, "out": f"{fn.name}_out",
                  "length": offset or size(fn.output.shape), "parts": parts,
                  "call": f"{prefix}_{fn.name}({', '.join(args)})", "expected": f"{BY_NAME[fn.expected].name}_expected",
-                 "label": fn.name, "times": None, "stacked": fn.check.stacked}
+                 "label": fn.name, "times": None, "stacked": fn.check.stacked,
+                 "own": not fn.check.expected}  # whether its expected values are its own (declared once)
+        check["size"] = None
+        if fn.check.size:  # |Y| |pi| of that regressor, computed at the same state before this check
+            regressor = BY_NAME[fn.check.size]
+            rows, cols = (dims[d] for d in regressor.output.shape)
+            check["size"] = {"Y": f"{regressor.name}_out", "pi": f"{regressor.check.times}_out", "rows": rows,
+                             "cols": cols}
         if fn.check.times:
             rows, cols = (dims[d] for d in fn.output.shape)
             check["times"] = {"out": f"{fn.check.times}_out", "rows": rows, "cols": cols}

@@ -1,0 +1,135 @@
+"""The CasADi competitor of bench_dynamics.py: a plain recursive Newton-Euler over casadi.SX,
+code-generated to C, as a careful CasADi user would write it.
+
+The arm is the Pinocchio model of the benchmark (tests/oracles/pinocchio_arm.py): per joint a
+placement (R, t) in the parent joint's frame, a rotation (RZ) or translation (PZ) about the
+local z, and the body's inertia in the joint frame. Rotation entries within 1e-12 of 0 or +-1
+are written as exact 0 and +-1 (what a user writing cos(pi/2) as 0 does), so that CasADi drops
+the products with them. Two variants, both code-generated with cse=True:
+
+    <arm>_cas_<fn>        the link parameters are an input: Pinocchio's dynamic parameters,
+                          10 per body [m, m c, I about the joint origin (xx, xy, yy, xz, yz, zz)]
+    <arm>_casb_<fn>       the same with the parameters baked in as numbers
+
+fn: rnea(q, qd, qdd[, params]), gravity(q[, params]) = rnea(q, 0, 0), mass_matrix(q[, params])
+= d rnea(q, 0, qdd; no gravity) / d qdd (casadi.jacobian), full n x n, row-major as dyngen's.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+VARIANTS = ("cas", "casb")
+FUNCTIONS = ("rnea", "gravity", "mass_matrix")
+
+
+def _clean(x: float) -> float:
+    for exact in (0.0, 1.0, -1.0):
+        if abs(x - exact) < 1e-12:
+            return exact
+    return float(x)
+
+
+def _cross(a, b):
+    return ca.vertcat(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _joints(model):
+    out = []
+    for j in range(1, model.njoints):
+        kind = model.joints[j].shortname()
+        M = model.jointPlacements[j]
+        R = ca.DM([[_clean(v) for v in row] for row in np.asarray(M.rotation)])
+        t = ca.DM([_clean(v) for v in np.asarray(M.translation)])
+        out.append((kind == "JointModelRZ", R, t))
+    return out
+
+
+def rnea(model, q, qd, qdd, params, gravity):
+    """tau of the plain recursion (SX); params: 10 per body, Pinocchio's dynamic parameters."""
+    joints = _joints(model)
+    n = len(joints)
+    z = ca.DM([0, 0, 1])
+    w, wd, a = ca.SX.zeros(3), ca.SX.zeros(3), -ca.SX(ca.DM(list(gravity)))
+    frames, wrenches = [], []
+    for i, (revolute, R0, t) in enumerate(joints):
+        if revolute:
+            c, s = ca.cos(q[i]), ca.sin(q[i])
+            Rq = ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
+            R, p = ca.mtimes(R0, Rq), t
+        else:
+            R, p = R0, t + ca.mtimes(R0, z) * q[i]
+        E = R.T
+        w_in = ca.mtimes(E, w)
+        a_i = ca.mtimes(E, a + _cross(wd, p) + _cross(w, _cross(w, p)))
+        wd_i = ca.mtimes(E, wd)
+        if revolute:
+            w_i = w_in + z * qd[i]
+            wd_i = wd_i + _cross(w_in, z * qd[i]) + z * qdd[i]
+        else:
+            w_i = w_in
+            a_i = a_i + 2 * _cross(w_i, z * qd[i]) + z * qdd[i]
+        w, wd, a = w_i, wd_i, a_i
+        m, h = params[10 * i], params[10 * i + 1:10 * i + 4]
+        xx, xy, yy, xz, yz, zz = (params[10 * i + k] for k in range(4, 10))
+        inertia = ca.vertcat(ca.horzcat(xx, xy, xz), ca.horzcat(xy, yy, yz), ca.horzcat(xz, yz, zz))
+        F = m * a + _cross(wd, h) + _cross(w, _cross(w, h))
+        N = ca.mtimes(inertia, wd) + _cross(w, ca.mtimes(inertia, w)) + _cross(h, a)
+        frames.append((revolute, R, p))
+        wrenches.append((F, N))
+    tau = [None] * n
+    f, nm = ca.SX.zeros(3), ca.SX.zeros(3)
+    for i in reversed(range(n)):
+        F, N = wrenches[i]
+        if i + 1 < n:
+            _, Rc, pc = frames[i + 1]
+            fc = ca.mtimes(Rc, f)
+            f, nm = F + fc, N + ca.mtimes(Rc, nm) + _cross(pc, fc)
+        else:
+            f, nm = F, N
+        tau[i] = nm[2] if frames[i][0] else f[2]
+    return ca.vertcat(*tau)
+
+
+def body_parameters(model) -> np.ndarray:
+    return np.concatenate([np.asarray(model.inertias[j].toDynamicParameters()).ravel()
+                           for j in range(1, model.njoints)])
+
+
+def functions(model, name: str) -> list:
+    """The six casadi.Function objects of one arm (both variants, three functions)."""
+    n = model.nv
+    q, qd, qdd = ca.SX.sym("q", n), ca.SX.sym("qd", n), ca.SX.sym("qdd", n)
+    params = ca.SX.sym("params", 10 * n)
+    baked = ca.SX(ca.DM(body_parameters(model)))
+    gravity = np.asarray(model.gravity.linear, dtype=float)
+    zero = ca.SX.zeros(n)
+    out = []
+    for variant, P in (("cas", params), ("casb", baked)):
+        extra = [params] if variant == "cas" else []
+        tau = rnea(model, q, qd, qdd, P, gravity)
+        g = rnea(model, q, zero, zero, P, gravity)
+        M = ca.jacobian(rnea(model, q, zero, qdd, P, [0.0, 0.0, 0.0]), qdd)
+        M_rows = ca.reshape(M.T, n * n, 1)  # row-major
+        opts = {"cse": True}
+        out.append(ca.Function(f"{name}_{variant}_rnea", [q, qd, qdd, *extra], [tau], opts))
+        out.append(ca.Function(f"{name}_{variant}_gravity", [q, *extra], [g], opts))
+        out.append(ca.Function(f"{name}_{variant}_mass_matrix", [q, *extra], [ca.densify(M_rows)], opts))
+    return out
+
+
+def generate(model, name: str, folder: Path) -> dict:
+    """Writes <name>_casadi.c and .h into folder; returns {function name: (sz_iw, sz_w)} and
+    the SX operation counts {function name: n_instructions}."""
+    fns = functions(model, name)
+    cg = ca.CodeGenerator(f"{name}_casadi.c", {"with_header": True, "casadi_real": "double"})
+    for f in fns:
+        cg.add(f)
+    cwd = Path.cwd()
+    folder.mkdir(parents=True, exist_ok=True)
+    cg.generate(str(folder) + "/")
+    del cwd
+    return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
+            for f in fns}
