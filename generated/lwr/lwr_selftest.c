@@ -1277,23 +1277,23 @@ size_of(regressor_out, pi_full_out, 7, 43));
         ++checks;
 
         lwr_control(q, qd, standard_from_dynamic_out, control_g_out, control_M_out, control_c_out);
-        failures += !compare("control.g", k, control_g_out, control_expected[k] + 0, 7);
+        failures += !compare("control.g", k, control_g_out, control_expected[k] + 0, 7, 0.0);
         ++checks;
-        failures += !compare("control.M", k, control_M_out, control_expected[k] + 7, 49);
+        failures += !compare("control.M", k, control_M_out, control_expected[k] + 7, 49, 0.0);
         ++checks;
-        failures += !compare("control.c", k, control_c_out, control_expected[k] + 56, 7);
+        failures += !compare("control.c", k, control_c_out, control_expected[k] + 56, 7, 0.0);
         ++checks;
 
         lwr_control_with_jacobian(q, qd, standard_from_dynamic_out, control_with_jacobian_g_out, control_with_jacobian_M_out, control_with_jacobian_c_out, control_with_jacobian_J_out, control_with_jacobian_jdot_qd_out);
-        failures += !compare("control_with_jacobian.g", k, control_with_jacobian_g_out, control_with_jacobian_expected[k] + 0, 7);
+        failures += !compare("control_with_jacobian.g", k, control_with_jacobian_g_out, control_with_jacobian_expected[k] + 0, 7, 0.0);
         ++checks;
-        failures += !compare("control_with_jacobian.M", k, control_with_jacobian_M_out, control_with_jacobian_expected[k] + 7, 49);
+        failures += !compare("control_with_jacobian.M", k, control_with_jacobian_M_out, control_with_jacobian_expected[k] + 7, 49, 0.0);
         ++checks;
-        failures += !compare("control_with_jacobian.c", k, control_with_jacobian_c_out, control_with_jacobian_expected[k] + 56, 7);
+        failures += !compare("control_with_jacobian.c", k, control_with_jacobian_c_out, control_with_jacobian_expected[k] + 56, 7, 0.0);
         ++checks;
-        failures += !compare("control_with_jacobian.J", k, control_with_jacobian_J_out, control_with_jacobian_expected[k] + 63, 42);
+        failures += !compare("control_with_jacobian.J", k, control_with_jacobian_J_out, control_with_jacobian_expected[k] + 63, 42, 0.0);
         ++checks;
-        failures += !compare("control_with_jacobian.jdot_qd", k, control_with_jacobian_jdot_qd_out, control_with_jacobian_expected[k] + 105, 6);
+        failures += !compare("control_with_jacobian.jdot_qd", k, control_with_jacobian_jdot_qd_out, control_with_jacobian_expected[k] + 105, 6, 0.0);
         ++checks;
     }
     printf("lwr self-test (%s): %s, %d checks at %d states, worst relative error %.1e (%s, state %d), tolerance %.0e\n",
