@@ -32,6 +32,9 @@
  *   lwr_rnea                     375 mul, 368 add, 0 div, 12 sin/cos
  *   lwr_gravity                  108 mul, 72 add, 0 div, 12 sin/cos
  *   lwr_mass_matrix              781 mul, 584 add, 0 div, 12 sin/cos
+ *   lwr_coriolis_matrix          1601 mul, 1401 add, 0 div, 12 sin/cos
+ *   lwr_mass_matrix_derivative   1607 mul, 1422 add, 0 div, 12 sin/cos
+ *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 12 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -164,6 +167,34 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
  * 781 mul, 584 add, 0 div, 12 sin/cos
  */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
+
+/* Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   C        [7 x 7]  row-major (written)
+ * 1601 mul, 1401 add, 0 div, 12 sin/cos
+ */
+void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *C);
+
+/* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   Mdot     [7 x 7]  row-major, symmetric (written)
+ * 1607 mul, 1422 add, 0 div, 12 sin/cos
+ */
+void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *Mdot);
+
+/* Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qr_d     [7]  reference velocities (Slotine-Li: qd_d - Lambda e)
+ *   qr_dd    [7]  reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)
+ *   Y        [7 x 43]  row-major (written)
+ * 773 mul, 465 add, 0 div, 12 sin/cos
+ */
+void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_real *qr_d, const lwr_real *qr_dd, lwr_real *Y);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [35] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

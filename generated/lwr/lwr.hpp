@@ -27,6 +27,7 @@
  *   RegressorInertia         28 x 39   Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)
  *   Regressor                 7 x 43   Y(q, qd, qdd): tau = Y pi_full
  *   Friction                 35 x 1    friction values, 5 per joint: Fc, Fv, Fs, vs, eps
+ *   JointMatrix               7 x 7    N x N, row-major: C(q, qd), M_dot(q, qd)
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -55,6 +56,7 @@ using RegressorGravity = Eigen::Matrix<Real, 7, 12, Eigen::RowMajor>;
 using RegressorInertia = Eigen::Matrix<Real, 28, 39, Eigen::RowMajor>;
 using Regressor = Eigen::Matrix<Real, 7, 43, Eigen::RowMajor>;
 using Friction = Eigen::Matrix<Real, 35, 1, Eigen::ColMajor>;
+using JointMatrix = Eigen::Matrix<Real, 7, 7, Eigen::RowMajor>;
 
 namespace detail {
 
@@ -314,6 +316,54 @@ inline Joints friction(const Eigen::MatrixBase<A0> &qd, const Eigen::MatrixBase<
     Joints tau;
     friction(qd, f, tau);
     return tau;
+}
+
+/* Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.
+ * lwr_coriolis_matrix(q: Joints, qd: Joints, s: Parameters, C: JointMatrix written) */
+template <typename A0, typename A1, typename A2, typename Out>
+inline void coriolis_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out> &C)
+{
+    lwr_coriolis_matrix(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<JointMatrix>(C));
+}
+
+template <typename A0, typename A1, typename A2>
+inline JointMatrix coriolis_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s)
+{
+    JointMatrix C;
+    coriolis_matrix(q, qd, s, C);
+    return C;
+}
+
+/* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.
+ * lwr_mass_matrix_derivative(q: Joints, qd: Joints, s: Parameters, Mdot: JointMatrix written) */
+template <typename A0, typename A1, typename A2, typename Out>
+inline void mass_matrix_derivative(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out> &Mdot)
+{
+    lwr_mass_matrix_derivative(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<JointMatrix>(Mdot));
+}
+
+template <typename A0, typename A1, typename A2>
+inline JointMatrix mass_matrix_derivative(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s)
+{
+    JointMatrix Mdot;
+    mass_matrix_derivative(q, qd, s, Mdot);
+    return Mdot;
+}
+
+/* Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).
+ * lwr_regressor_slotine_li(q: Joints, qd: Joints, qr_d: Joints, qr_dd: Joints, Y: Regressor written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out>
+inline void regressor_slotine_li(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qr_d, const Eigen::MatrixBase<A3> &qr_dd, const Eigen::MatrixBase<Out> &Y)
+{
+    lwr_regressor_slotine_li(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qr_d), detail::in<Joints>(qr_dd), detail::out<Regressor>(Y));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Regressor regressor_slotine_li(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qr_d, const Eigen::MatrixBase<A3> &qr_dd)
+{
+    Regressor Y;
+    regressor_slotine_li(q, qd, qr_d, qr_dd, Y);
+    return Y;
 }
 
 }  // namespace lwr

@@ -32,6 +32,9 @@
  *   stanford_rnea                311 mul, 314 add, 0 div, 8 sin/cos
  *   stanford_gravity             83 mul, 56 add, 0 div, 8 sin/cos
  *   stanford_mass_matrix         454 mul, 347 add, 0 div, 8 sin/cos
+ *   stanford_coriolis_matrix     946 mul, 793 add, 0 div, 8 sin/cos
+ *   stanford_mass_matrix_derivative 951 mul, 808 add, 0 div, 8 sin/cos
+ *   stanford_regressor_slotine_li 458 mul, 290 add, 0 div, 8 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -164,6 +167,34 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
  * 454 mul, 347 add, 0 div, 8 sin/cos
  */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
+
+/* Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   C        [6 x 6]  row-major (written)
+ * 946 mul, 793 add, 0 div, 8 sin/cos
+ */
+void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *C);
+
+/* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   Mdot     [6 x 6]  row-major, symmetric (written)
+ * 951 mul, 808 add, 0 div, 8 sin/cos
+ */
+void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot);
+
+/* Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qr_d     [6]  reference velocities (Slotine-Li: qd_d - Lambda e)
+ *   qr_dd    [6]  reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)
+ *   Y        [6 x 33]  row-major (written)
+ * 458 mul, 290 add, 0 div, 8 sin/cos
+ */
+void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *qd, const stanford_real *qr_d, const stanford_real *qr_dd, stanford_real *Y);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [30] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

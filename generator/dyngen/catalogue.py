@@ -39,6 +39,9 @@ ARGUMENTS = {
     "s": Argument(("parameters",), "standard parameters, 10 per link (docs/conventions.md)", "Parameters"),
     "gravity": Argument(("gravity_symbols",), "gravity symbols", "GravitySymbols"),  # only when gravity has symbols
     "f": Argument(("friction",), "per joint Fc, Fv, Fs, vs, eps", "Friction"),
+    "qr_d": Argument(("dof",), "reference velocities (Slotine-Li: qd_d - Lambda e)", "Joints"),
+    "qr_dd": Argument(("dof",), "reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)", "Joints"),
+    "tau": Argument(("dof",), "joint torques/forces", "Joints"),
 }
 
 
@@ -126,15 +129,30 @@ FRICTION = Function(
     Output("tau", ("dof",), "friction torques", "Joints"),
     "Joint friction (Coulomb, viscous, Stribeck), templates/friction.c.j2.", Check())
 
+CORIOLIS_MATRIX = Function(
+    "coriolis_matrix", "coriolis", "coriolis_matrix", ("q", "qd", "s"),
+    Output("C", ("dof", "dof"), "row-major", "JointMatrix"),
+    "Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.", Check())
+MASS_MATRIX_DERIVATIVE = Function(
+    "mass_matrix_derivative", "coriolis", "mass_matrix_derivative", ("q", "qd", "s"),
+    Output("Mdot", ("dof", "dof"), "row-major, symmetric", "JointMatrix"),
+    "Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.", Check())
+REGRESSOR_SLOTINE_LI = Function(
+    "regressor_slotine_li", "regressors", "regressor_slotine_li", ("q", "qd", "qr_d", "qr_dd", "gravity"),
+    Output("Y", ("dof", "pi_full"), "row-major", "Regressor"),
+    "Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).",
+    Check("rnea", times="pi_full"), "full")
+
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
-             FRICTION)
+             FRICTION, CORIOLIS_MATRIX, MASS_MATRIX_DERIVATIVE, REGRESSOR_SLOTINE_LI)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
 JACOBIANS = {"gravity": PI_GRAVITY_JACOBIAN, "inertia": PI_INERTIA_JACOBIAN, "full": PI_FULL_JACOBIAN}
 REGRESSORS = {"gravity": REGRESSOR_GRAVITY, "inertia": REGRESSOR_INERTIA, "full": REGRESSOR}
 SOURCES = {"parameters": "parameters and base coefficients", "regressors": "base regressors",
-           "dynamics": "inverse dynamics, gravity and inertia matrix"}  # straight-line C files, in order
+           "dynamics": "inverse dynamics, gravity and inertia matrix",
+           "coriolis": "Coriolis matrix and inertia matrix derivative"}  # straight-line C files, in order
 
 
 def dimensions(dof: int, ranks: dict, gravity_symbols: int) -> dict:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from .atomic import write_folder
 from .catalogue import KINDS
+from .derivation.controller import controller_models
 from .derivation.models import Derivation
 from .description import Robot, load_robot
 from .emission.render import Emitted, emit
@@ -54,7 +55,7 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
         regressors = {kind: derivation.regressor(kind) for kind in ("gravity", "full")}
         reduced = {**regressors, "inertia": derivation.regressor("full_without_gravity")}
         models = {"rnea": derivation.rnea(), "gravity": derivation.gravity(), "mass_matrix": derivation.mass_matrix(),
-                  "unit_accelerations": derivation.unit_accelerations()}
+                  "unit_accelerations": derivation.unit_accelerations(), **controller_models(derivation)}
     with progress.step("reduce to base coefficients (exact rank)"):
         bases: dict[str, BaseSet] = {kind: reduce_model(reduced[kind], kind) for kind in KINDS}
         if bases["gravity"].rank == 0:  # C has no zero-length arrays for pi_gravity and Y_g

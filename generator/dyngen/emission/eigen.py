@@ -20,6 +20,7 @@ TYPE_DOCS = {
     "RegressorInertia": "Y_m(q): row k is entry k of the stacked upper triangle of M (M11, M12, ..., MNN)",
     "Regressor": "Y(q, qd, qdd): tau = Y pi_full",
     "Friction": "friction values, 5 per joint: Fc, Fv, Fs, vs, eps",
+    "JointMatrix": "N x N, row-major: C(q, qd), M_dot(q, qd)",
 }
 
 

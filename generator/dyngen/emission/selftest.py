@@ -115,7 +115,9 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
 def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
     """What the self-test calls and compares, one entry per catalogue function, in catalogue
     order (the functions of p alone first: their outputs feed the others)."""
-    arrays = {"s": "standard_from_dynamic_out"}  # an argument computed by another function
+    # an argument computed by another function, or a state array standing for another one
+    # (the Slotine-Li regressor at qr_d = qd, qr_dd = qdd is the regressor of tau)
+    arrays = {"s": "standard_from_dynamic_out", "qr_d": "qd", "qr_dd": "qdd", "tau": "rnea_out"}
 
     def size(shape):
         return math.prod(dims[d] for d in shape)
