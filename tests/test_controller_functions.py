@@ -58,3 +58,19 @@ def test_slotine_li_regressor(built):
         for name, (got, want) in checks.items():
             worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
     assert all(err < TOL for err in worst.values()), worst
+
+
+def test_forward_dynamics(built):
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 4):
+        tau = built.c("rnea", q, qd, qdd, s)
+        M = lag.mass_matrix(built.arm, q, p)
+        bias = lag.coriolis(built.arm, q, qd, p) + lag.gravity(built.arm, q, p)
+        checks = {"FD(ID(qdd)) = qdd": (built.c("forward_dynamics", q, qd, tau, s), qdd),
+                  "Lagrangian M^-1 (tau - c - g)": (built.c("forward_dynamics", q, qd, tau, s),
+                                                    np.linalg.solve(M, tau - bias)),
+                  "Pinocchio aba": (built.c("forward_dynamics", q, qd, tau, s),
+                                    pin_control.forward_dynamics(built.arm, p, q, qd, tau))}
+        for name, (got, want) in checks.items():
+            worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+    assert all(err < TOL for err in worst.values()), worst

@@ -35,6 +35,7 @@
  *   lwr_coriolis_matrix          1601 mul, 1401 add, 0 div, 12 sin/cos
  *   lwr_mass_matrix_derivative   1607 mul, 1422 add, 0 div, 12 sin/cos
  *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 12 sin/cos
+ *   lwr_forward_dynamics         1268 mul, 1038 add, 7 div, 12 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -195,6 +196,16 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
  * 773 mul, 465 add, 0 div, 12 sin/cos
  */
 void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_real *qr_d, const lwr_real *qr_dd, lwr_real *Y);
+
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   tau      [7]  joint torques/forces
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   qdd      [7]  joint accelerations (written)
+ * 1268 mul, 1038 add, 7 div, 12 sin/cos
+ */
+void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [35] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

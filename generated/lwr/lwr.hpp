@@ -366,6 +366,22 @@ inline Regressor regressor_slotine_li(const Eigen::MatrixBase<A0> &q, const Eige
     return Y;
 }
 
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+ * lwr_forward_dynamics(q: Joints, qd: Joints, tau: Joints, s: Parameters, qdd: Joints written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out>
+inline void forward_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out> &qdd)
+{
+    lwr_forward_dynamics(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(tau), detail::in<Parameters>(s), detail::out<Joints>(qdd));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Joints forward_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s)
+{
+    Joints qdd;
+    forward_dynamics(q, qd, tau, s, qdd);
+    return qdd;
+}
+
 }  // namespace lwr
 
 #endif /* LWR_HPP */

@@ -835,6 +835,11 @@ static const double mass_matrix_derivative_expected[N_STATES][49] = {
       -0.009150858819026036, 0.000989740954794594, -0.006420773828128923, -0.003187660289531038, -0.001128770459969717, -0.0007831416173099657, 0.0,
       1.7847510794440083e-44, 0.0001541232451148026, 1.0232819729254876e-05, -7.79316869924158e-05, 5.3985789793848064e-05, 0.0, 0.0 },
 };
+static const double forward_dynamics_expected[N_STATES][7] = {
+    { -2.0, -1.0000000000000004, 5.077122607461265e-17, 0.9999999999999994, 1.9999999999999993, -1.333333333333333, -0.3333333333333326 },
+    { -0.33333333333333287, 0.6666666666666671, 1.6666666666666656, -1.6666666666666652, -0.6666666666666657, 0.3333333333333345, 1.3333333333333337 },
+    { 1.3333333333333326, -1.9999999999999996, -0.9999999999999993, 1.5032938827546726e-15, 0.9999999999999991, 2.0000000000000004, -1.333333333333334 },
+};
 
 /* Work arrays: static rather than on the stack, for small firmware stacks. */
 static lwr_real p[LWR_N_PARAMETERS], f[5 * LWR_DOF];
@@ -856,6 +861,7 @@ static lwr_real friction_out[7];
 static lwr_real coriolis_matrix_out[49];
 static lwr_real mass_matrix_derivative_out[49];
 static lwr_real regressor_slotine_li_out[301];
+static lwr_real forward_dynamics_out[7];
 static double got[3010], want[3010];
 
 static double worst = 0.0;
@@ -982,6 +988,10 @@ int main(void)
         lwr_regressor_slotine_li(q, qd, qd, qdd, regressor_slotine_li_out);
         times(regressor_slotine_li_out, pi_full_out, 7, 43, got);
         failures += !check("regressor_slotine_li * pi_full", k, got, rnea_expected[k], 7);
+        ++checks;
+
+        lwr_forward_dynamics(q, qd, rnea_out, standard_from_dynamic_out, forward_dynamics_out);
+        failures += !compare("forward_dynamics", k, forward_dynamics_out, forward_dynamics_expected[k], 7);
         ++checks;
     }
     printf("lwr self-test (%s): %s, %d checks at %d states, worst relative error %.1e (%s, state %d), tolerance %.0e\n",

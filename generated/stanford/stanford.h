@@ -35,6 +35,7 @@
  *   stanford_coriolis_matrix     946 mul, 793 add, 0 div, 8 sin/cos
  *   stanford_mass_matrix_derivative 951 mul, 808 add, 0 div, 8 sin/cos
  *   stanford_regressor_slotine_li 458 mul, 290 add, 0 div, 8 sin/cos
+ *   stanford_forward_dynamics    826 mul, 693 add, 6 div, 8 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -195,6 +196,16 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
  * 458 mul, 290 add, 0 div, 8 sin/cos
  */
 void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *qd, const stanford_real *qr_d, const stanford_real *qr_dd, stanford_real *Y);
+
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   tau      [6]  joint torques/forces
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   qdd      [6]  joint accelerations (written)
+ * 826 mul, 693 add, 6 div, 8 sin/cos
+ */
+void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [30] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

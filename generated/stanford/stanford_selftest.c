@@ -601,6 +601,11 @@ static const double mass_matrix_derivative_expected[N_STATES][36] = {
       2.064398051816869, -1.6488621353583504, -0.2508515545684599, -0.0004500775856441996, 0.0, -2.3128431153681106e-42,
       0.00011092227351973778, -8.104534588022096e-05, 0.0, 0.00012622064772118446, -2.3128431153681106e-42, 0.0 },
 };
+static const double forward_dynamics_expected[N_STATES][6] = {
+    { -2.0, -1.0, 8.822325264848042e-16, 1.0000000000000002, 2.0000000000000004, -1.3333333333333333 },
+    { -0.33333333333333337, 0.6666666666666667, 1.6666666666666672, -1.6666666666666663, -0.6666666666666664, 0.33333333333333315 },
+    { 1.3333333333333333, -2.0, -1.0000000000000007, 1.2290219352678131e-16, 1.0000000000000007, 1.9999999999999998 },
+};
 
 /* Work arrays: static rather than on the stack, for small firmware stacks. */
 static stanford_real p[STANFORD_N_PARAMETERS], f[5 * STANFORD_DOF];
@@ -622,6 +627,7 @@ static stanford_real friction_out[6];
 static stanford_real coriolis_matrix_out[36];
 static stanford_real mass_matrix_derivative_out[36];
 static stanford_real regressor_slotine_li_out[198];
+static stanford_real forward_dynamics_out[6];
 static double got[1980], want[1980];
 
 static double worst = 0.0;
@@ -748,6 +754,10 @@ int main(void)
         stanford_regressor_slotine_li(q, qd, qd, qdd, regressor_slotine_li_out);
         times(regressor_slotine_li_out, pi_full_out, 6, 33, got);
         failures += !check("regressor_slotine_li * pi_full", k, got, rnea_expected[k], 6);
+        ++checks;
+
+        stanford_forward_dynamics(q, qd, rnea_out, standard_from_dynamic_out, forward_dynamics_out);
+        failures += !compare("forward_dynamics", k, forward_dynamics_out, forward_dynamics_expected[k], 6);
         ++checks;
     }
     printf("stanford self-test (%s): %s, %d checks at %d states, worst relative error %.1e (%s, state %d), tolerance %.0e\n",

@@ -142,17 +142,23 @@ REGRESSOR_SLOTINE_LI = Function(
     Output("Y", ("dof", "pi_full"), "row-major", "Regressor"),
     "Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).",
     Check("rnea", times="pi_full"), "full")
+FORWARD_DYNAMICS = Function(
+    "forward_dynamics", "forward", "forward_dynamics", ("q", "qd", "tau", "s", "gravity"),
+    Output("qdd", ("dof",), "joint accelerations", "Joints"),
+    "Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.", Check())
 
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
-             FRICTION, CORIOLIS_MATRIX, MASS_MATRIX_DERIVATIVE, REGRESSOR_SLOTINE_LI)
+             FRICTION, CORIOLIS_MATRIX, MASS_MATRIX_DERIVATIVE, REGRESSOR_SLOTINE_LI,
+             FORWARD_DYNAMICS)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
 JACOBIANS = {"gravity": PI_GRAVITY_JACOBIAN, "inertia": PI_INERTIA_JACOBIAN, "full": PI_FULL_JACOBIAN}
 REGRESSORS = {"gravity": REGRESSOR_GRAVITY, "inertia": REGRESSOR_INERTIA, "full": REGRESSOR}
 SOURCES = {"parameters": "parameters and base coefficients", "regressors": "base regressors",
            "dynamics": "inverse dynamics, gravity and inertia matrix",
-           "coriolis": "Coriolis matrix and inertia matrix derivative"}  # straight-line C files, in order
+           "coriolis": "Coriolis matrix and inertia matrix derivative",
+           "forward": "forward dynamics"}  # straight-line C files, in order
 
 
 def dimensions(dof: int, ranks: dict, gravity_symbols: int) -> dict:

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from . import coriolis
+from . import coriolis, forward_dynamics
 from .models import Derivation
 
 
 def controller_models(derivation: Derivation) -> dict:
     return {"coriolis_matrix": coriolis.coriolis_matrix(derivation),
             "mass_matrix_derivative": coriolis.mass_matrix_derivative(derivation),
-            "regressor_slotine_li": coriolis.slotine_li_regressor(derivation)}
+            "regressor_slotine_li": coriolis.slotine_li_regressor(derivation),
+            "forward_dynamics": forward_dynamics.forward_dynamics(derivation)}

@@ -56,7 +56,7 @@ def _step(chain: Chain, i, parent: Motion, wu_parent, u_i, v_i, qdd_i):
     return Motion(wv, wd, lets(a_in), U, ww), wu
 
 
-def _start(derivation: Derivation):
+def start(derivation: Derivation):
     program = Program()
     sym = joint_symbols(derivation.robot)
     return program, sym, Chain(derivation.robot, program, sym)
@@ -85,15 +85,15 @@ def coriolis_columns(derivation: Derivation, chain: Chain, qd) -> sp.Matrix:
 
 
 def coriolis_matrix(derivation: Derivation) -> Model:
-    program, sym, chain = _start(derivation)
+    program, sym, chain = start(derivation)
     C = coriolis_columns(derivation, chain, sym.qd)
-    return Model("coriolis_matrix", _joint_inputs(sym, "q", "qd") + [_params(derivation)], list(C),
+    return Model("coriolis_matrix", model_inputs(derivation, sym, qd=True), list(C),
                  (derivation.n, derivation.n), "Christoffel Coriolis matrix C(q, qd), row-major", program, sym.trig)
 
 
 def mass_matrix_derivative(derivation: Derivation) -> Model:
     """M_dot = C + C^T (M_dot - 2 C is skew-symmetric)."""
-    program, sym, chain = _start(derivation)
+    program, sym, chain = start(derivation)
     C = coriolis_columns(derivation, chain, sym.qd)
     program.section = "M_dot = C + C^T"
     n = derivation.n
@@ -101,7 +101,7 @@ def mass_matrix_derivative(derivation: Derivation) -> Model:
     for i in range(n):
         for j in range(i, n):
             Md[i, j] = Md[j, i] = program.let(C[i, j] + C[j, i])
-    return Model("mass_matrix_derivative", _joint_inputs(sym, "q", "qd") + [_params(derivation)], list(Md),
+    return Model("mass_matrix_derivative", model_inputs(derivation, sym, qd=True), list(Md),
                  (n, n), "time derivative of the inertia matrix, row-major", program, sym.trig)
 
 
@@ -112,24 +112,23 @@ def reference_symbols(n: int) -> dict:
 
 def slotine_li_regressor(derivation: Derivation) -> Model:
     """Y(q, qd, qr_d, qr_dd) over all 10N standard parameters: Y s = M qr_dd + C(q, qd) qr_d + g."""
-    program, sym, chain = _start(derivation)
+    program, sym, chain = start(derivation)
     ref = reference_symbols(derivation.n)
     half = program.let_vector([HALF * x for x in sym.qd])
     rows = chain.regressor_columns(bilinear_forward(chain, half, ref["qr_d"], ref["qr_dd"], derivation.robot.gravity))
-    inputs = (_joint_inputs(sym, "q", "qd") + [Input(k, ref[k], ARGUMENTS[k].meaning) for k in ("qr_d", "qr_dd")]
-              + _gravity(derivation))
+    inputs = model_inputs(derivation, sym, qd=True, s=False, gravity=True, **ref)
     return Model("regressor_slotine_li", inputs, [x for row in rows for x in row], (len(rows), PER_LINK * derivation.n),
                  "Slotine-Li regressor over all standard parameters", program, sym.trig)
 
 
-def _joint_inputs(sym, *which) -> list[Input]:
-    return [Input(w, getattr(sym, w), ARGUMENTS[w].meaning) for w in which]
-
-
-def _params(derivation: Derivation) -> Input:
-    return Input("s", derivation.s, ARGUMENTS["s"].meaning)
-
-
-def _gravity(derivation: Derivation) -> list[Input]:
+def model_inputs(derivation: Derivation, sym, q=True, qd=False, qdd=False, s=True, gravity=False, **extra) -> list[Input]:
+    """A model's inputs in the catalogue's order: q, qd, qdd, then the extra vectors (name ->
+    symbols, e.g. qr_d, tau), s, gravity (only when gravity has symbols)."""
+    inputs = [Input(w, getattr(sym, w), ARGUMENTS[w].meaning) for w, on in (("q", q), ("qd", qd), ("qdd", qdd)) if on]
+    inputs += [Input(name, symbols, ARGUMENTS[name].meaning) for name, symbols in extra.items()]
+    if s:
+        inputs.append(Input("s", derivation.s, ARGUMENTS["s"].meaning))
     g = list(derivation.robot.gravity_symbols)
-    return [Input("gravity", g, ARGUMENTS["gravity"].meaning + " " + ", ".join(map(str, g)))] if g else []
+    if gravity and g:
+        inputs.append(Input("gravity", g, ARGUMENTS["gravity"].meaning + " " + ", ".join(map(str, g))))
+    return inputs

@@ -95,7 +95,8 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
     gravity = [GRAVITY_SYMBOL_VALUES[k % len(GRAVITY_SYMBOL_VALUES)] for k in range(len(robot.gravity_symbols))]
     f = fixed_friction(robot.dof)
     states = fixed_states(robot)
-    direct = [fn for fn in FUNCTIONS if not fn.check.expected]
+    direct = [fn for fn in FUNCTIONS if not fn.check.expected]  # in catalogue order: rnea before what takes
+    # its output as tau (selftest_checks passes rnea_out)
     once = {fn.name: evaluate(programs[fn.name][0], joint_models, {"p": p}) for fn in direct if not fn.state}
     s = once["standard_from_dynamic"]
     per_state = {}
@@ -107,8 +108,9 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
             per_state[fn.name] = [friction_torques(qd, f) for _, qd, _ in states]
         else:
             per_state[fn.name] = [evaluate(programs[fn.name][0], joint_models,
-                                           {"q": q, "qd": qd, "qdd": qdd, "s": s, "gravity": gravity})
-                                  for q, qd, qdd in states]
+                                           {"q": q, "qd": qd, "qdd": qdd, "s": s, "gravity": gravity,
+                                            **({"tau": per_state["rnea"][k]} if "tau" in fn.inputs else {})})
+                                  for k, (q, qd, qdd) in enumerate(states)]
     return SelfTestData(p, gravity, f, states, once, per_state)
 
 
