@@ -74,3 +74,45 @@ def test_forward_dynamics(built):
         for name, (got, want) in checks.items():
             worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
     assert all(err < TOL for err in worst.values()), worst
+
+
+def central_differences(f, q, qd, h=1e-6):
+    """[df/dq | df/dqd] of a vector function f(q, qd) by central differences."""
+    n = q.size
+    D = np.zeros((n, 2 * n))
+    for k in range(2 * n):
+        e = np.zeros(2 * n)
+        e[k] = h
+        D[:, k] = (f(q + e[:n], qd + e[n:]) - f(q - e[:n], qd - e[n:])) / (2 * h)
+    return D
+
+
+def test_rnea_derivatives(built):
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 5, count=30):
+        D = built.c("rnea_derivatives", q, qd, qdd, s)
+        dq, dv = pin_control.rnea_derivatives(built.arm, p, q, qd, qdd)
+        numeric = central_differences(lambda a, b: built.c("rnea", a, b, qdd, s), q, qd)
+        worst["Pinocchio computeRNEADerivatives"] = max(worst.get("Pinocchio computeRNEADerivatives", 0.0),
+                                                       rel_err(D, np.hstack([dq, dv])))
+        worst["central differences of rnea"] = max(worst.get("central differences of rnea", 0.0), rel_err(D, numeric))
+    assert worst["Pinocchio computeRNEADerivatives"] < TOL, worst
+    assert worst["central differences of rnea"] < 1e-7, worst  # the differences' own truncation and rounding
+
+
+def test_forward_dynamics_derivatives(built):
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 6, count=30):
+        tau = built.c("rnea", q, qd, qdd, s)
+        D = built.c("forward_dynamics_derivatives", q, qd, tau, s)
+        dq, dv = pin_control.aba_derivatives(built.arm, p, q, qd, tau)
+        M = lag.mass_matrix(built.arm, q, p)
+        through_rnea = -np.linalg.solve(M, built.c("rnea_derivatives", q, qd, qdd, s))
+        numeric = central_differences(lambda a, b: built.c("forward_dynamics", a, b, tau, s), q, qd)
+        checks = {"Pinocchio computeABADerivatives": (D, np.hstack([dq, dv])),
+                  "-M^-1 d rnea (Lagrangian M)": (D, through_rnea)}
+        for name, (got, want) in checks.items():
+            worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+        worst["central differences of FD"] = max(worst.get("central differences of FD", 0.0), rel_err(D, numeric))
+    assert worst["Pinocchio computeABADerivatives"] < TOL and worst["-M^-1 d rnea (Lagrangian M)"] < TOL, worst
+    assert worst["central differences of FD"] < 1e-6, worst

@@ -36,6 +36,8 @@
  *   lwr_mass_matrix_derivative   1607 mul, 1422 add, 0 div, 12 sin/cos
  *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 12 sin/cos
  *   lwr_forward_dynamics         1268 mul, 1038 add, 7 div, 12 sin/cos
+ *   lwr_rnea_derivatives         3375 mul, 2931 add, 0 div, 12 sin/cos
+ *   lwr_forward_dynamics_derivatives 5167 mul, 4463 add, 7 div, 12 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -206,6 +208,26 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
  * 1268 mul, 1038 add, 7 div, 12 sin/cos
  */
 void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd);
+
+/* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qdd      [7]  joint accelerations
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [7 x 14]  row-major, [d tau / d q | d tau / d qd] (written)
+ * 3375 mul, 2931 add, 0 div, 12 sin/cos
+ */
+void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *D);
+
+/* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   tau      [7]  joint torques/forces
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [7 x 14]  row-major, [d qdd / d q | d qdd / d qd] (written)
+ * 5167 mul, 4463 add, 7 div, 12 sin/cos
+ */
+void lwr_forward_dynamics_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *D);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [35] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

@@ -28,6 +28,7 @@
  *   Regressor                 7 x 43   Y(q, qd, qdd): tau = Y pi_full
  *   Friction                 35 x 1    friction values, 5 per joint: Fc, Fv, Fs, vs, eps
  *   JointMatrix               7 x 7    N x N, row-major: C(q, qd), M_dot(q, qd)
+ *   Derivatives               7 x 14   N x 2N, row-major: [d / d q | d / d qd] of tau or qdd
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -57,6 +58,7 @@ using RegressorInertia = Eigen::Matrix<Real, 28, 39, Eigen::RowMajor>;
 using Regressor = Eigen::Matrix<Real, 7, 43, Eigen::RowMajor>;
 using Friction = Eigen::Matrix<Real, 35, 1, Eigen::ColMajor>;
 using JointMatrix = Eigen::Matrix<Real, 7, 7, Eigen::RowMajor>;
+using Derivatives = Eigen::Matrix<Real, 7, 14, Eigen::RowMajor>;
 
 namespace detail {
 
@@ -380,6 +382,38 @@ inline Joints forward_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::Matr
     Joints qdd;
     forward_dynamics(q, qd, tau, s, qdd);
     return qdd;
+}
+
+/* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).
+ * lwr_rnea_derivatives(q: Joints, qd: Joints, qdd: Joints, s: Parameters, D: Derivatives written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out>
+inline void rnea_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out> &D)
+{
+    lwr_rnea_derivatives(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qdd), detail::in<Parameters>(s), detail::out<Derivatives>(D));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Derivatives rnea_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &s)
+{
+    Derivatives D;
+    rnea_derivatives(q, qd, qdd, s, D);
+    return D;
+}
+
+/* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).
+ * lwr_forward_dynamics_derivatives(q: Joints, qd: Joints, tau: Joints, s: Parameters, D: Derivatives written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out>
+inline void forward_dynamics_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out> &D)
+{
+    lwr_forward_dynamics_derivatives(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(tau), detail::in<Parameters>(s), detail::out<Derivatives>(D));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Derivatives forward_dynamics_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s)
+{
+    Derivatives D;
+    forward_dynamics_derivatives(q, qd, tau, s, D);
+    return D;
 }
 
 }  // namespace lwr

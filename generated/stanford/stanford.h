@@ -36,6 +36,8 @@
  *   stanford_mass_matrix_derivative 951 mul, 808 add, 0 div, 8 sin/cos
  *   stanford_regressor_slotine_li 458 mul, 290 add, 0 div, 8 sin/cos
  *   stanford_forward_dynamics    826 mul, 693 add, 6 div, 8 sin/cos
+ *   stanford_rnea_derivatives    2017 mul, 1731 add, 0 div, 8 sin/cos
+ *   stanford_forward_dynamics_derivatives 3180 mul, 2726 add, 6 div, 8 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -206,6 +208,26 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
  * 826 mul, 693 add, 6 div, 8 sin/cos
  */
 void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd);
+
+/* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qdd      [6]  joint accelerations
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [6 x 12]  row-major, [d tau / d q | d tau / d qd] (written)
+ * 2017 mul, 1731 add, 0 div, 8 sin/cos
+ */
+void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *D);
+
+/* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   tau      [6]  joint torques/forces
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [6 x 12]  row-major, [d qdd / d q | d qdd / d qd] (written)
+ * 3180 mul, 2726 add, 6 div, 8 sin/cos
+ */
+void stanford_forward_dynamics_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *D);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [30] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

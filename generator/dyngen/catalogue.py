@@ -7,7 +7,7 @@ manifest derive from it; code that calls the generated functions (identification
 validation, diagnosis) takes their names from here. The C name is <robot>_<name>.
 
 Shapes are tuples of dimension names, resolved per robot by `dimensions`:
-dof (N), parameters (10 N), stacked (N(N+1)/2), gravity_symbols, friction (5 N) and
+dof (N), state (2 N: q and qd), parameters (10 N), stacked (N(N+1)/2), gravity_symbols, friction (5 N) and
 pi_<kind> (the number of base coefficients of a kind).
 """
 
@@ -146,11 +146,20 @@ FORWARD_DYNAMICS = Function(
     "forward_dynamics", "forward", "forward_dynamics", ("q", "qd", "tau", "s", "gravity"),
     Output("qdd", ("dof",), "joint accelerations", "Joints"),
     "Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.", Check())
+RNEA_DERIVATIVES = Function(
+    "rnea_derivatives", "derivatives", "rnea_derivatives", ("q", "qd", "qdd", "s", "gravity"),
+    Output("D", ("dof", "state"), "row-major, [d tau / d q | d tau / d qd]", "Derivatives"),
+    "Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).", Check())
+FORWARD_DYNAMICS_DERIVATIVES = Function(
+    "forward_dynamics_derivatives", "derivatives", "forward_dynamics_derivatives", ("q", "qd", "tau", "s", "gravity"),
+    Output("D", ("dof", "state"), "row-major, [d qdd / d q | d qdd / d qd]", "Derivatives"),
+    "Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] "
+    "at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).", Check())
 
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
              FRICTION, CORIOLIS_MATRIX, MASS_MATRIX_DERIVATIVE, REGRESSOR_SLOTINE_LI,
-             FORWARD_DYNAMICS)
+             FORWARD_DYNAMICS, RNEA_DERIVATIVES, FORWARD_DYNAMICS_DERIVATIVES)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
 JACOBIANS = {"gravity": PI_GRAVITY_JACOBIAN, "inertia": PI_INERTIA_JACOBIAN, "full": PI_FULL_JACOBIAN}
@@ -158,11 +167,12 @@ REGRESSORS = {"gravity": REGRESSOR_GRAVITY, "inertia": REGRESSOR_INERTIA, "full"
 SOURCES = {"parameters": "parameters and base coefficients", "regressors": "base regressors",
            "dynamics": "inverse dynamics, gravity and inertia matrix",
            "coriolis": "Coriolis matrix and inertia matrix derivative",
-           "forward": "forward dynamics"}  # straight-line C files, in order
+           "forward": "forward dynamics",
+           "derivatives": "derivatives of inverse and forward dynamics"}  # straight-line C files, in order
 
 
 def dimensions(dof: int, ranks: dict, gravity_symbols: int) -> dict:
     """Dimension name -> size for one robot; ranks: kind -> number of base coefficients."""
-    return {"dof": dof, "parameters": PER_LINK * dof, "stacked": dof * (dof + 1) // 2,
+    return {"dof": dof, "state": 2 * dof, "parameters": PER_LINK * dof, "stacked": dof * (dof + 1) // 2,
             "gravity_symbols": gravity_symbols, "friction": FRICTION_PER_JOINT * dof,
             **{f"pi_{kind}": rank for kind, rank in ranks.items()}}

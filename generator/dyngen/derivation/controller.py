@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from . import coriolis, forward_dynamics
+from . import coriolis, derivatives, forward_dynamics
 from .models import Derivation
 
 
@@ -10,4 +10,6 @@ def controller_models(derivation: Derivation) -> dict:
     return {"coriolis_matrix": coriolis.coriolis_matrix(derivation),
             "mass_matrix_derivative": coriolis.mass_matrix_derivative(derivation),
             "regressor_slotine_li": coriolis.slotine_li_regressor(derivation),
-            "forward_dynamics": forward_dynamics.forward_dynamics(derivation)}
+            "forward_dynamics": forward_dynamics.forward_dynamics(derivation),
+            "rnea_derivatives": derivatives.rnea_derivatives(derivation),
+            "forward_dynamics_derivatives": derivatives.forward_dynamics_derivatives(derivation)}

@@ -21,6 +21,7 @@ TYPE_DOCS = {
     "Regressor": "Y(q, qd, qdd): tau = Y pi_full",
     "Friction": "friction values, 5 per joint: Fc, Fv, Fs, vs, eps",
     "JointMatrix": "N x N, row-major: C(q, qd), M_dot(q, qd)",
+    "Derivatives": "N x 2N, row-major: [d / d q | d / d qd] of tau or qdd",
 }
 
 
