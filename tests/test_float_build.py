@@ -59,6 +59,13 @@ def test_float_build_agrees_with_double(built, tmp_path_factory):
             compare("regressor_gravity", q, *g)
             compare("regressor_inertia", q)
             compare("regressor", q, qd, qdd, *g)
+            compare("coriolis_matrix", q, qd, s)
+            compare("mass_matrix_derivative", q, qd, s)
+            compare("regressor_slotine_li", q, qd, *float_inputs(rng.uniform(-2, 2, n), rng.uniform(-5, 5, n)), *g)
+            compare("rnea_derivatives", q, qd, qdd, s, *g)
+            (tau,) = float_inputs(double("rnea", q, qd, qdd, s, *g))
+            compare("forward_dynamics", q, qd, tau, s, *g)
+            compare("forward_dynamics_derivatives", q, qd, tau, s, *g)
             # friction: per joint Fc, Fv, Fs, vs, eps (templates/friction.c.j2)
             (f,) = float_inputs(np.column_stack([rng.uniform(0, 2, n), rng.uniform(0, 1, n), rng.uniform(0, 1, n),
                                                  rng.uniform(0.01, 0.5, n), rng.uniform(1e-3, 0.05, n)]).ravel())
