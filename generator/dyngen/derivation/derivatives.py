@@ -26,18 +26,22 @@ class ForwardMode:
     """Tangents of some outputs of a program along input directions, as new lets of the same
     program; the partial derivatives of an assignment are shared by every direction."""
 
-    def __init__(self, program: Program, outputs):
-        self.program, self.outputs = program, list(outputs)
-        self.assignments = program.pruned(self.outputs)  # before any tangent is added
+    def __init__(self, program: Program, outputs, frozen=frozenset()):
+        """frozen: symbols held constant (tangent zero); what only they need is not visited."""
+        self.program, self.outputs, self.frozen = program, list(outputs), frozen
+        needed = set().union(*(sp.sympify(o).free_symbols for o in self.outputs))
+        kept = []
+        for a in reversed(program.assignments):  # before any tangent is added
+            if a.symbol in needed and a.symbol not in frozen:
+                kept.append(a)
+                needed |= a.expr.free_symbols
+        self.assignments = kept[::-1]
         self._partials = {}
 
-    def tangents(self, seed: dict, frozen=frozenset()) -> list:
-        """seed: input symbol -> its tangent; frozen symbols (and whatever the seed does not
-        reach) have tangent zero."""
+    def tangents(self, seed: dict) -> list:
+        """seed: input symbol -> its tangent; whatever the seed does not reach has tangent zero."""
         t = dict(seed)
         for a in self.assignments:
-            if a.symbol in frozen:
-                continue
             moved = sorted((f for f in a.expr.free_symbols if t.get(f, 0) != 0), key=lambda f: f.name)
             if moved:
                 t[a.symbol] = self.program.let(sp.Add(*(self._partial(a, f) * t[f] for f in moved)))
@@ -83,10 +87,10 @@ def forward_dynamics_derivatives(derivation: Derivation) -> Model:
     tau = joint_forces(derivation, fd.chain, fd.chain.forward(sym.qd, fd.qdd, derivation.robot.gravity))
     frozen = frozenset(x if x.is_Symbol else -x for x in map(sp.sympify, fd.qdd))  # each a let (or its negative)
     assert all(x.is_Symbol for x in frozen), fd.qdd
-    forward_mode, columns = ForwardMode(program, tau), []
+    forward_mode, columns = ForwardMode(program, tau, frozen), []
     for k, seed in enumerate(directions(derivation, sym)):
         program.section = f"d qdd / d {'q' if k < n else 'qd'}{k % n + 1} = -M^-1 d tau / d ..."
-        partial = forward_mode.tangents(seed, frozen)
+        partial = forward_mode.tangents(seed)
         columns.append(solve(program, fd.factors, [-x for x in partial]))
     return Model("forward_dynamics_derivatives", model_inputs(derivation, sym, qd=True, gravity=True, tau=fd.tau),
                  [columns[k][i] for i in range(n) for k in range(2 * n)], (n, 2 * n),
