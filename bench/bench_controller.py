@@ -27,12 +27,11 @@ import hashlib
 import os
 import shlex
 import shutil
-import subprocess
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from bench_dynamics import (BENCH, DEFAULT_FLAGS, ROOT, finish_pinocchio_object, markdown, pinocchio_object,
+from bench_dynamics import (BENCH, DEFAULT_FLAGS, finish_pinocchio_object, markdown, pinocchio_object,
                             pinocchio_toolchain, prepare_arm, run)
 from common import arm_yaml, compiler_version, example_arms, log, machine
 

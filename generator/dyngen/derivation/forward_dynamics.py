@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..catalogue import ARGUMENTS
 from .coriolis import joint_forces, model_inputs, start
 from .models import Derivation, Model
 from .program import Program
