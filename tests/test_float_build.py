@@ -70,6 +70,13 @@ def test_float_build_agrees_with_double(built, tmp_path_factory):
             err = float(np.max(np.abs(single("inverse_dynamics", q, qd, qdd, pi, *g).astype(np.float64)
                                       - double("inverse_dynamics", q, qd, qdd, pi, *g)))) / float(np.max(size))
             worst["inverse_dynamics"] = max(worst.get("inverse_dynamics", 0.0), err)
+            compare("coriolis_matrix", q, qd, s)
+            compare("mass_matrix_derivative", q, qd, s)
+            compare("regressor_slotine_li", q, qd, *float_inputs(rng.uniform(-2, 2, n), rng.uniform(-5, 5, n)), *g)
+            compare("rnea_derivatives", q, qd, qdd, s, *g)
+            (tau,) = float_inputs(double("rnea", q, qd, qdd, s, *g))
+            compare("forward_dynamics", q, qd, tau, s, *g)
+            compare("forward_dynamics_derivatives", q, qd, tau, s, *g)
             # friction: per joint its terms' fields (terms/friction.py): values and velocity scales
             (f,) = float_inputs(np.column_stack([rng.uniform(0, 2, n) if field.kind == "value" else
                                                  rng.uniform(1e-3, 0.5, n) for field in FRICTION_FIELDS]).ravel())

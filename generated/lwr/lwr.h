@@ -40,6 +40,12 @@
  *   lwr_jacobian_dot_qd          149 mul, 93 add, 0 div, 6 sin/cos
  *   lwr_control                  586 mul, 511 add, 0 div, 6 sin/cos
  *   lwr_control_with_jacobian    757 mul, 626 add, 0 div, 7 sin/cos
+ *   lwr_coriolis_matrix          1467 mul, 1401 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix_derivative   1473 mul, 1422 add, 0 div, 6 sin/cos
+ *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 6 sin/cos
+ *   lwr_forward_dynamics         1236 mul, 1038 add, 7 div, 6 sin/cos
+ *   lwr_rnea_derivatives         2955 mul, 2931 add, 0 div, 6 sin/cos
+ *   lwr_forward_dynamics_derivatives 4715 mul, 4463 add, 7 div, 6 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -287,6 +293,64 @@ void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_r
  * 757 mul, 626 add, 0 div, 7 sin/cos
  */
 void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c, lwr_real *J, lwr_real *jdot_qd);
+
+/* Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   C        [7 x 7]  row-major (written)
+ * 1467 mul, 1401 add, 0 div, 6 sin/cos
+ */
+void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *C);
+
+/* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   Mdot     [7 x 7]  row-major, symmetric (written)
+ * 1473 mul, 1422 add, 0 div, 6 sin/cos
+ */
+void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *Mdot);
+
+/* Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qr_d     [7]  reference velocities (Slotine-Li: qd_d - Lambda e)
+ *   qr_dd    [7]  reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)
+ *   Y        [7 x 43]  row-major (written)
+ * 773 mul, 465 add, 0 div, 6 sin/cos
+ */
+void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_real *qr_d, const lwr_real *qr_dd, lwr_real *Y);
+
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   tau      [7]  joint torques/forces
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   qdd      [7]  joint accelerations (written)
+ * 1236 mul, 1038 add, 7 div, 6 sin/cos
+ */
+void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd);
+
+/* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qdd      [7]  joint accelerations
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [7 x 14]  row-major, [d tau / d q | d tau / d qd] (written)
+ * 2955 mul, 2931 add, 0 div, 6 sin/cos
+ */
+void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *D);
+
+/* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   tau      [7]  joint torques/forces
+ *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [7 x 14]  row-major, [d qdd / d q | d qdd / d qd] (written)
+ * 4715 mul, 4463 add, 7 div, 6 sin/cos
+ */
+void lwr_forward_dynamics_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *D);
 
 /* Optional joint friction (lwr_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [7], f [56] = per joint Fc, Fv, Fs, vs, eps; tau [7] (written) */

@@ -40,6 +40,12 @@
  *   stanford_jacobian_dot_qd     128 mul, 85 add, 0 div, 4 sin/cos
  *   stanford_control             416 mul, 370 add, 0 div, 4 sin/cos
  *   stanford_control_with_jacobian 566 mul, 485 add, 0 div, 5 sin/cos
+ *   stanford_coriolis_matrix     878 mul, 793 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix_derivative 883 mul, 808 add, 0 div, 4 sin/cos
+ *   stanford_regressor_slotine_li 456 mul, 290 add, 0 div, 4 sin/cos
+ *   stanford_forward_dynamics    804 mul, 693 add, 6 div, 4 sin/cos
+ *   stanford_rnea_derivatives    1795 mul, 1731 add, 0 div, 4 sin/cos
+ *   stanford_forward_dynamics_derivatives 2936 mul, 2726 add, 6 div, 4 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -287,6 +293,64 @@ void stanford_control(const stanford_real *q, const stanford_real *qd, const sta
  * 566 mul, 485 add, 0 div, 5 sin/cos
  */
 void stanford_control_with_jacobian(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c, stanford_real *J, stanford_real *jdot_qd);
+
+/* Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   C        [6 x 6]  row-major (written)
+ * 878 mul, 793 add, 0 div, 4 sin/cos
+ */
+void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *C);
+
+/* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   Mdot     [6 x 6]  row-major, symmetric (written)
+ * 883 mul, 808 add, 0 div, 4 sin/cos
+ */
+void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot);
+
+/* Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qr_d     [6]  reference velocities (Slotine-Li: qd_d - Lambda e)
+ *   qr_dd    [6]  reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)
+ *   Y        [6 x 33]  row-major (written)
+ * 456 mul, 290 add, 0 div, 4 sin/cos
+ */
+void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *qd, const stanford_real *qr_d, const stanford_real *qr_dd, stanford_real *Y);
+
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   tau      [6]  joint torques/forces
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   qdd      [6]  joint accelerations (written)
+ * 804 mul, 693 add, 6 div, 4 sin/cos
+ */
+void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd);
+
+/* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qdd      [6]  joint accelerations
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [6 x 12]  row-major, [d tau / d q | d tau / d qd] (written)
+ * 1795 mul, 1731 add, 0 div, 4 sin/cos
+ */
+void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *D);
+
+/* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   tau      [6]  joint torques/forces
+ *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
+ *   D        [6 x 12]  row-major, [d qdd / d q | d qdd / d qd] (written)
+ * 2936 mul, 2726 add, 6 div, 4 sin/cos
+ */
+void stanford_forward_dynamics_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *D);
 
 /* Optional joint friction (stanford_friction.c): tau_j = (Fc + Fs exp(-(qd/vs)^2)) tanh(qd/eps) + Fv qd,
  *   qd [6], f [48] = per joint Fc, Fv, Fs, vs, eps; tau [6] (written) */

@@ -32,6 +32,8 @@
  *   Jacobian                  6 x 6    geometric Jacobian, rows [v; w] in the base frame
  *   LinkJacobians            36 x 6    the Jacobian of every link frame's origin stacked, link 1 first
  *   Twist                     6 x 1    [linear; angular] in the base frame
+ *   JointMatrix               6 x 6    N x N, row-major: C(q, qd), M_dot(q, qd)
+ *   Derivatives               6 x 12   N x 2N, row-major: [d / d q | d / d qd] of tau or qdd
  * Parameter orders: p per link m, cx, cy, cz, Ixx, Ixy, Ixz, Iyy, Iyz, Izz (inertia about the
  * centre of mass); s per link m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ (about the frame origin).
  */
@@ -65,6 +67,8 @@ using Pose = Eigen::Matrix<Real, 4, 4, Eigen::RowMajor>;
 using Jacobian = Eigen::Matrix<Real, 6, 6, Eigen::RowMajor>;
 using LinkJacobians = Eigen::Matrix<Real, 36, 6, Eigen::RowMajor>;
 using Twist = Eigen::Matrix<Real, 6, 1, Eigen::ColMajor>;
+using JointMatrix = Eigen::Matrix<Real, 6, 6, Eigen::RowMajor>;
+using Derivatives = Eigen::Matrix<Real, 6, 12, Eigen::RowMajor>;
 
 namespace detail {
 
@@ -436,6 +440,102 @@ template <typename A0, typename A1, typename A2, typename Out0, typename Out1, t
 inline void control_with_jacobian(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out0> &g, const Eigen::MatrixBase<Out1> &M, const Eigen::MatrixBase<Out2> &c, const Eigen::MatrixBase<Out3> &J, const Eigen::MatrixBase<Out4> &jdot_qd)
 {
     stanford_control_with_jacobian(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<Joints>(g), detail::out<MassMatrix>(M), detail::out<Joints>(c), detail::out<Jacobian>(J), detail::out<Twist>(jdot_qd));
+}
+
+/* Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.
+ * stanford_coriolis_matrix(q: Joints, qd: Joints, s: Parameters, C: JointMatrix written) */
+template <typename A0, typename A1, typename A2, typename Out0>
+inline void coriolis_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out0> &C)
+{
+    stanford_coriolis_matrix(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<JointMatrix>(C));
+}
+
+template <typename A0, typename A1, typename A2>
+inline JointMatrix coriolis_matrix(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s)
+{
+    JointMatrix C;
+    coriolis_matrix(q, qd, s, C);
+    return C;
+}
+
+/* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.
+ * stanford_mass_matrix_derivative(q: Joints, qd: Joints, s: Parameters, Mdot: JointMatrix written) */
+template <typename A0, typename A1, typename A2, typename Out0>
+inline void mass_matrix_derivative(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s, const Eigen::MatrixBase<Out0> &Mdot)
+{
+    stanford_mass_matrix_derivative(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Parameters>(s), detail::out<JointMatrix>(Mdot));
+}
+
+template <typename A0, typename A1, typename A2>
+inline JointMatrix mass_matrix_derivative(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &s)
+{
+    JointMatrix Mdot;
+    mass_matrix_derivative(q, qd, s, Mdot);
+    return Mdot;
+}
+
+/* Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).
+ * stanford_regressor_slotine_li(q: Joints, qd: Joints, qr_d: Joints, qr_dd: Joints, Y: Regressor written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out0>
+inline void regressor_slotine_li(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qr_d, const Eigen::MatrixBase<A3> &qr_dd, const Eigen::MatrixBase<Out0> &Y)
+{
+    stanford_regressor_slotine_li(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qr_d), detail::in<Joints>(qr_dd), detail::out<Regressor>(Y));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Regressor regressor_slotine_li(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qr_d, const Eigen::MatrixBase<A3> &qr_dd)
+{
+    Regressor Y;
+    regressor_slotine_li(q, qd, qr_d, qr_dd, Y);
+    return Y;
+}
+
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+ * stanford_forward_dynamics(q: Joints, qd: Joints, tau: Joints, s: Parameters, qdd: Joints written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out0>
+inline void forward_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out0> &qdd)
+{
+    stanford_forward_dynamics(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(tau), detail::in<Parameters>(s), detail::out<Joints>(qdd));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Joints forward_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s)
+{
+    Joints qdd;
+    forward_dynamics(q, qd, tau, s, qdd);
+    return qdd;
+}
+
+/* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).
+ * stanford_rnea_derivatives(q: Joints, qd: Joints, qdd: Joints, s: Parameters, D: Derivatives written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out0>
+inline void rnea_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out0> &D)
+{
+    stanford_rnea_derivatives(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qdd), detail::in<Parameters>(s), detail::out<Derivatives>(D));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Derivatives rnea_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<A3> &s)
+{
+    Derivatives D;
+    rnea_derivatives(q, qd, qdd, s, D);
+    return D;
+}
+
+/* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).
+ * stanford_forward_dynamics_derivatives(q: Joints, qd: Joints, tau: Joints, s: Parameters, D: Derivatives written) */
+template <typename A0, typename A1, typename A2, typename A3, typename Out0>
+inline void forward_dynamics_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out0> &D)
+{
+    stanford_forward_dynamics_derivatives(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(tau), detail::in<Parameters>(s), detail::out<Derivatives>(D));
+}
+
+template <typename A0, typename A1, typename A2, typename A3>
+inline Derivatives forward_dynamics_derivatives(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s)
+{
+    Derivatives D;
+    forward_dynamics_derivatives(q, qd, tau, s, D);
+    return D;
 }
 
 }  // namespace stanford

@@ -7,7 +7,7 @@ manifest derive from it; code that calls the generated functions (identification
 validation, diagnosis) takes their names from here. The C name is <robot>_<name>.
 
 Shapes are tuples of dimension names, resolved per robot by `dimensions`:
-dof (N), parameters (10 N), stacked (N(N+1)/2), gravity_symbols, friction (5 N),
+dof (N), state (2 N: q and qd), parameters (10 N), stacked (N(N+1)/2), gravity_symbols, friction,
 pi_<kind> (the number of base coefficients of a kind), homogeneous (4), twist (6),
 link_pose_rows (4 N) and link_twist_rows (6 N).
 """
@@ -42,6 +42,9 @@ ARGUMENTS = {
     "gravity": Argument(("gravity_symbols",), "gravity symbols", "GravitySymbols"),  # only when gravity has symbols
     "f": Argument(("friction",), "per joint " + ", ".join(FRICTION_NAMES), "Friction"),
     "pi_full": Argument(("pi_full",), "base coefficients pi_full (e.g. identified; from p: pi_full())", "PiFull"),
+    "qr_d": Argument(("dof",), "reference velocities (Slotine-Li: qd_d - Lambda e)", "Joints"),
+    "qr_dd": Argument(("dof",), "reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)", "Joints"),
+    "tau": Argument(("dof",), "joint torques/forces", "Joints"),
 }
 
 
@@ -183,10 +186,38 @@ CONTROL_WITH_JACOBIAN = Function(
     more=_CONTROL_OUTPUTS + (Output("J", ("twist", "dof"), "flange Jacobian, row-major, rows [v; w]", "Jacobian"),
                              Output("jdot_qd", ("twist",), "Jdot qd of the flange", "Twist")))
 
+CORIOLIS_MATRIX = Function(
+    "coriolis_matrix", "coriolis", "coriolis_matrix", ("q", "qd", "s"),
+    Output("C", ("dof", "dof"), "row-major", "JointMatrix"),
+    "Coriolis matrix C(q, qd) of the Christoffel symbols: c = C qd, M_dot - 2C skew-symmetric.", Check())
+MASS_MATRIX_DERIVATIVE = Function(
+    "mass_matrix_derivative", "coriolis", "mass_matrix_derivative", ("q", "qd", "s"),
+    Output("Mdot", ("dof", "dof"), "row-major, symmetric", "JointMatrix"),
+    "Time derivative of the inertia matrix M_dot(q, qd) = C + C^T.", Check())
+REGRESSOR_SLOTINE_LI = Function(
+    "regressor_slotine_li", "regressors", "regressor_slotine_li", ("q", "qd", "qr_d", "qr_dd", "gravity"),
+    Output("Y", ("dof", "pi_full"), "row-major", "Regressor"),
+    "Slotine-Li regressor: Y(q, qd, qr_d, qr_dd) pi_full = M(q) qr_dd + C(q, qd) qr_d + g(q).",
+    Check("rnea", times="pi_full"), "full")
+FORWARD_DYNAMICS = Function(
+    "forward_dynamics", "forward", "forward_dynamics", ("q", "qd", "tau", "s", "gravity"),
+    Output("qdd", ("dof",), "joint accelerations", "Joints"),
+    "Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.", Check())
+RNEA_DERIVATIVES = Function(
+    "rnea_derivatives", "derivatives", "rnea_derivatives", ("q", "qd", "qdd", "s", "gravity"),
+    Output("D", ("dof", "state"), "row-major, [d tau / d q | d tau / d qd]", "Derivatives"),
+    "Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd).", Check())
+FORWARD_DYNAMICS_DERIVATIVES = Function(
+    "forward_dynamics_derivatives", "derivatives", "forward_dynamics_derivatives", ("q", "qd", "tau", "s", "gravity"),
+    Output("D", ("dof", "state"), "row-major, [d qdd / d q | d qdd / d qd]", "Derivatives"),
+    "Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] "
+    "at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).", Check())
+
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
              PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
              INVERSE_DYNAMICS, FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD,
-             CONTROL, CONTROL_WITH_JACOBIAN)
+             CONTROL, CONTROL_WITH_JACOBIAN, CORIOLIS_MATRIX, MASS_MATRIX_DERIVATIVE,
+             REGRESSOR_SLOTINE_LI, FORWARD_DYNAMICS, RNEA_DERIVATIVES, FORWARD_DYNAMICS_DERIVATIVES)
 KINEMATICS = (LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD)
 BY_NAME = {f.name: f for f in FUNCTIONS}
 COEFFICIENTS = {"gravity": PI_GRAVITY, "inertia": PI_INERTIA, "full": PI_FULL}
@@ -195,12 +226,15 @@ REGRESSORS = {"gravity": REGRESSOR_GRAVITY, "inertia": REGRESSOR_INERTIA, "full"
 SOURCES = {"parameters": "parameters and base coefficients", "regressors": "base regressors",
            "dynamics": "inverse dynamics, gravity and inertia matrix",
            "kinematics": "forward kinematics and Jacobians",
-           "control": "one call per control cycle"}  # straight-line C files, in order
+           "control": "one call per control cycle",
+           "coriolis": "Coriolis matrix and inertia matrix derivative",
+           "forward": "forward dynamics",
+           "derivatives": "derivatives of inverse and forward dynamics"}  # straight-line C files, in order
 
 
 def dimensions(dof: int, ranks: dict, gravity_symbols: int) -> dict:
     """Dimension name -> size for one robot; ranks: kind -> number of base coefficients."""
-    return {"dof": dof, "parameters": PER_LINK * dof, "stacked": dof * (dof + 1) // 2,
+    return {"dof": dof, "state": 2 * dof, "parameters": PER_LINK * dof, "stacked": dof * (dof + 1) // 2,
             "gravity_symbols": gravity_symbols, "friction": FRICTION_PER_JOINT * dof,
             "homogeneous": 4, "twist": 6, "link_pose_rows": 4 * dof, "link_twist_rows": 6 * dof,
             **{f"pi_{kind}": rank for kind, rank in ranks.items()}}

@@ -11,6 +11,7 @@ from .atomic import write_folder
 from .catalogue import KINDS
 from .derivation.control import control_model
 from .derivation.kinematics_functions import KinematicsModels
+from .derivation.controller import controller_models
 from .derivation.models import Derivation
 from .description import Robot, load_robot
 from .emission.render import Emitted, emit
@@ -72,7 +73,8 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
                   "inverse_dynamics": derivation.inverse_dynamics(bases["full"]),
                   "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),
                   "control": control_model(robot, bases),
-                  "control_with_jacobian": control_model(robot, bases, with_jacobian=True)}
+                  "control_with_jacobian": control_model(robot, bases, with_jacobian=True),
+                  **controller_models(derivation)}
     with progress.step("emit C"):
         emitted = emit(robot, derivation, regressors, bases, models)
     return bases, emitted

@@ -26,6 +26,8 @@ TYPE_DOCS = {
     "Jacobian": "geometric Jacobian, rows [v; w] in the base frame",
     "LinkJacobians": "the Jacobian of every link frame's origin stacked, link 1 first",
     "Twist": "[linear; angular] in the base frame",
+    "JointMatrix": "N x N, row-major: C(q, qd), M_dot(q, qd)",
+    "Derivatives": "N x 2N, row-major: [d / d q | d / d qd] of tau or qdd",
 }
 
 

@@ -124,8 +124,9 @@ def _programs(derivation, regressors: dict, bases: dict, models: dict) -> dict:
             model = coefficient_model(derivation, bases[f.kind], f.kind)
         elif f.model == "coefficient_jacobian":
             model = coefficient_jacobian_model(derivation, bases[f.kind], f.kind)
-        elif f.model == "regressor":
-            out[f.name] = (regressors[f.kind], base_regressor_outputs(regressors[f.kind], bases[f.kind]))
+        elif f.kind and f.model not in ("coefficients", "coefficient_jacobian", "unit_accelerations"):
+            full = regressors[f.kind] if f.model == "regressor" else models[f.model]  # over all 10N columns
+            out[f.name] = (full, base_regressor_outputs(full, bases[f.kind]))
             continue
         elif f.model == "unit_accelerations":
             continue

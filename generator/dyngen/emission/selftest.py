@@ -94,7 +94,8 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
     gravity = [GRAVITY_SYMBOL_VALUES[k % len(GRAVITY_SYMBOL_VALUES)] for k in range(len(robot.gravity_symbols))]
     f = fixed_friction(robot.dof)
     states = fixed_states(robot)
-    direct = [fn for fn in FUNCTIONS if not fn.check.expected]
+    direct = [fn for fn in FUNCTIONS if not fn.check.expected]  # in catalogue order: rnea before what takes
+    # its output as tau (selftest_checks passes rnea_out)
     once = {fn.name: evaluate(programs[fn.name][0], joint_models, {"p": p}) for fn in direct if not fn.state}
     s = once["standard_from_dynamic"]
     per_state = {}
@@ -106,15 +107,19 @@ def selftest_data(robot, programs: dict) -> SelfTestData:
             per_state[fn.name] = [friction_torques(qd, f) for _, qd, _ in states]
         else:
             per_state[fn.name] = [evaluate(programs[fn.name][0], joint_models,
-                                           {"q": q, "qd": qd, "qdd": qdd, "s": s, "gravity": gravity})
-                                  for q, qd, qdd in states]
+                                           {"q": q, "qd": qd, "qdd": qdd, "s": s, "gravity": gravity,
+                                            **({"tau": per_state["rnea"][k]} if "tau" in fn.inputs else {})})
+                                  for k, (q, qd, qdd) in enumerate(states)]
     return SelfTestData(p, gravity, f, states, once, per_state)
 
 
 def selftest_checks(prefix: str, dims: dict, has_gravity: bool) -> list[dict]:
     """What the self-test calls and compares, one entry per catalogue function, in catalogue
     order (the functions of p alone first: their outputs feed the others)."""
-    arrays = {"s": "standard_from_dynamic_out", "pi_full": "pi_full_out"}  # arguments computed by another function
+    # an argument computed by another function, or a state array standing for another one
+    # (the Slotine-Li regressor at qr_d = qd, qr_dd = qdd is the regressor of tau)
+    arrays = {"s": "standard_from_dynamic_out", "pi_full": "pi_full_out", "qr_d": "qd", "qr_dd": "qdd",
+              "tau": "rnea_out"}
 
     def size(shape):
         return math.prod(dims[d] for d in shape)

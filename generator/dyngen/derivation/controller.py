@@ -1,0 +1,15 @@
+"""The models of the controller functions (catalogue: coriolis_matrix, ...), by catalogue model name."""
+
+from __future__ import annotations
+
+from . import coriolis, derivatives, forward_dynamics
+from .models import Derivation
+
+
+def controller_models(derivation: Derivation) -> dict:
+    return {"coriolis_matrix": coriolis.coriolis_matrix(derivation),
+            "mass_matrix_derivative": coriolis.mass_matrix_derivative(derivation),
+            "regressor_slotine_li": coriolis.slotine_li_regressor(derivation),
+            "forward_dynamics": forward_dynamics.forward_dynamics(derivation),
+            "rnea_derivatives": derivatives.rnea_derivatives(derivation),
+            "forward_dynamics_derivatives": derivatives.forward_dynamics_derivatives(derivation)}

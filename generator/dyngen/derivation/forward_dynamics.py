@@ -1,0 +1,90 @@
+"""Forward dynamics qdd = M(q)^-1 (tau - b(q, qd)) as straight-line code: M by unit
+accelerations, the bias b = rnea(q, qd, 0) (gravity included) and a square-root-free
+Cholesky factorisation M = L D L^T (a serial chain's M is dense: no sparsity to use beyond
+its symmetry), all in one program so that the sines, cosines and rotations are shared.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from .coriolis import joint_forces, model_inputs, start
+from .models import Derivation, Model
+from .program import Program
+
+
+@dataclass
+class LDLT:
+    """M = L D L^T: L unit lower triangular (L[(i, j)], i > j), the inverses of D's entries."""
+
+    L: dict
+    D_inverse: list
+
+
+def factor(program: Program, M: sp.Matrix) -> LDLT:
+    """~n^3/6 multiplications and n divisions; W[i][j] = L_ij D_j saves one product per term."""
+    n = M.shape[0]
+    program.section = "M = L D L^T"
+    L, W, Dinv = {}, {}, []
+    for i in range(n):
+        for j in range(i):
+            W[(i, j)] = program.let(M[i, j] - sp.Add(*(W[(i, k)] * L[(j, k)] for k in range(j))))
+            L[(i, j)] = program.let(W[(i, j)] * Dinv[j])
+        D = program.let(M[i, i] - sp.Add(*(W[(i, k)] * L[(i, k)] for k in range(i))))
+        Dinv.append(program.let(1 / D))
+    return LDLT(L, Dinv)
+
+
+def solve(program: Program, f: LDLT, b) -> list:
+    """x with L D L^T x = b."""
+    n = len(b)
+    y = []
+    for i in range(n):
+        y.append(program.let(b[i] - sp.Add(*(f.L[(i, k)] * y[k] for k in range(i)))))
+    x = [None] * n
+    for i in reversed(range(n)):
+        x[i] = program.let(y[i] * f.D_inverse[i] - sp.Add(*(f.L[(k, i)] * x[k] for k in range(i + 1, n))))
+    return x
+
+
+def mass_matrix_in(derivation: Derivation, chain) -> sp.Matrix:
+    """M(q) in the chain's program, column k from a unit acceleration of joint k."""
+    n = derivation.n
+    M = sp.zeros(n, n)
+    for k in range(n):
+        column = joint_forces(derivation, chain, chain.forward([0] * n, [int(j == k) for j in range(n)], [0, 0, 0]))
+        for j in range(k + 1):
+            M[j, k] = M[k, j] = column[j]
+    return M
+
+
+@dataclass
+class ForwardDynamics:
+    """The pieces the derivatives of forward dynamics reuse."""
+
+    program: Program
+    symbols: object
+    chain: object
+    tau: list
+    factors: LDLT
+    qdd: list
+
+
+def forward_dynamics_in(derivation: Derivation) -> ForwardDynamics:
+    program, sym, chain = start(derivation)
+    n = derivation.n
+    tau = [sp.Symbol(f"tau{i + 1}", real=True) for i in range(n)]
+    M = mass_matrix_in(derivation, chain)
+    bias = joint_forces(derivation, chain, chain.forward(sym.qd, [0] * n, derivation.robot.gravity))
+    factors = factor(program, M)
+    program.section = "qdd = M^-1 (tau - b)"
+    qdd = solve(program, factors, [program.let(t - b) for t, b in zip(tau, bias)])
+    return ForwardDynamics(program, sym, chain, tau, factors, qdd)
+
+
+def forward_dynamics(derivation: Derivation) -> Model:
+    fd = forward_dynamics_in(derivation)
+    return Model("forward_dynamics", model_inputs(derivation, fd.symbols, qd=True, gravity=True, tau=fd.tau), fd.qdd, (derivation.n,),
+                 "forward dynamics qdd = M^-1 (tau - c - g), L D L^T", fd.program, fd.symbols.trig)

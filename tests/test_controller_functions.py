@@ -1,0 +1,118 @@
+"""The controller functions of the generated C (Coriolis matrix, M_dot, Slotine-Li regressor,
+forward dynamics, derivatives), compiled with cffi, on every example arm: against the numpy
+Lagrangian oracle (Christoffel symbols from dM/dq by complex step), against Pinocchio
+(computeCoriolisMatrix, aba, computeRNEADerivatives, computeABADerivatives) and against the
+identities they must satisfy, at random states and random consistent parameters, 1e-9 relative."""
+
+from __future__ import annotations
+
+import numpy as np
+from oracles import lagrangian as lag
+from oracles import pinocchio_control as pin_control
+from oracles.random_params import random_parameters
+from test_generated_c import random_state, rel_err
+
+N_STATES = 100
+TOL = 1e-9
+
+
+def states(built, seed, count=N_STATES):
+    rng = np.random.default_rng(seed)
+    p = random_parameters(built.robot.dof, seed=seed + 100)
+    s = built.c("standard_from_dynamic", p)
+    for _ in range(count):
+        yield (p, s, *random_state(built, rng))
+
+
+def test_coriolis_matrix_is_the_christoffel_one(built):
+    worst = {}
+    for p, s, q, qd, _ in states(built, 1):
+        C = built.c("coriolis_matrix", q, qd, s)
+        christoffel = np.einsum("ijk,k->ij", lag.christoffel(built.arm, q, p), qd)
+        M_dot = np.einsum("kij,k->ij", lag.mass_matrix_derivatives(built.arm, q, p), qd)
+        checks = {"C = sum_k Gamma_ijk qd_k": (C, christoffel),
+                  "Pinocchio computeCoriolisMatrix": (C, pin_control.coriolis_matrix(built.arm, p, q, qd)),
+                  "C qd = c": (C @ qd, lag.coriolis(built.arm, q, qd, p)),
+                  "M_dot": (built.c("mass_matrix_derivative", q, qd, s), M_dot),
+                  "M_dot - 2C skew": ((M_dot - 2 * C) + (M_dot - 2 * C).T, np.zeros_like(C))}
+        for name, (got, want) in checks.items():
+            worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+    assert all(err < TOL for err in worst.values()), worst
+
+
+def test_slotine_li_regressor(built):
+    n = built.robot.dof
+    rng = np.random.default_rng(3)
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 2):
+        pi = built.c("pi_full", p)
+        qr_d, qr_dd = rng.uniform(-2, 2, n), rng.uniform(-3, 3, n)
+        Y = built.c("regressor_slotine_li", q, qd, qr_d, qr_dd)
+        christoffel = np.einsum("ijk,k->ij", lag.christoffel(built.arm, q, p), qd)
+        want = lag.mass_matrix(built.arm, q, p) @ qr_dd + christoffel @ qr_d + lag.gravity(built.arm, q, p)
+        checks = {"Y pi = M qr_dd + C qr_d + g": (Y @ pi, want),
+                  "Y(q, qd, qd, qdd) pi = rnea": (built.c("regressor_slotine_li", q, qd, qd, qdd) @ pi,
+                                                  built.c("rnea", q, qd, qdd, s)),
+                  "Y(q, qd, qd, qdd) = regressor": (built.c("regressor_slotine_li", q, qd, qd, qdd),
+                                                    built.c("regressor", q, qd, qdd))}
+        for name, (got, want) in checks.items():
+            worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+    assert all(err < TOL for err in worst.values()), worst
+
+
+def test_forward_dynamics(built):
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 4):
+        tau = built.c("rnea", q, qd, qdd, s)
+        M = lag.mass_matrix(built.arm, q, p)
+        bias = lag.coriolis(built.arm, q, qd, p) + lag.gravity(built.arm, q, p)
+        checks = {"FD(ID(qdd)) = qdd": (built.c("forward_dynamics", q, qd, tau, s), qdd),
+                  "Lagrangian M^-1 (tau - c - g)": (built.c("forward_dynamics", q, qd, tau, s),
+                                                    np.linalg.solve(M, tau - bias)),
+                  "Pinocchio aba": (built.c("forward_dynamics", q, qd, tau, s),
+                                    pin_control.forward_dynamics(built.arm, p, q, qd, tau))}
+        for name, (got, want) in checks.items():
+            worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+    assert all(err < TOL for err in worst.values()), worst
+
+
+def central_differences(f, q, qd, h=1e-6):
+    """[df/dq | df/dqd] of a vector function f(q, qd) by central differences."""
+    n = q.size
+    D = np.zeros((n, 2 * n))
+    for k in range(2 * n):
+        e = np.zeros(2 * n)
+        e[k] = h
+        D[:, k] = (f(q + e[:n], qd + e[n:]) - f(q - e[:n], qd - e[n:])) / (2 * h)
+    return D
+
+
+def test_rnea_derivatives(built):
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 5, count=30):
+        D = built.c("rnea_derivatives", q, qd, qdd, s)
+        dq, dv = pin_control.rnea_derivatives(built.arm, p, q, qd, qdd)
+        numeric = central_differences(lambda a, b: built.c("rnea", a, b, qdd, s), q, qd)
+        worst["Pinocchio computeRNEADerivatives"] = max(worst.get("Pinocchio computeRNEADerivatives", 0.0),
+                                                       rel_err(D, np.hstack([dq, dv])))
+        worst["central differences of rnea"] = max(worst.get("central differences of rnea", 0.0), rel_err(D, numeric))
+    assert worst["Pinocchio computeRNEADerivatives"] < TOL, worst
+    assert worst["central differences of rnea"] < 1e-7, worst  # the differences' own truncation and rounding
+
+
+def test_forward_dynamics_derivatives(built):
+    worst = {}
+    for p, s, q, qd, qdd in states(built, 6, count=30):
+        tau = built.c("rnea", q, qd, qdd, s)
+        D = built.c("forward_dynamics_derivatives", q, qd, tau, s)
+        dq, dv = pin_control.aba_derivatives(built.arm, p, q, qd, tau)
+        M = lag.mass_matrix(built.arm, q, p)
+        through_rnea = -np.linalg.solve(M, built.c("rnea_derivatives", q, qd, qdd, s))
+        numeric = central_differences(lambda a, b: built.c("forward_dynamics", a, b, tau, s), q, qd)
+        checks = {"Pinocchio computeABADerivatives": (D, np.hstack([dq, dv])),
+                  "-M^-1 d rnea (Lagrangian M)": (D, through_rnea)}
+        for name, (got, want) in checks.items():
+            worst[name] = max(worst.get(name, 0.0), rel_err(got, want))
+        worst["central differences of FD"] = max(worst.get("central differences of FD", 0.0), rel_err(D, numeric))
+    assert worst["Pinocchio computeABADerivatives"] < TOL and worst["-M^-1 d rnea (Lagrangian M)"] < TOL, worst
+    assert worst["central differences of FD"] < 1e-6, worst
