@@ -27,6 +27,9 @@ STATES = 1000
 
 
 def main():
+    import argparse
+
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     lines = ["| arm | snaps | counts g/inertia/full | Pinocchio rank g/full | rnea | gravity | M |", "|---|---|---|---|---|---|---|"]
     for name, (file, tip) in sorted(ARMS.items()):
         robot = load_urdf(DATA / file, tip_link=tip)

@@ -36,6 +36,9 @@ def measure(load):
 
 
 def main():
+    import argparse
+
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     from dyngen.description import load_description
 
     lines = ["| arm | input | counts g/inertia/full | " + " | ".join(f"{f} mul/add" for f in FUNCTIONS)

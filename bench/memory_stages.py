@@ -50,6 +50,9 @@ def stage_of(frame, depth: int = 1) -> tuple[str, str]:
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] in (["-h"], ["--help"]):
+        print("usage: memory_stages.py [--depth K] [--trace] COMMAND [ARGS ...]\n\n" + __doc__)
+        return 0
     depth, trace = 1, False
     while argv[:1] in (["--depth"], ["--trace"]):
         if argv[0] == "--trace":  # also: the allocation sites that hold the most at the traced peak

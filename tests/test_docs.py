@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", ROOT / "BENCHMARKS.md", *sorted((ROOT / "docs").glob("*.md"))]
 FENCE = re.compile(r"^```[a-z]*\n(.*?)^```", re.S | re.M)
 LINK = re.compile(r"(?<!!)\[[^\]]*\]\(([^)\s]+)\)|!\[[^\]]*\]\(([^)\s]+)\)")
-PROGRAMS = ("dyngen", "python3 -m dyngen", "python bench/", "python3 bench/")
+PROGRAMS = ("dyngen ", "python3 -m dyngen", "python bench/", "python3 bench/")
 
 
 def _commands(page: Path) -> list[str]:
@@ -96,3 +96,19 @@ def test_every_relative_link_resolves(page, target):
     assert resolved.exists(), f"{page}: link to {target}: no such file"
     if anchor and resolved.suffix == ".md":
         assert anchor in _anchors(resolved), f"{page}: link to {target}: no such heading"
+
+
+def test_the_readme_c_example_compiles_and_runs(tmp_path):
+    """The README's C (its ```c block) against generated/lwr, strict C99, and it runs."""
+    blocks = re.findall(r"^```c\n(.*?)^```", (ROOT / "README.md").read_text(), re.S | re.M)
+    assert len(blocks) == 1
+    folder = ROOT / "generated" / "lwr"
+    (tmp_path / "example.c").write_text(blocks[0])
+    sources = [str(p) for p in sorted(folder.glob("lwr_*.c")) if p.name != "lwr_selftest.c"]
+    exe = tmp_path / "example"
+    subprocess.run(["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O1", "-I", str(folder),
+                    str(tmp_path / "example.c"), *sources, "-lm", "-o", str(exe)], check=True, timeout=300)
+    run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0 and run.stdout.startswith("tau1 = "), run.stdout + run.stderr
+    tau1, qdd1 = (float(x.split("=")[1]) for x in run.stdout.strip().split(","))
+    assert abs(qdd1) < 1e-9 * max(1.0, abs(tau1))  # FD(ID(0)) = 0: the forward dynamics undoes the rnea
