@@ -23,6 +23,7 @@ STAGES = (
     {"extraction"},  # consistent link parameters (its solver serves identify too)
     {"data"},  # recordings and their conditioning
     {"identification"},
+    {"streaming"},  # least squares and the gap in blocks, per recording, in parallel
     {"diagnosis"},
     {"commands"},
     {"cli", "__main__"},

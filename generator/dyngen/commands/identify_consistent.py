@@ -38,7 +38,7 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     sanity, sanity_table = check(robot, model, result, signals, select, prior)
     # ---
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
-    sources = [s.name for s in signals]  # printable: recording.read_recording
+    sources = [s.name for s in signals]  # printable: data/recording.py
     write_file(out, consistent_yaml(robot, result, sources, conditioning_text(signals)))
     table = out.with_suffix(".md")
     write_file(table, f"# {robot.name}: consistent identification from {', '.join(sources)}\n\n"

@@ -5,6 +5,7 @@
 """
 
 from .conditioning import Conditioning, Signals, condition
-from .recording import Recording, read_recording
+from .reader import read_recording
+from .recording import Recording
 
 __all__ = ["Conditioning", "Recording", "Signals", "condition", "read_recording"]

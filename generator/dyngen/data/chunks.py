@@ -25,8 +25,8 @@ import numpy as np
 from ..errors import InputError
 from ..untrusted import MAX_CSV_BYTES, regular_file
 from . import columnar
-from .recording import (Recording, _check_time, _check_values, _numbers, as_recording, check_header, csv_line,
-                        read_recording)
+from .reader import read_recording
+from .recording import Recording, _check_time, _check_values, _numbers, as_recording, check_header, csv_line
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -68,6 +68,9 @@ def _csv_blocks(path, rows: int):
         lines_of = io.BufferedReader(_Bounded(binary, name, MAX_CSV_BYTES))
         try:
             head = lines_of.readline()
+            if b"\r" in head.removesuffix(b"\r\n"):  # old Mac line ends (CR alone): as the whole-file reader
+                lines_of = io.BytesIO((head + lines_of.read()).replace(b"\r\n", b"\n").replace(b"\r", b"\n"))
+                head = lines_of.readline()
             header_line = _decoded([head], name, 1, 0, "utf-8-sig")
             offset = len(head)
             header = [h.strip() for h in next(csv.reader([header_line]), [])]

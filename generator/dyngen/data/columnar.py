@@ -35,14 +35,6 @@ def format_of(path) -> str | None:
     return None
 
 
-def read(path, dof: int, require_torques: bool = True, required: tuple = (), effort_topic: str | None = None
-         ) -> Recording:
-    if format_of(path) == "parquet":
-        return read_parquet(path, dof, require_torques, required)
-    from .rosbag import read_bag
-
-    return read_bag(path, dof, require_torques, effort_topic)
-
 
 def _module(name: str, path):
     try:

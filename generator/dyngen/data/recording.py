@@ -46,17 +46,10 @@ class Recording:
     extra: dict = field(default_factory=dict)  # other columns by name, (T,)
 
 
-def read_recording(path, dof: int, require_torques: bool = True, required: tuple = (),
-                   effort_topic: str | None = None) -> Recording:
-    """Read and check `path` for a robot of `dof` joints. `required` names further columns
-    (e.g. the stacked inertia entries) that must be present. Parquet files and ROS 2 bags are
-    read by data/columnar.py into the same columns and through the same checks (`effort_topic`:
-    a bag's topic of commanded efforts, data/rosbag.py)."""
+def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
+    """Read and check the CSV `path` for a robot of `dof` joints. `required` names further columns
+    (e.g. the stacked inertia entries) that must be present. (Any format: data/reader.py.)"""
     path = Path(path)
-    from . import columnar
-
-    if columnar.format_of(path) is not None:
-        return columnar.read(path, dof, require_torques, required, effort_topic)
     name = printable(path.name)  # the name reaches comments of written files and the terminal
     text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
     if "\r" in text:  # Windows (CR LF) and old Mac (CR alone) line ends are line ends

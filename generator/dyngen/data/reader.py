@@ -1,0 +1,23 @@
+"""A recording in any format dyngen reads: CSV (recording.py), Parquet files and ROS 2 bags
+(columnar.py, rosbag.py), all into the same Recording through the same checks."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .columnar import format_of, read_parquet
+from .recording import Recording, read_csv
+from .rosbag import read_bag
+
+
+def read_recording(path, dof: int, require_torques: bool = True, required: tuple = (),
+                   effort_topic: str | None = None) -> Recording:
+    """Read and check `path` for a robot of `dof` joints. `required` names further columns
+    (e.g. the stacked inertia entries) that must be present; `effort_topic`: a bag's topic of
+    commanded efforts (data/rosbag.py)."""
+    kind = format_of(Path(path))
+    if kind == "parquet":
+        return read_parquet(path, dof, require_torques, required)
+    if kind == "rosbag":
+        return read_bag(path, dof, require_torques, effort_topic)
+    return read_csv(path, dof, require_torques, required)
