@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -14,17 +15,19 @@ def _umask() -> int:
     return mask
 
 
-def write_folder(target: Path, files: dict[str, str]) -> None:
-    """Replace folder `target` by exactly `files` (name -> text), all at once."""
+@contextmanager
+def staged_folder(target: Path):
+    """Yield an empty staging folder beside `target`; on success it replaces `target` in one
+    rename (the previous folder is then removed); on failure it is removed and `target` is left
+    as it was."""
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.new-", dir=target.parent))
     os.chmod(staging, 0o777 & ~_umask())  # mkdtemp makes it private; the output folder is not
     try:
-        for name, text in sorted(files.items()):
-            (staging / name).write_text(text)
+        yield staging
         old = None
-        if target.exists():
+        if os.path.lexists(target):
             old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
             os.rmdir(old)
             os.rename(target, old)
@@ -34,6 +37,13 @@ def write_folder(target: Path, files: dict[str, str]) -> None:
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
+
+
+def write_folder(target: Path, files: dict[str, str]) -> None:
+    """Replace folder `target` by exactly `files` (name -> text), all at once."""
+    with staged_folder(target) as staging:
+        for name, text in sorted(files.items()):
+            (staging / name).write_text(text)
 
 
 def write_file(target: Path, text: str) -> None:

@@ -22,12 +22,11 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import stat
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
+from .atomic import staged_folder
 from .errors import InputError
 
 MARKER = ".dyngen-output"
@@ -136,26 +135,9 @@ def results_folder(target):
     """Yield a staging folder beside `target`; on success it becomes `target` (with MARKER) in
     one rename, and the previous folder is removed; on failure it is removed and `target` is
     left as it was."""
-    target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.new-", dir=target.parent))
-    try:
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(staging, 0o777 & ~mask)  # mkdtemp makes it private; a results folder is not
+    with staged_folder(target) as staging:
         yield staging
         (staging / MARKER).write_text(_MARKER_TEXT)
-        old = None
-        if os.path.lexists(target):
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
-            os.rmdir(old)
-            os.rename(target, old)
-        os.rename(staging, target)
-        if old is not None:
-            shutil.rmtree(old)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
 
 
 def shown(path, staging: Path, target: Path) -> Path:
