@@ -19,17 +19,19 @@ effects, test_signals are used for nothing but the reported held-out residual (r
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import simple_model
 from . import choose, findings_check, fit, joints, reidentify, roles, trust
 from .effects import Context, library
-from .findings import describe, fill_values, reported
+from .findings import describe, reported, with_values
 from .judge import judge, simple_mse
 from .notes import notes
 from .options import Options
-from .record import Diagnosis
+from .record import CandidateGain, Diagnosis, RecordingNote
 from .refine import restricted
 from .selection import forward, selection_mse, solve
 from .settle import settle
@@ -108,37 +110,38 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         if reid is not None:
             reid, consistent = choose.refit(robot, model, p, segments, reid, consistent)
     tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
-    fill_values(described, design, chosen, final, tau_corr, robot)
+    described = with_values(described, design, chosen, final, tau_corr, robot)
     # 5. test
     completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
     judged = judge(design, segments, chosen, final, simple)
     # 6. report
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
     selected, superseded = reported(chosen, described, replaced)
+    selection_before = np.sqrt(sel_before).tolist()
+    # findings outside their range: marked suspect
+    selected, apart = findings_check.check(selected, selection_before, model, s, fit_signals)
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}
     result = Diagnosis(
         robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected,
         rms_before=rms["before"], rms_after=rms["after"], rms_effects=rms["effects"], rms_simple=rms["simple"],
-        selection_before=np.sqrt(sel_before).tolist(), selection_after=np.sqrt(sel_effects).tolist(),
+        selection_before=selection_before, selection_after=np.sqrt(sel_effects).tolist(),
         selection_simple=np.sqrt(sel_simple).tolist(),
         simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=simple.values.tolist(),
         peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
-        candidates=[{"candidate": k, "selection_gain": g}
-                    for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
+        candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
         steps=selection.steps, dropped=dropped, refused=refused, superseded=superseded, correlation_samples=tau_corr,
         segments=segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(
             robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
         reidentified=reid,
-        conditioning=[{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
+        conditioning=[RecordingNote(sig.name, role, sig.note, sig.trim)
                       for role, group in (("fit", fit_signals), ("select", select_signals or []),
                                           ("test", test or [])) for sig in group])
-    apart = findings_check.check(result, model, s, fit_signals)  # findings outside their range: suspect
     if links_hint:
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)")
-    result.warnings = notes(result, model, s, fit_signals, select_signals or [], test or [], judged.used) + apart
-    return result
+    return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
+                                          judged.used) + apart)
