@@ -55,11 +55,9 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     design = fit.build(context, library(context, options.effects), segments, n)
 
     def correlation(chosen, fitted):
-        """Leaves each segment's correction at the chosen effects' values; the residual's
-        correlation time (the current context and design: the pipeline's own)."""
-        for seg in segments:
-            seg.correction = fit.predict(context, chosen, fitted.x, seg) if chosen else np.zeros_like(seg.residual)
-        return fit.correlation_time(segments, design.weights)
+        """The correlation time of what the chosen effects at the fitted values leave (the
+        current context and design: the pipeline's own)."""
+        return fit.correlation_time(fit.corrected(context, chosen, fitted.x, segments), design.weights)
 
     # 2. select
     selection = forward(design, options.min_gain, options.alpha)
@@ -72,48 +70,50 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
             context, segments, fit.reweighted(design, final), chosen, correlation, options)
         dropped += dropped_now
         refused += refused_now
-    correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
     # 4. choose, per joint: the effects, the simple model or both, all fitted on the fit samples
-    # only and compared on the selection samples (joints.py).
-    simple = simple_model.fit(segments)
+    # only and compared on the selection samples (joints.py). `selecting`: the segments with
+    # the effects' torques at the values from the fit samples.
+    selecting = fit.corrected(context, chosen, final.x, segments)
+    simple = simple_model.fit(selecting)
     sel_before = selection_mse(design, [])
     sel_effects = selection_mse(design, chosen)
-    sel_simple = simple_mse(segments, simple, "select", n)
+    sel_simple = simple_mse(selecting, simple, "select", n)
     if not design.select.count:
         modes = [joints.EFFECTS] * n
     elif select_signals:
-        modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain)
+        modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
-        modes = choose.on_folds(context, segments, design, chosen, final, options)
+        modes = choose.on_folds(context, selecting, design, chosen, final, options)
     reid, consistent = None, None
     # Without the re-identification its cheap gate still says where the rigid body's columns
     # explain what the effects leave: the link parameters may be off there.
     links_hint = []
-    if not options.reidentify and design.select.count and all(seg.correction is not None for seg in segments):
-        links_hint = reidentify.gate(model, segments, [seg.residual - seg.correction for seg in segments],
+    if not options.reidentify and design.select.count:
+        links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                      options.min_gain)
     if options.reidentify and design.select.count:
-        reid, consistent, modes = choose.reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
-                                                      options.min_gain)
+        reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
+                                                      modes, options.min_gain)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
     # The choice made, every sample of the fit recordings sets the values (selection blocks
     # included; separate selection recordings stay out of it, as test recordings do).
+    fitting = selecting
     if not select_signals:
-        for seg in segments:
-            seg.fit = seg.fit | seg.select
-        simple = simple_model.fit(segments)
+        fitting = [replace(seg, fit=seg.fit | seg.select) for seg in selecting]
+        simple = simple_model.fit(fitting)
         # position laws now known over every fit sample's positions
-        context = fit.ranged(context, segments, chosen)
+        context = fit.ranged(context, fitting, chosen)
         if chosen:
-            design, chosen = restricted(context, segments, design, chosen)
+            design, chosen = restricted(context, fitting, design, chosen)
             final = solve(design, chosen)
         if reid is not None:
-            reid, consistent = choose.refit(robot, model, p, segments, reid, consistent)
-    tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
+            reid, consistent = choose.refit(robot, model, p, fitting, reid, consistent)
+    fitted = fit.corrected(context, chosen, final.x, fitting)  # the effects at the final values
+    tau_corr = fit.correlation_time(fitted, design.weights)
     described = with_values(described, design, chosen, final, tau_corr, robot)
-    # 5. test
-    completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
-    judged = judge(design, segments, chosen, final, simple)
+    # 5. test: each joint's correction by the model it was given (the effects, the simple model, ...)
+    judged_segments, completed = joints.apply(context, fitted, chosen, final.x, simple, modes, consistent)
+    judged = judge(design, judged_segments, chosen, final, simple)
     # 6. report
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
     selected, superseded = reported(chosen, described, replaced)
@@ -131,7 +131,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
         candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
         steps=selection.steps, dropped=dropped, refused=refused, superseded=superseded, correlation_samples=tau_corr,
-        segments=segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
+        segments=judged_segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(
             robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
         reidentified=reid,
