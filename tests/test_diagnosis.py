@@ -194,7 +194,7 @@ def test_direction_dependent_coulomb_and_position_ripple(lwr):
     """Joint 3: Coulomb 1.0 Nm moving forwards, 0.6 Nm backwards (plain sign); joint 7: a torque
     0.3 cos(2 q7) + 0.2 sin(3 q7). This trajectory never rests, so a direction-dependent level
     and a sensor offset are the same columns there; the tie goes to the plainer offset
-    (selection.py), and the two friction levels come out right either way."""
+    (forward_selection.py), and the two friction levels come out right either way."""
     def effects(name, t, at, q, qd, qdd, tau):
         out = tau.copy()
         out[:, 2] += np.where(qd[:, 2] > 0, 1.0, -0.6)
@@ -287,7 +287,7 @@ def test_a_per_joint_effect_pays_for_what_it_spoils_elsewhere():
     the arm-wide values refitted with it); an arm-wide effect gets the sum over joints."""
     from types import SimpleNamespace
 
-    from dyngen.diagnosis.selection import selection_gain
+    from dyngen.diagnosis.forward_selection import selection_gain
 
     before = np.array([1.0, 4.0, 2.0])
     after = np.array([1.25, 2.0, 1.0])  # joint 1 worse by a fifth of its new error, joints 2 and 3 halved
@@ -304,7 +304,7 @@ def test_undoing_a_step_scores_minus_the_step():
     the way in and 1 - 0.5 ... on the way out."""
     from types import SimpleNamespace
 
-    from dyngen.diagnosis.selection import selection_gain
+    from dyngen.diagnosis.forward_selection import selection_gain
 
     without, with_it = np.array([1.0, 0.01]), np.array([0.1, 0.02])
     arm = SimpleNamespace(joint=None)
@@ -369,7 +369,7 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
 
     from dyngen.diagnosis import moments as dz
     from dyngen.diagnosis.fit import Design
-    from dyngen.diagnosis.selection import selection_mse
+    from dyngen.diagnosis.forward_selection import selection_mse
 
     rng = np.random.default_rng(4)
     n, size, per_group = 2, 3, 40

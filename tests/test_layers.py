@@ -35,16 +35,16 @@ RANK = {name: k for k, names in enumerate(STAGES) for name in names}
 DIAGNOSIS_STAGES = (
     {"record", "phases", "moments", "trust", "roles"},  # the result's types; 0. roles
     {"effects", "effects.base", "effects.body", "effects.friction", "effects.sensor", "effects.tilt", "fit"},  # 1. fit
-    {"selection"},  # 2. select
+    {"forward_selection"},  # 2. select
     {"refine", "settle"},  # 3. settle
     {"joints", "reidentify", "choose"},  # 4. choose
     {"judge"},  # 5. test
-    {"findings", "findings_check", "notes", "options", "pipeline"},  # 6. report; the pipeline
-    {"report", "model", "figures", "outputs", "unusable_output", ""},  # written out; the package
+    {"findings", "findings_check", "notes", "diagnose_options", "pipeline"},  # 6. report; the pipeline
+    {"report", "updated_model", "figures", "outputs", "unusable_output", ""},  # written out; the package
 )
 DIAGNOSIS_RANK = {name: k for k, names in enumerate(DIAGNOSIS_STAGES) for name in names}
 MEASURED_DATA = ("data", "diagnosis", "terms", "identification", "excitation", "streaming")
-MEASURED_COMMANDS = ("diagnose", "identify", "identify_consistent", "excite", "recordings", "least_squares", "survey")
+MEASURED_COMMANDS = ("diagnose", "identify", "identify_consistent", "excite", "recordings", "identify_least_squares", "survey")
 MAX_LINES = 300
 
 

@@ -16,7 +16,7 @@ from conftest import ROOT
 
 from dyngen.description import load_robot
 from dyngen.diagnosis.effects import Context, Coulomb, Direction, Stribeck, Viscous
-from dyngen.diagnosis.model import friction_vector
+from dyngen.diagnosis.updated_model import friction_vector
 from dyngen.diagnosis.record import Finding
 from dyngen.runtime import load
 from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, friction_torque

@@ -12,7 +12,7 @@ from ..terms import simple_model
 from . import joints, reidentify, roles
 from .fit import corrected, ranged
 from .refine import restricted
-from .selection import solve
+from .forward_selection import solve
 
 
 def on_folds(context, segments, design, chosen, final, options) -> list[str]:

@@ -10,7 +10,7 @@ from functools import partial
 import numpy as np
 
 from .record import Finding
-from .selection import relative_change, selection_gain, selection_mse
+from .forward_selection import relative_change, selection_gain, selection_mse
 
 
 def describe(robot, design, chosen, final, cand, min_gain) -> Finding:

@@ -2,7 +2,7 @@
 
     0. roles      the recordings cut into fit, selection and test samples (roles.py)
     1. fit        the moments of every candidate effect (fit.py, moments.py)
-    2. select     forward selection on the selection data (selection.py)
+    2. select     forward selection on the selection data (forward_selection.py)
     3. settle     settings refined, insignificant effects pruned, implausible ones refused
                   (settle.py, refine.py), once more with each joint weighted by what is left
     4. choose     per joint: the effects, the simple model (terms/simple_model.py), both, or re-identified
@@ -30,10 +30,10 @@ from .effects import Context, library
 from .findings import describe, reported, with_values
 from .judge import judge, simple_mse
 from .notes import notes
-from .options import Options
+from .diagnose_options import Options
 from .record import CandidateGain, Diagnosis, RecordingNote
 from .refine import restricted
-from .selection import forward, selection_mse, solve
+from .forward_selection import forward, selection_mse, solve
 from .settle import settle
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from . import moments as dz
 from .record import Refusal
 from .refine import refine, restricted
-from .selection import bases, prune, selection_mse, solve, without
+from .forward_selection import bases, prune, selection_mse, solve, without
 
 
 def settle(context, segments, design, chosen, correlation, options):

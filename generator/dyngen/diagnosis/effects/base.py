@@ -58,7 +58,7 @@ class Effect:
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
     tolerance = 0.0  # a setting refined by fixed-point iteration: steps this small (absolute) end it
     suspect = ""  # a symptom rather than a cause: why, reported with a warning
-    secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
+    secondary = False  # loses a near tie in the selection to any plainer effect (forward_selection.py)
     ranged = False  # its columns depend on the positions the fit data cover (Context.q_range)
     extends = ""  # name of the effect this one only adds to, on the same joint (selected first, dropped with it)
     simple_term = ""  # the simple model's term (baseline.NAMES) this effect is, if it is one (b, Fv)
@@ -157,7 +157,7 @@ class Effect:
 
     @classmethod
     def friction_terms(cls, values: dict, variant: dict) -> dict:
-        """Entries of its joint's generated <robot>_friction vector (model.FRICTION_FIELDS)."""
+        """Entries of its joint's generated <robot>_friction vector (updated_model.FRICTION_FIELDS)."""
         return {}
 
     @classmethod
