@@ -1,11 +1,18 @@
 """The diagnosis's result: the findings as types and one record (Diagnosis), built by keyword
-at the end of the pipeline (pipeline.py). Each type's `as_json()` is its diagnosis.json entry
-(docs/conventions.md, "Diagnosis JSON"); the record and the findings are frozen: a later step
+at the end of the pipeline (pipeline.py). A type's fields are its diagnosis.json entry (entry();
+docs/conventions.md, "Diagnosis JSON"); the record and the findings are frozen: a later step
 that changes a finding (findings_check marks it suspect) returns a new one."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
+
+
+def entry(finding) -> dict:
+    """A finding's diagnosis.json entry: its fields in order, an optional text left empty ("")
+    left out."""
+    return {f.name: getattr(finding, f.name) for f in fields(finding)
+            if not (f.default == "" and getattr(finding, f.name) == "")}
 
 
 @dataclass(frozen=True)
@@ -23,12 +30,6 @@ class Finding:
     rms_after: list  # per joint, selection data, with it
     suspect: str = ""  # why it is a symptom rather than a cause ("" if it is not)
 
-    def as_json(self) -> dict:
-        out = {"effect": self.effect, "joints": list(self.joints), "variant": self.variant, "values": self.values,
-               "std": self.std, "units": self.units, "derived": self.derived, "selection_gain": self.selection_gain,
-               "rms_before": self.rms_before, "rms_after": self.rms_after}
-        return out | ({"suspect": self.suspect} if self.suspect else {})
-
 
 @dataclass(frozen=True)
 class Refusal:
@@ -37,18 +38,12 @@ class Refusal:
     values: list
     reason: str = ""  # "" when its values alone are impossible
 
-    def as_json(self) -> dict:
-        return {"candidate": self.candidate, "values": self.values} | ({"reason": self.reason} if self.reason else {})
-
 
 @dataclass(frozen=True)
 class CandidateGain:
     """A candidate tried alone: its selection gain."""
     candidate: str
     selection_gain: float
-
-    def as_json(self) -> dict:
-        return {"candidate": self.candidate, "selection_gain": self.selection_gain}
 
 
 @dataclass(frozen=True)
@@ -58,10 +53,6 @@ class RecordingNote:
     role: str  # "fit", "select" or "test"
     note: str
     trimmed_samples: int
-
-    def as_json(self) -> dict:
-        return {"recording": self.recording, "role": self.role, "note": self.note,
-                "trimmed_samples": self.trimmed_samples}
 
 
 @dataclass(frozen=True)
@@ -78,12 +69,6 @@ class LinksOff:
     at_bounds: list
     dropped_columns: list
     fit_rms: list
-
-    def as_json(self) -> dict:
-        return {"joints": self.joints, "regularisation": self.regularisation, "selection": self.selection,
-                "link_parameters": self.link_parameters, "friction": self.friction, "smoothing": self.smoothing,
-                "lambda_min": self.lambda_min, "at_bounds": self.at_bounds, "dropped_columns": self.dropped_columns,
-                "fit_rms": self.fit_rms}
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ from dataclasses import is_dataclass
 import numpy as np
 
 from .joints import EFFECTS, TIED
+from .record import entry
 
 SCHEMA_VERSION = 2
 
@@ -33,7 +34,7 @@ def to_json(d, sources: dict) -> str:
 
 def _plain(x):
     if is_dataclass(x):  # the findings' types (record.py): their diagnosis.json entries
-        return _plain(x.as_json())
+        return _plain(entry(x))
     if isinstance(x, dict):
         return {k: _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
