@@ -368,7 +368,7 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
     from types import SimpleNamespace
 
     from dyngen.diagnosis import moments as dz
-    from dyngen.diagnosis.fit import Design
+    from dyngen.diagnosis.fit import CandidateMoments
     from dyngen.diagnosis.forward_selection import selection_mse
 
     rng = np.random.default_rng(4)
@@ -389,7 +389,7 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
         m.count = per_group
         groups.append(m)
     weights = np.array([1.0, 0.4])
-    design = Design([], groups[0], groups[1], dz.empty(n, size), weights, groups)
+    design = CandidateMoments([], groups[0], groups[1], dz.empty(n, size), weights, groups)
     chosen = [SimpleNamespace(slots=np.array([0, 2]))]  # two of the three columns
     expected = np.zeros(n)
     for k in range(3):

@@ -81,7 +81,7 @@ def _context(model, robot, p, s, options, segments) -> Context:
 @dataclass(frozen=True)
 class Settled:
     """Stage 3's result: the chosen effects refined, pruned and checked, fitted on the fit samples."""
-    design: object  # fit.Design
+    design: object  # fit.CandidateMoments
     chosen: list  # moments.Candidate
     fit: object  # forward_selection's fit of the chosen (x, covariance, slots)
     dropped: list  # selected, then dropped as not significant
