@@ -51,12 +51,12 @@ def run(lwr, extra, seed=0, **options):
 
 
 def claims(d):
-    return sorted((e["effect"], tuple(e["joints"])) for e in d.selected)
+    return sorted((e.effect, e.joints) for e in d.selected)
 
 
 def value(d, effect, joint=None):
-    e = next(e for e in d.selected if e["effect"] == effect and (joint is None or e["joints"] == [joint]))
-    return e["values"], e["std"]
+    e = next(e for e in d.selected if e.effect == effect and (joint is None or e.joints == (joint,)))
+    return e.values, e.std
 
 
 def near_noise(d, factor=1.3):
@@ -118,8 +118,8 @@ def test_tilted_base(lwr):
         return rigid_torques(tilted, p, q, qd, qdd)
 
     d = run(lwr, tilt)
-    assert [e["effect"] for e in d.selected] == ["tilt"]
-    angles = d.selected[0]["derived"]["tilt_deg"]
+    assert [e.effect for e in d.selected] == ["tilt"]
+    angles = d.selected[0].derived["tilt_deg"]
     assert np.hypot(*angles) == pytest.approx(2.0, rel=0.1)
     assert near_noise(d)
 
@@ -132,8 +132,8 @@ def test_payload_on_last_link(lwr):
         return rigid_torques(arm, p, q, qd, qdd, payload=payload)
 
     d = run(lwr, with_payload)
-    assert [e["effect"] for e in d.selected] == ["payload"]
-    values = d.selected[0]["values"]
+    assert [e.effect for e in d.selected] == ["payload"]
+    values = d.selected[0].values
     assert values["m"] == pytest.approx(1.5, rel=0.1)
     assert values["mx"] == pytest.approx(1.5 * 0.02, rel=0.2)
     assert near_noise(d)
@@ -148,8 +148,8 @@ def test_time_shift(lwr):
         return rigid_torques(arm, p, *at(t - dt))
 
     d = run(lwr, late)
-    assert [e["effect"] for e in d.selected] == ["time_shift"]
-    assert d.selected[0]["values"]["dt"] == pytest.approx(dt, rel=0.1)
+    assert [e.effect for e in d.selected] == ["time_shift"]
+    assert d.selected[0].values["dt"] == pytest.approx(dt, rel=0.1)
     assert near_noise(d)
 
 
@@ -174,7 +174,7 @@ def test_one_late_joint_is_no_time_shift_of_the_arm(lwr):
     assert diagnose(robot, model, p, [fit], None, only_shift, test=[held]).selected == []
     fit, held = measured(list(range(7)))
     d = diagnose(robot, model, p, [fit], None, only_shift, test=[held])
-    assert [e["effect"] for e in d.selected] == ["time_shift"]
+    assert [e.effect for e in d.selected] == ["time_shift"]
 
 
 def test_rotor_inertia_and_gain(lwr):
@@ -194,7 +194,7 @@ def test_direction_dependent_coulomb_and_position_ripple(lwr):
     """Joint 3: Coulomb 1.0 Nm moving forwards, 0.6 Nm backwards (plain sign); joint 7: a torque
     0.3 cos(2 q7) + 0.2 sin(3 q7). This trajectory never rests, so a direction-dependent level
     and a sensor offset are the same columns there; the tie goes to the plainer offset
-    (selection.py), and the two friction levels come out right either way."""
+    (forward_selection.py), and the two friction levels come out right either way."""
     def effects(name, t, at, q, qd, qdd, tau):
         out = tau.copy()
         out[:, 2] += np.where(qd[:, 2] > 0, 1.0, -0.6)
@@ -287,7 +287,7 @@ def test_a_per_joint_effect_pays_for_what_it_spoils_elsewhere():
     the arm-wide values refitted with it); an arm-wide effect gets the sum over joints."""
     from types import SimpleNamespace
 
-    from dyngen.diagnosis.selection import selection_gain
+    from dyngen.diagnosis.forward_selection import selection_gain
 
     before = np.array([1.0, 4.0, 2.0])
     after = np.array([1.25, 2.0, 1.0])  # joint 1 worse by a fifth of its new error, joints 2 and 3 halved
@@ -304,7 +304,7 @@ def test_undoing_a_step_scores_minus_the_step():
     the way in and 1 - 0.5 ... on the way out."""
     from types import SimpleNamespace
 
-    from dyngen.diagnosis.selection import selection_gain
+    from dyngen.diagnosis.forward_selection import selection_gain
 
     without, with_it = np.array([1.0, 0.01]), np.array([0.1, 0.02])
     arm = SimpleNamespace(joint=None)
@@ -368,8 +368,8 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
     from types import SimpleNamespace
 
     from dyngen.diagnosis import moments as dz
-    from dyngen.diagnosis.fit import Design
-    from dyngen.diagnosis.selection import selection_mse
+    from dyngen.diagnosis.fit import CandidateMoments
+    from dyngen.diagnosis.forward_selection import selection_mse
 
     rng = np.random.default_rng(4)
     n, size, per_group = 2, 3, 40
@@ -389,7 +389,7 @@ def test_selection_over_every_cut_is_a_refit_per_cut():
         m.count = per_group
         groups.append(m)
     weights = np.array([1.0, 0.4])
-    design = Design([], groups[0], groups[1], dz.empty(n, size), weights, groups)
+    design = CandidateMoments([], groups[0], groups[1], dz.empty(n, size), weights, groups)
     chosen = [SimpleNamespace(slots=np.array([0, 2]))]  # two of the three columns
     expected = np.zeros(n)
     for k in range(3):

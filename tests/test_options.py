@@ -18,14 +18,14 @@ from conftest import ROOT
 
 from dyngen.data import Conditioning
 from dyngen.description import load_robot
-from dyngen.diagnosis.options import Options as DiagnosisOptions
+from dyngen.diagnosis.diagnose_options import Options as DiagnosisOptions
 from dyngen.errors import InputError
 from dyngen.commands.excite import Sampling
 from dyngen.commands.excite import parser as excite_parser
 from dyngen.excitation.design import Settings
 from dyngen.description.extraction_options import Options
 from dyngen.identification.consistent import ConsistentOptions
-from dyngen.identification.options import Options as IdentifyOptions
+from dyngen.identification.identify_options import Options as IdentifyOptions
 from dyngen.commands.diagnose import parser as diagnose_parser
 from dyngen.commands.identify import parser as identify_parser
 from dyngen.options import add_arguments, default_of, flag_of, options_of, resolve

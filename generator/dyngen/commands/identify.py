@@ -12,7 +12,7 @@ from .recordings import add_data_options, compiled_model, read_all
 
 def parser(prog="dyngen identify") -> argparse.ArgumentParser:
     from ..identification.consistent import ConsistentOptions
-    from ..identification.options import Options
+    from ..identification.identify_options import Options
 
     parser = argparse.ArgumentParser(prog=prog, description=(
         "Identify from recordings. --kind full (default): physically consistent link parameters with "
@@ -44,7 +44,7 @@ def parser(prog="dyngen identify") -> argparse.ArgumentParser:
 def main(argv, prog="dyngen identify") -> int:
     args = parser(prog).parse_args(argv)
     from .identify_consistent import run_consistent
-    from ..identification.options import Options
+    from ..identification.identify_options import Options
 
     options = resolve(Options, args, {})
     from ..description import load_robot
@@ -56,7 +56,7 @@ def main(argv, prog="dyngen identify") -> int:
     # Bad input fails before anything is announced or written.
     out = check_outputs(args, robot, kind, options.ols)
     if kind != "full" or options.ols:  # least squares: accumulated per recording, in parallel
-        from .least_squares import run_least_squares
+        from .identify_least_squares import run_least_squares
 
         return run_least_squares(args, robot, kind, required, progress, out)
     signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required,

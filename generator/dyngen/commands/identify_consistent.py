@@ -19,7 +19,7 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     from .recordings import conditioning_text, read_all
 
     options = resolve(ConsistentOptions, args, {})
-    if "none" in options.candidates:  # names were checked by the parser (options.py)
+    if "none" in options.candidates:  # names were checked by the parser (dyngen.options)
         options = replace(options, candidates=())
     if args.prior:
         options = replace(options, prior=read_link_parameters(args.prior, robot.dof))

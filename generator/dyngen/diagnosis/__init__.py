@@ -9,17 +9,17 @@ The stages, in order (pipeline.py runs them):
     0. roles.py      recordings cut into fit, selection and test samples; the nominal residual
     1. fit.py        the moments of every candidate (moments.py) from the library of effects
                      (effects/: each a torque term of dyngen.terms with the diagnosis's rules)
-    2. selection.py  forward selection on the selection data
+    2. forward_selection.py  forward selection on the selection data
     3. settle.py     nonlinear settings refined (refine.py), insignificant effects pruned,
                      implausible ones refused
     4. choose.py     per joint: effects, the simple model (terms/simple_model.py), both, or re-identified
                      link parameters (joints.py, reidentify.py)
     5. judge.py      the figures on the judged data, per phase of the motion (phases.py)
     6. findings.py   the findings, notes.py the warnings, record.py the result (Diagnosis);
-                     report.py, figures.py and model.py write them (outputs.py)
+                     report.py, figures.py and updated_model.py write them (outputs.py)
 """
 
-from .options import Options
+from .diagnose_options import Options
 from .pipeline import diagnose
 from .record import Diagnosis
 

@@ -14,7 +14,9 @@ from . import roles
 
 
 @dataclass
-class Design:
+class CandidateMoments:
+    """Every candidate's moments on each role's samples, weighted per joint (the diagnosis's
+    design; not the excitation's, excitation/design.py)."""
     candidates: list
     fit: dz.Moments
     select: dz.Moments
@@ -30,7 +32,7 @@ class Design:
         self.g = w2 @ self.fit.b
 
 
-def build(context, effects, segments, n) -> Design:
+def build(context, effects, segments, n) -> CandidateMoments:
     candidates, moments = None, None
     for seg in segments:
         columns = dz.effect_columns(effects, context, seg)
@@ -51,7 +53,7 @@ def build(context, effects, segments, n) -> Design:
         raise ValueError("no fit samples (recordings too short for the filter's start-up?)")
     rms = np.sqrt(moments[0].c / max(moments[0].count, 1))
     weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
-    return Design(candidates, *moments, weights, groups if any(m.count for m in groups) else [])
+    return CandidateMoments(candidates, *moments, weights, groups if any(m.count for m in groups) else [])
 
 
 def predict(context, chosen, x, segment) -> np.ndarray:
@@ -71,14 +73,21 @@ def predict(context, chosen, x, segment) -> np.ndarray:
     return out
 
 
-def reweighted(design, final) -> Design:
+def corrected(context, chosen, x, segments) -> list:
+    """The segments with their correction: the chosen candidates' torques at values x (zero
+    without any)."""
+    return [dataclasses.replace(seg, correction=predict(context, chosen, x, seg) if chosen else
+                                np.zeros_like(seg.residual)) for seg in segments]
+
+
+def reweighted(design, final) -> CandidateMoments:
     """The design with each joint weighted by 1 / the RMS its residual keeps after the chosen
     effects (on the fit samples). The selection's weights come from the nominal residual, which
     holds the very effects sought: a payload's 9 Nm on joint 2 would weigh joint 2 down as if
     it were noise, and the arm-wide values would be set by the other joints alone."""
     rms = np.sqrt(design.fit.mse(final.slots, final.x))
     weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
-    return Design(design.candidates, design.fit, design.select, design.test, weights, design.groups)
+    return CandidateMoments(design.candidates, design.fit, design.select, design.test, weights, design.groups)
 
 
 def correlation_time(segments, weights) -> float:

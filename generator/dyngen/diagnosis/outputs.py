@@ -9,14 +9,14 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..atomic import write_file
-from . import model, reidentify, report
+from . import reidentify, report, updated_model
 
 
 def write_outputs(diagnosis, robot, p, out_dir, sources: dict, sign_velocity: float) -> dict:
     out = Path(out_dir)
     texts = {"report.md": report.markdown(diagnosis, sources),
              "diagnosis.json": report.to_json(diagnosis, sources),
-             "effects.yaml": model.effects_yaml(diagnosis, sources, sign_velocity)}
+             "effects.yaml": updated_model.effects_yaml(diagnosis, sources, sign_velocity)}
     paths = {}
     for name, text in texts.items():  # every text is built before the first is written
         write_file(out / name, text)
@@ -28,7 +28,7 @@ def write_outputs(diagnosis, robot, p, out_dir, sources: dict, sign_velocity: fl
         from ..export import write_all
 
         try:
-            exported = write_all(robot, model.with_payload(diagnosis, p), out, model.joint_dynamics(diagnosis))
+            exported = write_all(robot, updated_model.with_payload(diagnosis, p), out, updated_model.joint_dynamics(diagnosis))
             paths.update({path.name: path for path in exported})
         except ValueError as err:  # e.g. the paper's parameters: not physically consistent
             paths["export skipped"] = str(err)
@@ -46,7 +46,7 @@ def _consistent(diagnosis, robot, folder, sources: dict) -> dict:
     yaml = consistent_yaml(robot, c, fits, f"{sources.get('conditioning', 'as conditioned for the diagnosis')}; "
                            f"decimated to about {reidentify.RATE:g} Hz")
     table = (f"# {robot.name}: link parameters re-identified by the diagnosis (consistent, from {', '.join(fits)})\n\n"
-             f"Used on joint(s) {', '.join(map(str, diagnosis.consistent['joints']))}, where they did better than "
+             f"Used on joint(s) {', '.join(map(str, diagnosis.consistent.joints))}, where they did better than "
              "every effect and the simple model on selection data.\n\n"
              + "\n".join(summary_lines(robot, c)) + "\n\n" + consistent_table(c) + "\n")
     paths = {}

@@ -2,7 +2,7 @@
 
     0. roles      the recordings cut into fit, selection and test samples (roles.py)
     1. fit        the moments of every candidate effect (fit.py, moments.py)
-    2. select     forward selection on the selection data (selection.py)
+    2. select     forward selection on the selection data (forward_selection.py)
     3. settle     settings refined, insignificant effects pruned, implausible ones refused
                   (settle.py, refine.py), once more with each joint weighted by what is left
     4. choose     per joint: the effects, the simple model (terms/simple_model.py), both, or re-identified
@@ -13,25 +13,30 @@
 
     result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
 
+Each stage's result is a new value (the segments frozen: roles.Segment); stages 3 and 4 and the
+final fit are the functions below diagnose, each returning one record (Settled, Choice, Final).
+
 fit_signals set the values, select_signals (default: blocks of the fit data) choose the
 effects, test_signals are used for nothing but the reported held-out residual (roles.py).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import simple_model
 from . import choose, findings_check, fit, joints, reidentify, roles, trust
+from .diagnose_options import Options
 from .effects import Context, library
-from .findings import describe, fill_values, reported
+from .findings import describe, reported, with_values
+from .forward_selection import forward, selection_mse, solve
 from .judge import judge, simple_mse
 from .notes import notes
-from .options import Options
-from .record import Diagnosis
+from .record import CandidateGain, Diagnosis, RecordingNote
 from .refine import restricted
-from .selection import forward, selection_mse, solve
 from .settle import settle
 
 
@@ -39,106 +44,175 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
              test=None) -> Diagnosis:
     p = np.asarray(p, dtype=float)
     s = model(STANDARD_FROM_DYNAMIC.name, p)
-    n = robot.dof
     # 0. roles; a recording whose nominal residual exceeds its torques is conditioned again, or
     # trust.Unusable is raised (nothing claimed)
     fit_signals, select_signals, test = trust.checked_roles(model, s, fit_signals, select_signals, test)
     segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
-    # Position- and velocity-dependent laws are known only over what the fit data cover.
-    fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
-    fit_qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
-    context = Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)),
-                      (fit_qd.min(axis=0), fit_qd.max(axis=0)))
-    # 1. fit
-    design = fit.build(context, library(context, options.effects), segments, n)
-
-    def correlation(chosen, fitted):
-        """Leaves each segment's correction at the chosen effects' values; the residual's
-        correlation time (the current context and design: the pipeline's own)."""
-        for seg in segments:
-            seg.correction = fit.predict(context, chosen, fitted.x, seg) if chosen else np.zeros_like(seg.residual)
-        return fit.correlation_time(segments, design.weights)
-
+    context = _context(model, robot, p, s, options, segments)
+    # 1. fit: the moments of every candidate on every role's samples
+    design = fit.build(context, library(context, options.effects), segments, robot.dof)
     # 2. select
     selection = forward(design, options.min_gain, options.alpha)
     # 3. settle
-    design, chosen, final, dropped, refused = settle(context, segments, design, selection.chosen, correlation, options)
+    settled = _settle(context, segments, design, selection.chosen, options)
+    # 4. choose, per joint; then the final fit
+    choice = _choose(robot, model, p, context, segments, settled, bool(select_signals), options)
+    final = _final_fit(robot, model, p, context, settled, choice, bool(select_signals))
+    # 5. test: each joint's correction by the model it was given, judged on the judged data
+    judged_segments, completed = joints.apply(final.context, final.segments, final.chosen, final.fit.x, final.simple,
+                                              choice.modes, final.consistent)
+    judged = judge(final.design, judged_segments, final.chosen, final.fit, final.simple)
+    # 6. report
+    roles_of = (("fit", fit_signals), ("select", select_signals or []), ("test", test or []))
+    result = _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
+                     roles_of)
+    return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
+                                          judged.used) + result.warnings)
+
+
+def _context(model, robot, p, s, options, segments) -> Context:
+    """Position- and velocity-dependent laws are known only over what the fit data cover."""
+    fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
+    fit_qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
+    return Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)),
+                   (fit_qd.min(axis=0), fit_qd.max(axis=0)))
+
+
+@dataclass(frozen=True)
+class Settled:
+    """Stage 3's result: the chosen effects refined, pruned and checked, fitted on the fit samples."""
+    design: object  # fit.CandidateMoments
+    chosen: list  # moments.Candidate
+    fit: object  # forward_selection's fit of the chosen (x, covariance, slots)
+    dropped: list  # selected, then dropped as not significant
+    refused: list  # record.Refusal
+
+
+def _settle(context, segments, design, chosen, options) -> Settled:
+    """settle.py, then once more with each joint weighted by what the effects leave of its
+    residual: an effect kept only to make up for another fitted with the nominal weights goes."""
+
+    def correlation(chosen, fitted):
+        """The correlation time of what the chosen effects at the fitted values leave (with the
+        design of the round before: `design` as bound when called)."""
+        return fit.correlation_time(fit.corrected(context, chosen, fitted.x, segments), design.weights)
+
+    design, chosen, final, dropped, refused = settle(context, segments, design, chosen, correlation, options)
     if chosen:
-        # Once more with each joint weighted by what the effects leave of its residual: an
-        # effect kept only to make up for another fitted with the nominal weights goes now.
-        design, chosen, final, dropped_now, refused_now = settle(
+        reweighted, chosen, final, dropped_now, refused_now = settle(
             context, segments, fit.reweighted(design, final), chosen, correlation, options)
-        dropped += dropped_now
-        refused += refused_now
-    correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
-    # 4. choose, per joint: the effects, the simple model or both, all fitted on the fit samples
-    # only and compared on the selection samples (joints.py).
-    simple = simple_model.fit(segments)
-    sel_before = selection_mse(design, [])
-    sel_effects = selection_mse(design, chosen)
-    sel_simple = simple_mse(segments, simple, "select", n)
+        design, dropped, refused = reweighted, dropped + dropped_now, refused + refused_now
+    return Settled(design, chosen, final, dropped, refused)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """Stage 4's result: per joint the model it is given, chosen on the selection samples."""
+    segments: list  # the segments with the effects' torques at the values from the fit samples
+    simple: object  # terms.simple_model fit on the fit samples
+    modes: list  # per joint: joints.EFFECTS, SIMPLE, TIED, COMPLETED or CONSISTENT
+    reidentified: object  # identification.consistent.Consistent where it won a joint, else None
+    consistent: list | None  # per segment its corrections (T, N), with reidentified
+    links_hint: list  # 0-based joints where the rigid body's columns explain what the effects leave
+    described: list  # record.Finding per chosen effect, values not yet filled in
+    selection_mse: dict  # "before", "effects", "simple": per joint, on the selection samples
+
+
+def _choose(robot, model, p, context, segments, settled, separate_selection, options) -> Choice:
+    """The effects, the simple model or both, all fitted on the fit samples only and compared
+    on the selection samples (joints.py; on folds of the fit recordings without separate
+    selection recordings, choose.py), or re-identified link parameters (--reidentify)."""
+    design, chosen, final, n = settled.design, settled.chosen, settled.fit, robot.dof
+    selecting = fit.corrected(context, chosen, final.x, segments)
+    simple = simple_model.fit(selecting)
+    mse = {"before": selection_mse(design, []), "effects": selection_mse(design, chosen),
+           "simple": simple_mse(selecting, simple, "select", n)}
     if not design.select.count:
         modes = [joints.EFFECTS] * n
-    elif select_signals:
-        modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain)
+    elif separate_selection:
+        modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
-        modes = choose.on_folds(context, segments, design, chosen, final, options)
-    reid, consistent = None, None
-    # Without the re-identification its cheap gate still says where the rigid body's columns
-    # explain what the effects leave: the link parameters may be off there.
-    links_hint = []
-    if not options.reidentify and design.select.count and all(seg.correction is not None for seg in segments):
-        links_hint = reidentify.gate(model, segments, [seg.residual - seg.correction for seg in segments],
+        modes = choose.on_folds(context, selecting, design, chosen, final, options)
+    reid, consistent, links_hint = None, None, []
+    if design.select.count and not options.reidentify:
+        # Without the re-identification its cheap gate still says where the rigid body's
+        # columns explain what the effects leave: the link parameters may be off there.
+        links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                      options.min_gain)
-    if options.reidentify and design.select.count:
-        reid, consistent, modes = choose.reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
-                                                      options.min_gain)
+    if design.select.count and options.reidentify:
+        reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
+                                                      modes, options.min_gain)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
-    # The choice made, every sample of the fit recordings sets the values (selection blocks
-    # included; separate selection recordings stay out of it, as test recordings do).
-    if not select_signals:
-        for seg in segments:
-            seg.fit = seg.fit | seg.select
-        simple = simple_model.fit(segments)
-        # position laws now known over every fit sample's positions
-        context = fit.ranged(context, segments, chosen)
+    return Choice(selecting, simple, modes, reid, consistent, links_hint, described, mse)
+
+
+@dataclass(frozen=True)
+class Final:
+    """The final fit: the choice made, on every fit sample."""
+    context: Context
+    design: object
+    chosen: list
+    fit: object
+    simple: object
+    segments: list  # with the effects' torques at the final values
+    reidentified: object
+    consistent: list | None
+    correlation_samples: float  # of the final fit residual (scales the deviations)
+    findings: list  # record.Finding per chosen effect, with its values
+
+
+def _final_fit(robot, model, p, context, settled, choice, separate_selection) -> Final:
+    """Every sample of the fit recordings sets the values (selection blocks included; separate
+    selection recordings stay out of it, as test recordings do)."""
+    design, chosen, final, simple = settled.design, settled.chosen, settled.fit, choice.simple
+    reid, consistent, fitting = choice.reidentified, choice.consistent, choice.segments
+    if not separate_selection:
+        fitting = [replace(seg, fit=seg.fit | seg.select) for seg in fitting]
+        simple = simple_model.fit(fitting)
+        context = fit.ranged(context, fitting, chosen)  # position laws known over every fit sample's positions
         if chosen:
-            design, chosen = restricted(context, segments, design, chosen)
+            design, chosen = restricted(context, fitting, design, chosen)
             final = solve(design, chosen)
         if reid is not None:
-            reid, consistent = choose.refit(robot, model, p, segments, reid, consistent)
-    tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
-    fill_values(described, design, chosen, final, tau_corr, robot)
-    # 5. test
-    completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
-    judged = judge(design, segments, chosen, final, simple)
-    # 6. report
+            reid, consistent = choose.refit(robot, model, p, fitting, reid, consistent)
+    fitted = fit.corrected(context, chosen, final.x, fitting)
+    tau_corr = fit.correlation_time(fitted, design.weights)
+    findings = with_values(choice.described, design, chosen, final, tau_corr, robot)
+    return Final(context, design, chosen, final, simple, fitted, reid, consistent, tau_corr, findings)
+
+
+def _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
+            roles_of) -> Diagnosis:
+    """The record: the findings (those on joints another model won superseded; those outside
+    their range marked suspect, findings_check.py), the figures, and the warnings of the checks
+    (notes.py's are added by diagnose)."""
+    n, modes = robot.dof, choice.modes
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
-    selected, superseded = reported(chosen, described, replaced)
-    rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
-                                                    ("effects", judged.effects), ("simple", judged.simple))}
-    result = Diagnosis(
-        robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected,
-        rms_before=rms["before"], rms_after=rms["after"], rms_effects=rms["effects"], rms_simple=rms["simple"],
-        selection_before=np.sqrt(sel_before).tolist(), selection_after=np.sqrt(sel_effects).tolist(),
-        selection_simple=np.sqrt(sel_simple).tolist(),
-        simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=simple.values.tolist(),
-        peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
-        candidates=[{"candidate": k, "selection_gain": g}
-                    for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
-        steps=selection.steps, dropped=dropped, refused=refused, superseded=superseded, correlation_samples=tau_corr,
-        segments=segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
-        consistent=None if reid is None else reidentify.finding(
-            robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
-        reidentified=reid,
-        conditioning=[{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
-                      for role, group in (("fit", fit_signals), ("select", select_signals or []),
-                                          ("test", test or [])) for sig in group])
-    apart = findings_check.check(result, model, s, fit_signals)  # findings outside their range: suspect
-    if links_hint:
-        apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in links_hint)
+    selected, superseded = reported(final.chosen, final.findings, replaced)
+    selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
+    fit_signals = roles_of[0][1]
+    selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
+    if choice.links_hint:
+        apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in choice.links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)")
-    result.warnings = notes(result, model, s, fit_signals, select_signals or [], test or [], judged.used) + apart
-    return result
+    rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
+                                                    ("effects", judged.effects), ("simple", judged.simple))}
+    reid = final.reidentified
+    return Diagnosis(
+        robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected,
+        rms_before=rms["before"], rms_after=rms["after"], rms_effects=rms["effects"], rms_simple=rms["simple"],
+        selection_before=selection_rms["before"], selection_after=selection_rms["effects"],
+        selection_simple=selection_rms["simple"],
+        simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=final.simple.values.tolist(),
+        peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
+        candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
+        steps=selection.steps, dropped=settled.dropped, refused=settled.refused, superseded=superseded,
+        correlation_samples=final.correlation_samples, segments=judged_segments, joint_models=modes,
+        within_fit_speeds=judged.within_fit_speeds, completed=completed,
+        consistent=None if reid is None else reidentify.finding(
+            robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
+        reidentified=reid,
+        conditioning=[RecordingNote(sig.name, role, sig.note, sig.trim) for role, group in roles_of for sig in group],
+        warnings=apart)

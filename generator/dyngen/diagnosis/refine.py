@@ -27,7 +27,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from . import moments as dz
-from .selection import solve
+from .forward_selection import solve
 
 REFINE_TOLERANCE = 1e-3  # relative (fixed point)
 SEARCH_TOLERANCE = 0.01  # in the logarithm of a searched setting: 1 %

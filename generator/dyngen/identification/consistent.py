@@ -28,7 +28,7 @@ The order of work, every step on the fit recordings only (test data are never se
      residuals).
 
 Public entry point: identify_consistent(robot, model, folder, signals, options, select=None) -> Consistent
-(its options: options.py ConsistentOptions; the result and its YAML: consistent_output.py).
+(its options: identify_options.py ConsistentOptions; the result and its YAML: consistent_output.py).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from . import held_out
 from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
 from .consistent_output import Consistent
 from .normal import Normal, solve_unconstrained
-from .options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
+from .identify_options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
 from .solver import Solver
 from .statistics import estimate
 

@@ -46,7 +46,7 @@ class Effect:
     What the diagnosis needs to know of an effect lives here, as attributes and methods with
     plain defaults: an effect says what it needs (a context-built effect is made by `of`), what
     follows from its values (`derived`), what the updated model takes from it (`friction_terms`,
-    `simulator`, `last_link`, read from a report entry: classmethods) and when it is reported
+    `simulator`, `last_link`, read from a finding (record.Finding): classmethods) and when it is reported
     with a warning (`suspect`, `warnings`)."""
 
     term = None  # the terms.Term it is: its name, scope, parameters, units and physical range
@@ -58,7 +58,7 @@ class Effect:
     refinable = False  # has a nonlinear setting that refine.py searches once the effect is selected
     tolerance = 0.0  # a setting refined by fixed-point iteration: steps this small (absolute) end it
     suspect = ""  # a symptom rather than a cause: why, reported with a warning
-    secondary = False  # loses a near tie in the selection to any plainer effect (selection.py)
+    secondary = False  # loses a near tie in the selection to any plainer effect (forward_selection.py)
     ranged = False  # its columns depend on the positions the fit data cover (Context.q_range)
     extends = ""  # name of the effect this one only adds to, on the same joint (selected first, dropped with it)
     simple_term = ""  # the simple model's term (baseline.NAMES) this effect is, if it is one (b, Fv)
@@ -151,18 +151,18 @@ class Effect:
         return {}
 
     @classmethod
-    def warnings(cls, entry: dict) -> list[str]:
-        """Warnings on a selected effect's report entry (diagnosis.json's `selected`)."""
+    def warnings(cls, finding) -> list[str]:
+        """Warnings on a selected effect's finding (record.Finding)."""
         return []
 
     @classmethod
     def friction_terms(cls, values: dict, variant: dict) -> dict:
-        """Entries of its joint's generated <robot>_friction vector (model.FRICTION_FIELDS)."""
+        """Entries of its joint's generated <robot>_friction vector (updated_model.FRICTION_FIELDS)."""
         return {}
 
     @classmethod
     def last_link(cls, values: dict, variant: dict | None = None) -> np.ndarray | None:
-        """Standard parameters this effect adds to the last link (a payload; its report entry's
+        """Standard parameters this effect adds to the last link (a payload; its finding's
         values and variant); else None."""
         return None
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from ..options import option
 from ..terms.friction import SIGN_SCALE
 from .effects import DEFAULT_NAMES, NAMES
-from .selection import ALPHA, MIN_GAIN
+from .forward_selection import ALPHA, MIN_GAIN
 
 
 @dataclass(frozen=True)
