@@ -15,6 +15,7 @@ import numpy as np
 
 from dyngen.data import condition, read_recording
 from dyngen.diagnosis import diagnose
+from dyngen.diagnosis.effects import base
 from dyngen.description import load_robot
 from dyngen.runtime import load
 from oracles.arm import Arm, nominal_parameters
@@ -59,13 +60,20 @@ def test_long_recording_diagnosed_on_windows_with_the_gap_over_every_sample(tmp_
     assert "## Long recordings: diagnosed on a sample" in (tmp_path / "d" / "report.md").read_text()
 
 
-def test_recording_within_the_bound_is_the_in_memory_diagnosis(tmp_path):
+def test_recording_within_the_bound_is_the_in_memory_diagnosis(tmp_path, monkeypatch):
+    """Also: the memo's bound changes no result (the in-memory run keeps 1 MiB of columns, the
+    command 256 MiB)."""
     path = write_robot(tmp_path / "short.csv", seed=4, seconds=5.0, offset=OFFSET)
     run("--data", path, "--out", tmp_path / "d")
     doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
     assert "sampled" not in doc and doc["fit"] == ["short.csv"]
+    assert any(e["effect"] == "offset" and e["joints"] == [3] for e in doc["selected"])
     robot = load_robot(LWR)
+    monkeypatch.setattr(base, "MEMO_BYTES", 1 << 20)
     result = diagnose(robot, load(FOLDER), nominal_parameters(LWR), [condition(read_recording(path, N))])
     assert np.allclose(doc["rms_before"], result.rms_before, rtol=1e-9)
     assert np.allclose(doc["rms_after"], result.rms_after, rtol=1e-9)
     assert [e["effect"] for e in doc["selected"]] == [e["effect"] for e in result.selected]
+    for a, b in zip(doc["selected"], result.selected):
+        assert a["joints"] == b["joints"]
+        assert np.allclose(list(a["values"].values()), list(b["values"].values()), rtol=1e-9)
