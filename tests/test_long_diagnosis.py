@@ -77,3 +77,17 @@ def test_recording_within_the_bound_is_the_in_memory_diagnosis(tmp_path, monkeyp
     for a, b in zip(doc["selected"], result.selected):
         assert a["joints"] == b["joints"]
         assert np.allclose(list(a["values"].values()), list(b["values"].values()), rtol=1e-9)
+
+
+def test_a_bad_row_deep_in_a_long_recording_is_one_line_and_nothing_written(tmp_path):
+    path = write_robot(tmp_path / "long.csv", seed=5, seconds=30.0)
+    lines = path.read_text().splitlines()
+    lines[5001] = lines[5001].replace(lines[5001].split(",")[3], "nan", 1)  # line 5002, column q3
+    path.write_text("\n".join(lines) + "\n")
+    out = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--params", str(LWR), "--model",
+                          str(FOLDER), "--data", str(path), "--max-rows", "1000", "--out", str(tmp_path / "d"), "-q"],
+                         capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    assert out.returncode != 0
+    assert out.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 5002, column q3: nan (NaN or infinite value)"]
+    assert not (tmp_path / "d").exists()
