@@ -183,7 +183,7 @@ def figure(doc, path: Path) -> None:
     ax.set_ylabel("peak memory [MiB]")
     ax.set_ylim(0, 1024)
     ax.axhline(1024, color="grey", lw=0.8)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="upper left", fontsize=8)
     ax.set_title("LWR4+ (7 joints), real run tiled: peak memory against length", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110, metadata={"Software": None})
