@@ -19,7 +19,7 @@ import numpy as np
 
 from . import engine
 from .step import _local, _model
-from .triangular import Triangular, fold
+from .triangular import fold
 
 VELOCITY = 0.02  # rad/s, diagnosis.baseline.VELOCITY: the simple model's tanh scale
 

@@ -6,7 +6,8 @@ therefore read once, in blocks (data/chunks.py), and keeps only windows of `wind
 evenly spread over its length, at most `max_rows` samples in all. The spacing is found in the
 same pass without knowing the length: windows start every `window` seconds, and whenever the
 kept rows exceed the bound every other window goes and the spacing doubles, so the windows
-kept are evenly spread (every 2^k-th) and hold between half the bound and the bound. Each
+kept are evenly spread (every 2^k-th) and hold between half the bound and the bound (when
+two windows fit in it; else one is kept). Each
 window is its own recording (conditioned on its own; the diagnosis cuts it into its 2-s
 blocks), named `<file>@<start>s`. A recording within the bound is returned whole: the
 diagnosis is then the in-memory one.
