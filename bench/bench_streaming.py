@@ -8,8 +8,11 @@
 2. 20 recordings of 5 minutes (the tiled run, each one from another of the three real runs):
    wall time of `--workers 1` against `--workers 2` (target: at most 0.6x), and the same
    coefficients from both.
-3. The commands that still hold every row, for comparison: `dyngen identify` (consistent) on 5
-   and 30 minutes, `dyngen diagnose` on 5 minutes.
+   Also `dyngen diagnose` (the full diagnosis on evenly spread windows of at most --max-rows
+   samples, the gap and simple model over every sample in blocks: streaming/sample.py) on the
+   same files; a figure of the peaks against the length (results/streaming_memory.png).
+3. The command that still holds every row, for comparison: `dyngen identify` (consistent) on 5
+   and 30 minutes.
 Writes bench/results/streaming.md and streaming.json.
 
     python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel whole]
@@ -55,6 +58,19 @@ def survey(path: Path, tmp: Path, model: Path):
     return m
 
 
+def diagnosis(path: Path, tmp: Path, model: Path):
+    cmd = [sys.executable, "-m", "dyngen", "diagnose", ROOT / "examples" / "lwr.yaml", "--params",
+           ROOT / "examples" / "lwr_paper_solution.yaml", "--data", path, "--model", model, "--out", tmp / "diagnosis"]
+    m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    if m.returncode != 0:
+        raise SystemExit(f"failed: {' '.join(map(str, cmd))}\n{m.stderr}")
+    return m
+
+
+COMMANDS = {"identify --ols": lambda path, tmp, model: identify([path], tmp / "out.yaml", model),
+            "diagnose --survey": survey, "diagnose": diagnosis}
+
+
 def stage_seconds(m) -> float:
     """The per-recording stage's wall time, from the command's progress line."""
     import re
@@ -75,9 +91,9 @@ def part_memory(tmp, model, quick) -> dict:
     for minutes, rate, suffix in lengths:
         path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
         rows = write(path, minutes, rate)
-        for command in ("identify --ols", "diagnose --survey"):
+        for command, run in COMMANDS.items():
             log(f"{command} on {path.name} ({rows} rows) ...")
-            m = identify([path], tmp / "out.yaml", model) if command.startswith("identify") else survey(path, tmp, model)
+            m = run(path, tmp, model)
             rows_out.append({"command": command, "minutes": minutes, "rate": rate or 200, "format": suffix,
                              "rows": rows, "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
                              "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
@@ -131,17 +147,14 @@ def part_parallel(tmp, model, quick, repeat) -> dict:
 
 
 def part_whole(tmp, model, quick) -> dict:
-    """The commands that still hold every row: identify (consistent), diagnose."""
+    """The command that still holds every row: identify (consistent)."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "generator")}
     lwr = ROOT / "examples" / "lwr.yaml"
-    out = []
+    out = []  # (diagnose: in part 1, on a bounded sample)
     for minutes in ((5,) if quick else (5, 30)):
         path = tmp / f"lwr_{minutes}min.csv"
         rows = write(path, minutes)
         commands = [("identify (consistent)", ["identify", lwr, "--data", path, "-o", tmp / "c" / "id.yaml"])]
-        if minutes == 5:  # 30 minutes of diagnosis would need about 23 GB
-            commands.append(("diagnose", ["diagnose", lwr, "--params", ROOT / "examples" / "lwr_paper_solution.yaml",
-                                          "--data", path, "--out", tmp / "d"]))
         for what, argv in commands:
             log(f"{what} on {minutes} min ...")
             m = run_measured([sys.executable, "-m", "dyngen", *argv, "--model", model, "-q"], env=env)
@@ -151,6 +164,32 @@ def part_whole(tmp, model, quick) -> dict:
     return {"rows": out}
 
 
+def figure(doc, path: Path) -> None:
+    """Peak memory against the recording's length, per command (200 Hz CSV; the 1 kHz hour marked)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    for command in dict.fromkeys(r["command"] for r in doc["memory"]["rows"]):
+        rows = [r for r in doc["memory"]["rows"] if r["command"] == command]
+        at200 = [r for r in rows if r["rate"] == 200]
+        line, = ax.plot([r["minutes"] for r in at200], [r["peak_mib"] for r in at200], "o-", label=command)
+        for r in rows:
+            if r["rate"] != 200:
+                ax.plot([r["minutes"]], [r["peak_mib"]], "s", color=line.get_color(), mfc="none")
+    ax.set_xlabel("recording length [min] (squares: 1 kHz, Parquet; dots: 200 Hz, CSV)")
+    ax.set_ylabel("peak memory [MiB]")
+    ax.set_ylim(0, 1024)
+    ax.axhline(1024, color="grey", lw=0.8)
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title("LWR4+ (7 joints), real run tiled: peak memory against length", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, metadata={"Software": None})
+    plt.close(fig)
+
+
 def markdown(doc) -> list:
     md = ["# Hours of data, many recordings", "",
           f"Machine: {doc['machine']}; load average {doc['load'][0]:.1f} at the end of the last part run (other "
@@ -158,7 +197,8 @@ def markdown(doc) -> list:
     if "memory" in doc:
         md += ["`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR "
                "factors, dyngen.streaming) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
-               "streaming/gap.py) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
+               "streaming/gap.py) and `dyngen diagnose` (the full diagnosis on evenly spread 6-s windows of at most 24000 "
+               "samples, the gap and simple model over every sample in blocks: streaming/sample.py) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
                "200 Hz) repeated end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest "
                "resident set (bench/peak_memory.py) of the whole command (Python, NumPy, the compiled model).", "",
                "| command | length | rate | format | rows | file | wall | CPU | peak memory |",
@@ -190,7 +230,7 @@ def markdown(doc) -> list:
                    "about 0.5 on an idle 2-core machine)."]
         md.append("")
     if "whole" in doc:
-        md += ["Commands that still hold every row (not in blocks yet), on the same tiled run:", "",
+        md += ["The command that still holds every row (not in blocks yet), on the same tiled run:", "",
                "| command | length | rows | wall | CPU | peak memory |", "|---|---|---:|---:|---:|---:|"]
         for r in doc["whole"]["rows"]:
             md.append(f"| {r['command']} | {r['minutes']} min | {r['rows']} | {r['seconds']:.1f} s | "
@@ -225,6 +265,8 @@ def main(argv=None) -> int:
     RESULTS.mkdir(exist_ok=True)
     path.write_text(json.dumps(doc, indent=1) + "\n")
     md = markdown(doc)
+    if "memory" in doc:
+        figure(doc, RESULTS / "streaming_memory.png")
     (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
     print("\n".join(md))
     return 0

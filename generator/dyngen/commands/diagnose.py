@@ -13,7 +13,9 @@ from ..errors import InputError
 from ..errors import printable
 from ..options import add_arguments, resolve
 from ..progress import Progress
-from .recordings import add_data_options, check_enough, compiled_model, conditioning_of, conditioning_text, read_all
+from ..arguments import whole
+from ..streaming.sample import MAX_ROWS
+from .recordings import MIN_DIAGNOSIS_SAMPLES, add_data_options, check_enough, compiled_model, conditioning_of, conditioning_text, read_all
 
 
 def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
@@ -51,6 +53,10 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="only the gap of every --data recording and the simple model, per recording and pooled, "
                              "and which recordings stand out; each recording read in blocks, on all cores "
                              "(recordings.md, recordings.json)")
+    parser.add_argument("--max-rows", type=whole(MIN_DIAGNOSIS_SAMPLES, 10 ** 9), default=None, metavar="N",
+                        help="a --data recording of more samples is diagnosed on evenly spread 6-s windows of at most "
+                             "N samples in all, its gap and simple model reported over every sample (read in blocks: "
+                             f"memory independent of its length; default {MAX_ROWS})")
     add_arguments(parser.add_argument_group("diagnosis"), Options)
     return parser
 
@@ -98,17 +104,29 @@ def main(argv, prog="dyngen diagnose") -> int:
             check_enough(recording.name, recording.t)
         fit, select, test = ([condition(r[k], conditioning_of(args)) for r in pieces if r[k] is not None]
                              for k in range(3))
-    else:
-        fit = read_all(args.data, robot, args)
+    else:  # --data read in blocks once the model is compiled (long_diagnosis.py); their headers now
+        from .long_diagnosis import check_headers
+
+        check_headers(args.data, robot, args)
         select = read_all(args.select, robot, args) if args.select else []
         test = read_all(tests, robot, args) if tests else []
-        for path, recording in zip([*args.data, *(args.select or []), *tests], [*fit, *select, *test]):
+        for path, recording in zip([*(args.select or []), *tests], [*select, *test]):
             check_enough(Path(path).name, recording.t)
-    progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(fit)} fit, {len(select)} "
+    progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = compiled_model(args, robot, progress)
+    sampled = []
+    if not args.split:
+        from .long_diagnosis import read_fit
+
+        with progress.step("read the --data recordings (in blocks)"):
+            fit, sampled = read_fit(args.data, robot, args, model, p, args.max_rows or MAX_ROWS)
+        for recording in fit:
+            check_enough(recording.name, recording.t)
     sources = {"params": printable(Path(args.params).name), "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
+    if sampled:
+        sources["sampled"] = sampled
     from ..diagnosis.trust import EXIT_UNUSABLE, Unusable  # the diagnosis loads only once it runs
     from ..diagnosis.unusable_output import write_unusable
 
@@ -126,6 +144,11 @@ def main(argv, prog="dyngen diagnose") -> int:
     with progress.step("report, JSON, figures, updated model"):
         with results_folder(out) as staging:  # the folder is written as one unit
             paths = write_outputs(result, robot, p, staging, sources, options.sign_velocity)
+            if sampled:
+                from .long_diagnosis import markdown
+
+                with open(staging / "report.md", "a", encoding="utf-8") as f:
+                    f.write(markdown(sampled))
         paths = {k: shown(v, staging, out) if isinstance(v, Path) else v for k, v in paths.items()}
     if not args.quiet:
         print(f"{robot.name}: diagnosis in {time.perf_counter() - start:.1f} s ({result.split})")

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import engine
 from .step import _local, _model
-from .triangular import Triangular, fold
+from .triangular import fold
 
 VELOCITY = 0.02  # rad/s, diagnosis.baseline.VELOCITY: the simple model's tanh scale
 
@@ -45,31 +45,46 @@ class Gap:
     streamed: bool
 
 
+class Sums:
+    """The gap's sums and the simple model's factors, block by block."""
+
+    def __init__(self, model, p, dof: int):
+        self.model, self.s = model, p
+        self.factors = [None] * dof
+        self.rows, self.total, self.squares = 0, np.zeros(dof), np.zeros(dof)
+
+    @classmethod
+    def start(cls, model, p, dof: int) -> "Sums":
+        from ..catalogue import STANDARD_FROM_DYNAMIC
+
+        return cls(model, model(STANDARD_FROM_DYNAMIC.name, np.asarray(p, dtype=float)), dof)
+
+    def add(self, q, qd, qdd, tau, tanh) -> None:
+        from ..catalogue import RNEA
+
+        r = tau - self.model.batch(RNEA.name, q, qd, qdd, self.s)
+        for j in range(len(self.factors)):
+            self.factors[j] = fold(self.factors[j], np.column_stack([np.ones(r.shape[0]), tanh[:, j], qd[:, j],
+                                                                     r[:, j]]))
+        self.rows += r.shape[0]
+        self.total += r.sum(axis=0)
+        self.squares += (r ** 2).sum(axis=0)
+
+    def result(self, name: str, streamed: bool) -> Gap:
+        return Gap(name, self.factors, self.rows, self.total, self.squares, streamed)
+
+
 def run(task: GapTask) -> Gap:
-    from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
     from ..data import condition, read_recording
     from ..data.chunks import chunks
 
-    model = _model(task.folder)
-    s = model(STANDARD_FROM_DYNAMIC.name, np.asarray(task.p, dtype=float))
-    factors = [None] * task.dof
-    rows, total, squares = 0, np.zeros(task.dof), np.zeros(task.dof)
-
-    def add(q, qd, qdd, tau, tanh):
-        nonlocal rows
-        r = tau - model.batch(RNEA.name, q, qd, qdd, s)
-        for j in range(task.dof):
-            factors[j] = fold(factors[j], np.column_stack([np.ones(r.shape[0]), tanh[:, j], qd[:, j], r[:, j]]))
-        rows += r.shape[0]
-        total[:] += r.sum(axis=0)
-        squares[:] += (r ** 2).sum(axis=0)
-
+    sums = Sums.start(_model(task.folder), task.p, task.dof)
     blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
     first = next(blocks)
     if _local(first, task.conditioning):
         for piece in itertools.chain([first], blocks):  # one block at a time, never all
-            add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
-        return Gap(first.name, factors, rows, total, squares, True)
+            sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
+        return sums.result(first.name, True)
     blocks.close()
     sig = condition(read_recording(task.path, task.dof, True, (), task.effort_topic), task.conditioning)
     keep = sig.inner()  # the filter's start-up is not data (as in the diagnosis)
@@ -77,8 +92,8 @@ def run(task: GapTask) -> Gap:
     index = np.flatnonzero(keep)
     for a in range(0, index.size, task.rows):
         k = index[a:a + task.rows]
-        add(sig.q[k], sig.qd[k], sig.qdd[k], sig.tau[k], tanh[k])
-    return Gap(sig.name, factors, rows, total, squares, False)
+        sums.add(sig.q[k], sig.qd[k], sig.qdd[k], sig.tau[k], tanh[k])
+    return sums.result(sig.name, False)
 
 
 @dataclass

@@ -1,0 +1,70 @@
+"""`dyngen diagnose` on recordings longer than the diagnosis should hold (--max-rows): each
+such --data recording read once in blocks, diagnosed on evenly spread windows of it, its gap
+and simple model over every row reported beside (dyngen.streaming.sample). Recordings within
+the bound are read whole, as before: the diagnosis is the in-memory one."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .recordings import MIN_DIAGNOSIS_SAMPLES, conditioning_of
+
+
+def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
+    """(the fit signals in the order of `paths`, the sampled recordings' summaries for the report)."""
+    from ..data import condition, read_recording
+    from ..data.recording import check_informative
+    from ..streaming.gap import GapTask
+    from ..streaming.sample import sample
+
+    recordings, sampled = [], []
+    for path in paths:
+        task = GapTask(str(path), robot.dof, str(model.folder), tuple(float(v) for v in p), conditioning_of(args),
+                       args.effort_topic)
+        got = sample(task, max_rows)
+        if not got.sampled:  # the whole-file reader and its checks, as before
+            recordings.append(read_recording(path, robot.dof, True, (), args.effort_topic))
+            continue
+        windows = [w for w in got.recordings if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+        recordings += windows
+        sampled.append(summary(got, windows))
+    check_informative(recordings, True)
+    return [condition(r, conditioning_of(args)) for r in recordings], sampled
+
+
+def summary(got, windows) -> dict:
+    from ..streaming.gap import _rms, _solve
+
+    g = got.gap
+    simple = np.array([_solve(R) for R in g.factors])
+    return {"recording": g.name, "rows": got.rows, "seconds": round(got.seconds, 3),
+            "windows": len(windows), "rows_diagnosed": int(sum(w.t.size for w in windows)),
+            "gap_rms": np.sqrt(g.squares / g.rows).tolist(), "gap_mean": (g.total / g.rows).tolist(),
+            "simple_model": simple.tolist(),
+            "simple_rms": [_rms(R, x, g.rows) for R, x in zip(g.factors, simple)],
+            "streamed": g.streamed}
+
+
+def markdown(sampled: list) -> str:
+    """The report's section on the sampled recordings."""
+    lines = ["", "## Long recordings: diagnosed on a sample", ""]
+    for s in sampled:
+        n = len(s["gap_rms"])
+        lines += [f"{s['recording']}: {s['rows']} samples ({s['seconds']:.0f} s); the diagnosis above ran on "
+                  f"{s['windows']} windows spread evenly over it ({s['rows_diagnosed']} samples). Over every "
+                  "sample (read in blocks):", "",
+                  "| | " + " | ".join(f"J{j + 1}" for j in range(n)) + " |",
+                  "|---|" + "---|" * n,
+                  "| gap RMS [Nm] | " + " | ".join(f"{x:.3g}" for x in s["gap_rms"]) + " |",
+                  "| gap mean [Nm] | " + " | ".join(f"{x:+.3g}" for x in s["gap_mean"]) + " |",
+                  "| after the simple model [Nm] | " + " | ".join(f"{x:.3g}" for x in s["simple_rms"]) + " |",
+                  ""]
+    return "\n".join(lines)
+
+
+def check_headers(paths, robot, args) -> None:
+    """Headers and first rows: a bad file fails before anything is announced."""
+    from ..data.chunks import chunks
+
+    for path in paths:
+        next(chunks(path, robot.dof, True, (), 64, args.effort_topic))

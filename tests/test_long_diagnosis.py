@@ -1,0 +1,93 @@
+"""`dyngen diagnose` on a recording longer than --max-rows: read in blocks, diagnosed on evenly
+spread windows, the gap and simple model over every sample. Oracles: Pinocchio's torques at
+the recorded samples and numpy's least squares (the gap and simple model over the whole file),
+the simulated sensor offset (what the diagnosis of the windows must find), and the in-memory
+diagnosis (the public function on the whole recording) for a recording within the bound."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from dyngen.data import condition, read_recording
+from dyngen.diagnosis import diagnose
+from dyngen.diagnosis.effects import base
+from dyngen.description import load_robot
+from dyngen.runtime import load
+from oracles.arm import Arm, nominal_parameters
+from synthetic import rigid_torques
+from test_streaming import FOLDER, LWR, N, ROOT, write_robot
+
+OFFSET = [0, 0, 1.5, 0, 0, 0, 0]  # Nm: the torque sensor's offset on J3
+
+
+def run(*args):
+    out = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--params", str(LWR), "--model",
+                          str(FOLDER), "-q", *map(str, args)], capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    assert out.returncode == 0, out.stderr
+    return out
+
+
+def test_long_recording_diagnosed_on_windows_with_the_gap_over_every_sample(tmp_path):
+    path = write_robot(tmp_path / "long.csv", seed=3, seconds=40.0, offset=OFFSET)  # 8000 samples
+    run("--data", path, "--max-rows", 3000, "--out", tmp_path / "d")
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    (s,) = doc["sampled"]
+    r = read_recording(path, N)
+    assert s["rows"] == r.t.size and s["streamed"]
+    # windows every 6 * 2^k s, between half the bound and the bound, evenly spread
+    starts = [float(name.rpartition("@")[2].rstrip("s")) for name in doc["fit"]]
+    assert len(starts) == s["windows"] >= 2 and 1500 < s["rows_diagnosed"] <= 3000
+    spacing = np.diff(starts)
+    assert np.all(spacing == spacing[0]) and np.log2(spacing[0] / 6.0) % 1 == 0
+    # the gap and the simple model over every sample: Pinocchio and numpy
+    gap = r.tau - rigid_torques(Arm.from_yaml(LWR), nominal_parameters(LWR), r.q, r.qd, r.qdd)
+    assert np.allclose(s["gap_rms"], np.sqrt(np.mean(gap ** 2, axis=0)), rtol=1e-6)
+    assert np.allclose(s["gap_mean"], gap.mean(axis=0), atol=1e-6)
+    for j in range(N):
+        A = np.column_stack([np.ones(r.t.size), np.tanh(r.qd[:, j] / 0.02), r.qd[:, j]])
+        x, *_ = np.linalg.lstsq(A, gap[:, j], rcond=None)
+        assert np.allclose(s["simple_model"][j], x, rtol=1e-6, atol=1e-8)
+        assert np.isclose(s["simple_rms"][j], np.sqrt(np.mean((gap[:, j] - A @ x) ** 2)), rtol=1e-6)
+    # the windows' diagnosis finds the sensor's offset
+    offset = [e for e in doc["selected"] if e["effect"] == "offset" and e["joints"] == [3]]
+    assert offset and abs(offset[0]["values"]["b"] - 1.5) < 0.1
+    assert "## Long recordings: diagnosed on a sample" in (tmp_path / "d" / "report.md").read_text()
+
+
+def test_recording_within_the_bound_is_the_in_memory_diagnosis(tmp_path, monkeypatch):
+    """Also: the memo's bound changes no result (the in-memory run keeps 1 MiB of columns, the
+    command 256 MiB)."""
+    path = write_robot(tmp_path / "short.csv", seed=4, seconds=5.0, offset=OFFSET)
+    run("--data", path, "--out", tmp_path / "d")
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    assert "sampled" not in doc and doc["fit"] == ["short.csv"]
+    assert any(e["effect"] == "offset" and e["joints"] == [3] for e in doc["selected"])
+    robot = load_robot(LWR)
+    monkeypatch.setattr(base, "MEMO_BYTES", 1 << 20)
+    result = diagnose(robot, load(FOLDER), nominal_parameters(LWR), [condition(read_recording(path, N))])
+    assert np.allclose(doc["rms_before"], result.rms_before, rtol=1e-9)
+    assert np.allclose(doc["rms_after"], result.rms_after, rtol=1e-9)
+    assert [e["effect"] for e in doc["selected"]] == [e["effect"] for e in result.selected]
+    for a, b in zip(doc["selected"], result.selected):
+        assert a["joints"] == b["joints"]
+        assert np.allclose(list(a["values"].values()), list(b["values"].values()), rtol=1e-9)
+
+
+def test_a_bad_row_deep_in_a_long_recording_is_one_line_and_nothing_written(tmp_path):
+    path = write_robot(tmp_path / "long.csv", seed=5, seconds=30.0)
+    lines = path.read_text().splitlines()
+    lines[5001] = lines[5001].replace(lines[5001].split(",")[3], "nan", 1)  # line 5002, column q3
+    path.write_text("\n".join(lines) + "\n")
+    out = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--params", str(LWR), "--model",
+                          str(FOLDER), "--data", str(path), "--max-rows", "1000", "--out", str(tmp_path / "d"), "-q"],
+                         capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    assert out.returncode != 0
+    assert out.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 5002, column q3: nan (NaN or infinite value)"]
+    assert not (tmp_path / "d").exists()
