@@ -116,8 +116,8 @@ def main():
     single_time = time.perf_counter() - start
     assert np.allclose(batch, single, rtol=0, atol=1e-12)
 
-    claims = ", ".join(f"{e['effect']} joint(s) {e['joints']}" for e in d.selected)
-    encoder_claims = ", ".join(f"{e['effect']} joint(s) {e['joints']}" for e in ed.selected)
+    claims = ", ".join(f"{e.effect} joint(s) {list(e.joints)}" for e in d.selected)
+    encoder_claims = ", ".join(f"{e.effect} joint(s) {list(e.joints)}" for e in ed.selected)
     samples = fit.t.size
     lines = [
         "# Diagnosis speed (bench/bench_diagnosis.py)", "",

@@ -75,16 +75,16 @@ def main() -> int:
                   f"| final model with `--reidentify` ({r_seconds:.1f} s) | " + " | ".join(f"{x:.3f}" for x in r_after)
                   + f" | {r_after.mean():.3f} |", "",
                   f"With `--reidentify`: worse than the simple model on {r_worse or 'none'}; link parameters off: "
-                  f"{r.consistent['joints'] if r.consistent else 'not claimed'}"
-                  + (f" (regularisation {r.consistent['regularisation']:g})" if r.consistent else "") + ".", "",
+                  f"{r.consistent.joints if r.consistent else 'not claimed'}"
+                  + (f" (regularisation {r.consistent.regularisation:g})" if r.consistent else "") + ".", "",
                   within_fit_speeds(d),
                   f"Joints where the final model is worse than the simple model: {worse or 'none'}. Per joint "
                   f"model: {', '.join(f'J{j + 1} {m}' for j, m in enumerate(d.joint_models))}.", "",
-                  "Selected: " + "; ".join(f"{e['effect']} {e['joints']}" for e in d.selected) + ".", ""]
+                  "Selected: " + "; ".join(f"{e.effect} {list(e.joints)}" for e in d.selected) + ".", ""]
         lines += [f"- warning: {w}" for w in d.warnings] + [""]
         print(f"{name}: after {np.round(after, 3)} mean {after.mean():.3f}; simple {np.round(simple, 3)}; "
               f"worse on {worse}; --reidentify {np.round(r_after, 3)} mean {r_after.mean():.3f} worse on {r_worse}, "
-              f"link parameters off {r.consistent['joints'] if r.consistent else None}", flush=True)
+              f"link parameters off {r.consistent.joints if r.consistent else None}", flush=True)
     lines += positions_only(robot, model, p)
     lines += block_lengths(robot, model, p, recording)
     write_file(ROOT / "bench" / "results" / "lwr_real.md", "\n".join(lines))
@@ -119,7 +119,7 @@ def positions_only(robot, model, p) -> list[str]:
         after, simple = np.array(d.rms_after), np.array(d.rms_simple)
         worse = [j + 1 for j in range(7) if after[j] > simple[j] + 1e-9]
         name = f"m{'+m'.join(map(str, fit))} -> m{test[0]}"
-        cut = ", ".join(f"{c['note']}" for c in d.conditioning[:1])
+        cut = ", ".join(f"{c.note}" for c in d.conditioning[:1])
         label = "worse than simple on " + (", ".join(f"J{j}" for j in worse) if worse else "none")
         lines += [f"| {name} | **final model** ({label}) | " + " | ".join(f"{x:.3f}" for x in after)
                   + f" | {after.mean():.3f} |",

@@ -51,12 +51,12 @@ def run(lwr, extra, seed=0, **options):
 
 
 def claims(d):
-    return sorted((e["effect"], tuple(e["joints"])) for e in d.selected)
+    return sorted((e.effect, e.joints) for e in d.selected)
 
 
 def value(d, effect, joint=None):
-    e = next(e for e in d.selected if e["effect"] == effect and (joint is None or e["joints"] == [joint]))
-    return e["values"], e["std"]
+    e = next(e for e in d.selected if e.effect == effect and (joint is None or e.joints == (joint,)))
+    return e.values, e.std
 
 
 def near_noise(d, factor=1.3):
@@ -118,8 +118,8 @@ def test_tilted_base(lwr):
         return rigid_torques(tilted, p, q, qd, qdd)
 
     d = run(lwr, tilt)
-    assert [e["effect"] for e in d.selected] == ["tilt"]
-    angles = d.selected[0]["derived"]["tilt_deg"]
+    assert [e.effect for e in d.selected] == ["tilt"]
+    angles = d.selected[0].derived["tilt_deg"]
     assert np.hypot(*angles) == pytest.approx(2.0, rel=0.1)
     assert near_noise(d)
 
@@ -132,8 +132,8 @@ def test_payload_on_last_link(lwr):
         return rigid_torques(arm, p, q, qd, qdd, payload=payload)
 
     d = run(lwr, with_payload)
-    assert [e["effect"] for e in d.selected] == ["payload"]
-    values = d.selected[0]["values"]
+    assert [e.effect for e in d.selected] == ["payload"]
+    values = d.selected[0].values
     assert values["m"] == pytest.approx(1.5, rel=0.1)
     assert values["mx"] == pytest.approx(1.5 * 0.02, rel=0.2)
     assert near_noise(d)
@@ -148,8 +148,8 @@ def test_time_shift(lwr):
         return rigid_torques(arm, p, *at(t - dt))
 
     d = run(lwr, late)
-    assert [e["effect"] for e in d.selected] == ["time_shift"]
-    assert d.selected[0]["values"]["dt"] == pytest.approx(dt, rel=0.1)
+    assert [e.effect for e in d.selected] == ["time_shift"]
+    assert d.selected[0].values["dt"] == pytest.approx(dt, rel=0.1)
     assert near_noise(d)
 
 
@@ -174,7 +174,7 @@ def test_one_late_joint_is_no_time_shift_of_the_arm(lwr):
     assert diagnose(robot, model, p, [fit], None, only_shift, test=[held]).selected == []
     fit, held = measured(list(range(7)))
     d = diagnose(robot, model, p, [fit], None, only_shift, test=[held])
-    assert [e["effect"] for e in d.selected] == ["time_shift"]
+    assert [e.effect for e in d.selected] == ["time_shift"]
 
 
 def test_rotor_inertia_and_gain(lwr):

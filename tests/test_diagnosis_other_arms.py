@@ -45,8 +45,8 @@ def test_friction_and_offset_on_other_arms(name):
     rng = np.random.default_rng(0)
     fit, test = (encoder_recording(k, arm, p, seed, rng) for k, seed in (("fit", 11), ("test", 12)))
     d = diagnose(robot, model, p, [fit], None, test=[test])
-    assert sorted((e["effect"], tuple(e["joints"])) for e in d.selected) == [("coulomb", (2,)), ("offset", (1,))]
-    values = {e["effect"]: e["values"] for e in d.selected}
+    assert sorted((e.effect, e.joints) for e in d.selected) == [("coulomb", (2,)), ("offset", (1,))]
+    values = {e.effect: e.values for e in d.selected}
     assert values["coulomb"]["Fc"] == pytest.approx(FC, rel=0.1)
     assert values["offset"]["b"] == pytest.approx(OFFSET, rel=0.1)
     # Where both models hold the same offset, their test RMS differ by estimation noise only.

@@ -25,7 +25,7 @@ SAMPLE = Path("/work/shared/data/withheld-sample")
 
 
 def _offset(d, joint):
-    return next(e for e in d.selected if e["effect"] == "offset" and e["joints"] == [joint])
+    return next(e for e in d.selected if e.effect == "offset" and e.joints == (joint,))
 
 
 def test_an_offset_larger_than_the_whole_residual_is_flagged():
@@ -40,7 +40,7 @@ def test_an_offset_larger_than_the_whole_residual_is_flagged():
     residual = fit.tau[keep] - model.batch("rnea", fit.q[keep], fit.qd[keep], fit.qdd[keep],
                                            model("standard_from_dynamic", p))
     whole = float(np.sqrt(np.mean(residual[:, 5] ** 2)))
-    assert abs(e["values"]["b"]) > 2 * whole and "suspect" in e
+    assert abs(e.values["b"]) > 2 * whole and e.suspect
     assert any(x.startswith("joint 6: offset and ripple make up for each other") for x in d.warnings)
     assert np.allclose(d.rms_after, [0.238, 0.291, 0.169, 0.282, 0.264, 0.081, 0.026], atol=6e-4)
 
@@ -50,8 +50,8 @@ def test_injected_offsets_are_not_flagged():
     p = read_link_parameters(SAMPLE / "nominal.yaml", 7)
     fit, test = (condition(read_recording(SAMPLE / "payload_offset" / f"{k}.csv", 7)) for k in ("excitation", "validation"))
     d = diagnose(robot, model, p, [fit], None, test=[test])
-    assert abs(_offset(d, 1)["values"]["b"] - 0.3) < 0.01 and abs(_offset(d, 6)["values"]["b"] + 0.25) < 0.01
-    assert not any("suspect" in e for e in d.selected)
+    assert abs(_offset(d, 1).values["b"] - 0.3) < 0.01 and abs(_offset(d, 6).values["b"] + 0.25) < 0.01
+    assert not any(e.suspect for e in d.selected)
     assert not any("make up for each other" in w for w in d.warnings)
 
 
@@ -82,10 +82,10 @@ def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
         assert any(w.startswith("the link parameters may be off") for w in plain.warnings), case.name
         d = diagnose(robot, model, p_model, [fit], None, Options(reidentify=True), test=[test])
         found[case.name] = d
-        assert d.consistent and {2, 3} <= set(d.consistent["joints"]), case.name
+        assert d.consistent and {2, 3} <= set(d.consistent.joints), case.name
         assert any(w.startswith("link parameters off") for w in d.warnings)
-        assert not any(e["effect"] in ("coulomb", "ripple", "gain") for e in d.selected), case.name
+        assert not any(e.effect in ("coulomb", "ripple", "gain") for e in d.selected), case.name
         assert np.all(np.array(d.rms_after) < 0.05), (case.name, d.rms_after)  # the noise is 0.05 Nm before filtering
-    assert not any(e["effect"] == "payload" for e in found["unloaded"].selected)
-    payload = next(e for e in found["loaded"].selected if e["effect"] == "payload")
-    assert abs(payload["values"]["m"] - 1.5) < 0.075
+    assert not any(e.effect == "payload" for e in found["unloaded"].selected)
+    payload = next(e for e in found["loaded"].selected if e.effect == "payload")
+    assert abs(payload.values["m"] - 1.5) < 0.075

@@ -1,6 +1,8 @@
 """The package's import graph, read from the source with ast (every import, at module level or
 inside a function): no module imports from a later stage, and no circle between modules. A stage
-may use the stages before it; the order is the one a reader follows, foundations first."""
+may use the stages before it; the order is the one a reader follows, foundations first. Inside
+the diagnosis the same holds for its pipeline's stages (diagnosis/__init__.py), and no module of
+the measured-data half is over MAX_LINES lines."""
 
 from __future__ import annotations
 
@@ -29,6 +31,21 @@ STAGES = (
     {"cli", "__main__"},
 )
 RANK = {name: k for k, names in enumerate(STAGES) for name in names}
+# The diagnosis's stages (diagnosis/__init__.py), its result's types and shared tools first.
+DIAGNOSIS_STAGES = (
+    {"record", "phases", "moments", "trust", "roles"},  # the result's types; 0. roles
+    {"effects", "effects.base", "effects.body", "effects.friction", "effects.sensor", "effects.tilt", "fit"},  # 1. fit
+    {"selection"},  # 2. select
+    {"refine", "settle"},  # 3. settle
+    {"joints", "reidentify", "choose"},  # 4. choose
+    {"judge"},  # 5. test
+    {"findings", "findings_check", "notes", "options", "pipeline"},  # 6. report; the pipeline
+    {"report", "model", "figures", "outputs", "unusable_output", ""},  # written out; the package
+)
+DIAGNOSIS_RANK = {name: k for k, names in enumerate(DIAGNOSIS_STAGES) for name in names}
+MEASURED_DATA = ("data", "diagnosis", "terms", "identification", "excitation", "streaming")
+MEASURED_COMMANDS = ("diagnose", "identify", "identify_consistent", "excite", "recordings", "least_squares", "survey")
+MAX_LINES = 300
 
 
 def modules() -> dict:
@@ -106,3 +123,24 @@ def test_no_circle():
         if node not in state:
             visit(node, [node])
     assert not circles, circles
+
+
+def diagnosis_stage(module: str) -> int:
+    return DIAGNOSIS_RANK[module.removeprefix("dyngen.diagnosis").removeprefix(".")]
+
+
+def test_diagnosis_stages_in_order():
+    """No module of the diagnosis imports from a later stage of its pipeline."""
+    inside = {a: {b for b in bs if b.startswith("dyngen.diagnosis")} for a, bs in graph().items()
+              if a.startswith("dyngen.diagnosis")}
+    assert set(map(diagnosis_stage, inside)) == set(range(len(DIAGNOSIS_STAGES)))  # every module has a stage
+    late = sorted(f"{a} -> {b}" for a, bs in inside.items() for b in bs if diagnosis_stage(b) > diagnosis_stage(a))
+    assert not late, late
+
+
+def test_measured_data_modules_are_short():
+    paths = [p for d in MEASURED_DATA for p in PACKAGE.joinpath(d).rglob("*.py")]
+    paths += [PACKAGE / "commands" / f"{name}.py" for name in MEASURED_COMMANDS]
+    assert len(paths) > 60 and all(p.exists() for p in paths)
+    long = sorted(f"{p.relative_to(PACKAGE)}: {n}" for p in paths if (n := len(p.read_text().splitlines())) > MAX_LINES)
+    assert not long, long

@@ -121,7 +121,7 @@ def test_recorded_accelerations_that_are_noise_are_replaced(arm, khz, tmp_path):
     robot, model = arm
     d = diagnose(robot, model, nominal_model(robot), [condition(read_recording(path, 7))])
     assert any("conditioned again" in w for w in d.warnings)
-    found = {(e["effect"], tuple(e["joints"])) for e in d.selected}
+    found = {(e.effect, e.joints) for e in d.selected}
     assert {("coulomb", (1,)), ("coulomb", (6,))} <= found
 
 

@@ -125,7 +125,7 @@ def test_m1_to_m3(m1_m3):
     assert np.mean(after) <= 0.25
     assert any("faster than any fit data" in w and "4 (" in w for w in m1_m3.warnings)
     assert m1_m3.joint_models[4] == joints.TIED
-    assert any(e["effect"] == "coulomb" and e["joints"] == [5] for e in m1_m3.selected)
+    assert any(e.effect == "coulomb" and e.joints == (5,) for e in m1_m3.selected)
 
 
 def test_the_terminal_says_where_the_simple_model_is_better(setup):
@@ -166,7 +166,7 @@ def test_repeated_trajectory_is_flagged(setup, m1_m3):
 
 def test_steady_biases_found_as_offsets(m1_m3):
     """The data README: about +0.9 Nm on joint 1 (and a bias on joint 6, here with friction)."""
-    offsets = {e["joints"][0]: e["values"]["b"] for e in m1_m3.selected if e["effect"] == "offset"}
+    offsets = {e.joints[0]: e.values["b"] for e in m1_m3.selected if e.effect == "offset"}
     assert offsets[1] == pytest.approx(0.9, abs=0.15)
 
 

@@ -17,6 +17,7 @@ from conftest import ROOT
 from dyngen.description import load_robot
 from dyngen.diagnosis.effects import Context, Coulomb, Direction, Stribeck, Viscous
 from dyngen.diagnosis.model import friction_vector
+from dyngen.diagnosis.record import Finding
 from dyngen.runtime import load
 from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, friction_torque
 
@@ -64,7 +65,8 @@ def test_friction_vector_of_a_diagnosis_is_the_fitted_law(model):
     context = Context(model, robot, None, None, sign_velocity)
     chosen = [(Coulomb(0.04), {"Fc": 0.7}), (Stribeck(0.1), {"Fs": 0.3}), (Viscous(), {"Fv": 0.2}),
               (Direction(), {"dFc": 0.05})]
-    selected = [{"effect": e.name, "joints": [3], "values": v, "variant": e.fixed()} for e, v in chosen]
+    selected = [Finding(effect=e.name, joints=(3,), variant=e.fixed(), values=v, std={}, units={}, derived={},
+                        selection_gain=0.0, rms_before=[], rms_after=[]) for e, v in chosen]
     f = friction_vector(SimpleNamespace(joints=N, selected=selected), sign_velocity)
     rng = np.random.default_rng(3)
     qd = rng.normal(0, 0.2, (50, N))
@@ -122,3 +124,33 @@ def test_one_tilt_for_identify_and_diagnose():
     assert np.allclose(tilt.rotation_columns(robot, p, q, g, estimate), ours, rtol=1e-12, atol=1e-12)
     turned = g + tilt.directions(g).T @ tilt.change(g, estimate)
     assert np.linalg.norm(turned) == pytest.approx(np.linalg.norm(g), rel=1e-12)
+
+
+def test_excitation_matrix_is_what_identify_fits(model):
+    """The excitation's information matrix times [pi_full(p), per joint Fc, Fv, b and Ia where
+    the rigid body does not carry it] is Pinocchio's rnea plus the friction, offset and rotor
+    torques written out here; identify's own per-joint columns are the same columns."""
+    from oracles.arm import Arm
+    from oracles.random_params import random_parameters
+    from synthetic import rigid_torques
+
+    from dyngen.excitation import identification_matrix
+    from dyngen.identification.columns import joint_column
+
+    rng = np.random.default_rng(12)
+    T, v = 25, 0.03
+    q, qd, qdd = rng.uniform(-1.5, 1.5, (T, N)), rng.normal(0, 1, (T, N)), rng.normal(0, 2, (T, N))
+    p = random_parameters(N, seed=4)
+    armature = [j % 2 == 0 for j in range(N)]
+    Fc, Fv, b, Ia = (rng.uniform(0.1, 1.0, N) for _ in range(4))
+    x = np.concatenate([model("pi_full", p)] + [[Fc[j], Fv[j], b[j]] + ([Ia[j]] if armature[j] else [])
+                                                for j in range(N)])
+    written = (rigid_torques(Arm.from_yaml(ROOT / "examples" / "lwr.yaml"), p, q, qd, qdd) + Fc * np.tanh(qd / v)
+               + Fv * qd + b + Ia * qdd * np.array(armature))
+    A = identification_matrix(model, q, qd, qdd, v, armature)
+    assert np.allclose(A @ x, written.ravel(), rtol=1e-9, atol=1e-9)
+    signals = SimpleNamespace(t=np.arange(T) * 0.01, q=q, qd=qd, qdd=qdd)
+    for kind, column in (("viscous", qd), ("offset", np.ones_like(q)), ("armature", qdd), ("ripple_cos", np.cos(q)),
+                         ("ripple_sin", np.sin(q))):
+        for j in range(N):
+            assert np.allclose(joint_column(signals, kind, j), column[:, j], rtol=1e-15), kind

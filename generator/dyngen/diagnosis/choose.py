@@ -4,11 +4,13 @@ fit and selection blocks, and the consistent re-identification, reidentify.py)."
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..terms import simple_model
 from . import joints, reidentify, roles
-from .fit import predict, ranged
+from .fit import corrected, ranged
 from .refine import restricted
 from .selection import solve
 
@@ -17,30 +19,21 @@ def on_folds(context, segments, design, chosen, final, options) -> list[str]:
     """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS ways of
     cutting the fit recordings into fit and selection blocks, each model refitted per fold. One
     cut selects on one phase of the motion only (on a periodic trajectory, the same stretch
-    every period); every sample judges once this way. Leaves the segments' masks and
-    corrections as they were."""
-    saved = [(seg.fit, seg.select, seg.correction) for seg in segments]
-    own = [seg.fit.any() or seg.select.any() for seg in segments]
+    every period); every sample judges once this way."""
     totals = None
-    try:
-        for phase in range(roles.FOLDS):
-            for seg, mine in zip(segments, own):
-                if mine:
-                    seg.fit, seg.select = roles.blocks(seg.signals, options.block_seconds, phase)
-            # Position laws are known only over the positions this cut's fit blocks cover, as the
-            # final model's are over all the fit data (else a ripple would be judged on guesses).
-            fold = ranged(context, segments, chosen)
-            x = np.zeros(0)
-            if chosen:
-                fold_design, fold_chosen = restricted(fold, segments, design, chosen)
-                x = solve(fold_design, fold_chosen, covariance=False).x
-            for seg in segments:
-                seg.correction = predict(fold, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
-            sse = joints.errors(fold, segments, chosen, x, simple_model.fit(segments))
-            totals = sse if totals is None else [{k: a[k] + b[k] for k in a} for a, b in zip(totals, sse)]
-    finally:
-        for seg, (fit, select, correction) in zip(segments, saved):
-            seg.fit, seg.select, seg.correction = fit, select, correction
+    for phase in range(roles.FOLDS):
+        cut = [replace(seg, **dict(zip(("fit", "select"), roles.blocks(seg.signals, options.block_seconds, phase))))
+               if seg.fit.any() or seg.select.any() else seg for seg in segments]
+        # Position laws are known only over the positions this cut's fit blocks cover, as the
+        # final model's are over all the fit data (else a ripple would be judged on guesses).
+        fold = ranged(context, cut, chosen)
+        x = np.zeros(0)
+        if chosen:
+            fold_design, fold_chosen = restricted(fold, cut, design, chosen)
+            x = solve(fold_design, fold_chosen, covariance=False).x
+        cut = corrected(fold, chosen, x, cut)
+        sse = joints.errors(fold, cut, chosen, x, simple_model.fit(cut))
+        totals = sse if totals is None else [{k: a[k] + b[k] for k in a} for a, b in zip(totals, sse)]
     return joints.choose(totals, chosen, joints.FOLDS_PER_VALUE)
 
 

@@ -4,16 +4,18 @@ those reported and those superseded on joints another model won."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
 
+from .record import Finding
 from .selection import relative_change, selection_gain, selection_mse
 
 
-def describe(robot, design, chosen, final, cand, min_gain) -> dict:
+def describe(robot, design, chosen, final, cand, min_gain) -> Finding:
     """What an effect does on the selection data (its gain, the joints it helps); its values
-    are filled in by _values once the final fit is made."""
+    are filled in by with_values once the final fit is made."""
     mse_without = selection_mse(design, [c for c in chosen if c is not cand])
     mse_with = selection_mse(design, chosen)
     gain_per_joint = relative_change(mse_without, mse_with)
@@ -21,31 +23,27 @@ def describe(robot, design, chosen, final, cand, min_gain) -> dict:
     joints = [cand.joint + 1] if cand.joint is not None else \
         [j + 1 for j in range(len(gain_per_joint)) if gain_per_joint[j] >= min_gain]
     names = list(cand.effect.parameters)
-    out = {
-        "effect": cand.effect.name, "joints": joints, "variant": cand.effect.fixed(),
-        "values": {}, "std": {}, "units": dict(zip(names, cand.effect.units)), "derived": {},
-        "selection_gain": gain,
-        "rms_before": np.sqrt(mse_without).tolist(), "rms_after": np.sqrt(mse_with).tolist(),
-    }
-    if cand.effect.suspect:
-        out["suspect"] = cand.effect.suspect
-    return out
+    return Finding(effect=cand.effect.name, joints=tuple(joints), variant=cand.effect.fixed(), values={}, std={},
+                   units=dict(zip(names, cand.effect.units)), derived={}, selection_gain=gain,
+                   rms_before=np.sqrt(mse_without).tolist(), rms_after=np.sqrt(mse_with).tolist(),
+                   suspect=cand.effect.suspect)
 
 
-def fill_values(described, design, chosen, final, tau_corr, robot) -> None:
-    """The final values of every chosen effect, with deviations scaled for the residual's
-    correlation in time, and what follows from them (Effect.derived)."""
-    offset = 0
+def with_values(described, design, chosen, final, tau_corr, robot) -> list[Finding]:
+    """The findings with the final values of every chosen effect, deviations scaled for the
+    residual's correlation in time, and what follows from them (Effect.derived)."""
+    offset, out = 0, []
     for cand, e in zip(chosen, described):
         k = slice(offset, offset + cand.size)
         offset += cand.size
         std = np.sqrt(np.maximum(np.diag(final.covariance)[k], 0.0) * tau_corr)
         identifiable = _identifiable(design, chosen, k)
         names = list(cand.effect.parameters)
-        e["values"] = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], identifiable)}
-        e["std"] = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
-        e["variant"] = cand.effect.fixed()
-        e["derived"] = cand.effect.derived(robot, e["values"], e["std"], partial(_torque_rms, design, cand, final.x[k]))
+        values = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], identifiable)}
+        std = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
+        derived = cand.effect.derived(robot, values, std, partial(_torque_rms, design, cand, final.x[k]))
+        out.append(replace(e, values=values, std=std, variant=cand.effect.fixed(), derived=derived))
+    return out
 
 
 def _torque_rms(design, cand, x) -> float:
@@ -65,7 +63,7 @@ def _identifiable(design, chosen, k) -> np.ndarray:
     return loading[k] < 0.5
 
 
-def reported(chosen, described, replaced) -> tuple[list, list]:
+def reported(chosen, described, replaced) -> tuple[list[Finding], list[Finding]]:
     """(selected, superseded): the findings reported, and the per-joint ones on joints another
     model won (replaced, 0-based); an arm-wide finding keeps only the joints not replaced."""
     selected, superseded = [], []
@@ -73,6 +71,5 @@ def reported(chosen, described, replaced) -> tuple[list, list]:
         if c.joint is not None and c.joint in replaced:
             superseded.append(e)
             continue
-        e["joints"] = [j for j in e["joints"] if j - 1 not in replaced]
-        selected.append(e)
+        selected.append(replace(e, joints=tuple(j for j in e.joints if j - 1 not in replaced)))
     return selected, superseded

@@ -10,10 +10,13 @@ M_jj over the fit data) is outside its physical range. Such entries are marked `
 report prints them so, and the terminal and report.md carry the reason as a warning), and where
 two terms of one joint are both too large a warning says that the data cannot tell them apart.
 
-    warnings = check(result, model, s, fit_signals)   # marks entries; returns what could not be told apart
+    selected, warnings = check(selected, selection_before, model, s, fit_signals)
+    # the findings, those out of range marked suspect; warnings: what could not be told apart
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -23,43 +26,44 @@ ROTOR_RATIO = 10.0
 
 def _size(e) -> float | None:
     """The RMS-like size [Nm] of a per-joint finding's torque, where it has a scale of its own."""
-    v = e.get("values", {})
-    if e["effect"] == "offset" and v.get("b") is not None:
-        return abs(v["b"])
-    if e["effect"] == "ripple":
-        rms = e.get("derived", {}).get("torque_rms_Nm")
+    if e.effect == "offset" and e.values.get("b") is not None:
+        return abs(e.values["b"])
+    if e.effect == "ripple":
+        rms = e.derived.get("torque_rms_Nm")
         return None if rms is None else float(rms)
     return None
 
 
-def check(d, model, s, fit_signals) -> list[str]:
-    before = np.asarray(d.selection_before, dtype=float)
-    out, large = [], {}
+def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list[str]]:
+    """(the findings, those outside their range marked suspect; what could not be told apart)."""
+    before = np.asarray(selection_before, dtype=float)
+    out, large, checked = [], {}, []
     n = before.size
     inertia = None
-    for e in d.selected:
-        if len(e["joints"]) != 1 or e["effect"] not in ("offset", "ripple", "armature"):
+    for e in selected:
+        checked.append(e)
+        if len(e.joints) != 1 or e.effect not in ("offset", "ripple", "armature"):
             continue
-        j = e["joints"][0] - 1
+        j = e.joints[0] - 1
         reason = None
         size = _size(e)
         if size is not None and size > LARGER * before[j]:
             reason = (f"on joint {j + 1}, its torque ({size:.3g} Nm) is larger than the joint's whole nominal residual "
                       f"({before[j]:.3g} Nm on the selection data): it makes up for another term")
-        if e["effect"] == "armature" and e["values"].get("Ia") is not None:
+        if e.effect == "armature" and e.values.get("Ia") is not None:
             if inertia is None:
                 inertia = _inertia_about_joints(model, s, fit_signals, n)
-            ia = e["values"]["Ia"]
+            ia = e.values["Ia"]
             if ia > ROTOR_RATIO * inertia[j]:
                 reason = (f"on joint {j + 1}, {ia:.3g} kg m^2 is {ia / inertia[j]:.0f} x the arm's own inertia about the joint "
                           f"({inertia[j]:.3g} kg m^2): outside a rotor inertia's range")
         if reason:
-            e["suspect"] = reason
-            large.setdefault(j, []).append(e["effect"])
+            checked[-1] = replace(e, suspect=reason)
+            large.setdefault(j, []).append(e.effect)
     for j, names in sorted(large.items()):
         if len(names) > 1:
             out.append(f"joint {j + 1}: {' and '.join(names)} make up for each other; the data cannot tell them apart")
-    return out
+    return checked, out
 
 
 def _inertia_about_joints(model, s, signals, n) -> np.ndarray:

@@ -71,6 +71,13 @@ def predict(context, chosen, x, segment) -> np.ndarray:
     return out
 
 
+def corrected(context, chosen, x, segments) -> list:
+    """The segments with their correction: the chosen candidates' torques at values x (zero
+    without any)."""
+    return [dataclasses.replace(seg, correction=predict(context, chosen, x, seg) if chosen else
+                                np.zeros_like(seg.residual)) for seg in segments]
+
+
 def reweighted(design, final) -> Design:
     """The design with each joint weighted by 1 / the RMS its residual keeps after the chosen
     effects (on the fit samples). The selection's weights come from the nominal residual, which

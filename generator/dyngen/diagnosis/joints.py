@@ -39,6 +39,8 @@ samples, a few hundred in 25 s at 200 Hz), so 2 % per value is still several tim
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..terms import simple_model as baseline
@@ -156,21 +158,21 @@ def _better(sse, size, best_sse, best_size, min_gain) -> bool:
     return sse <= best_sse / (1 - min_gain) ** (best_size - size)
 
 
-def apply(context, segments, chosen, x, simple, modes, consistent=None) -> dict:
-    """Set seg.correction per joint by its mode (the effects' torques already there; consistent:
-    per segment the consistent model's corrections); returns {joint (1-based): values of the
-    completed model} for the report."""
-    completed = {}
+def apply(context, segments, chosen, x, simple, modes, consistent=None) -> tuple[list, dict]:
+    """(segments with each joint's correction by its mode, {joint (1-based): values of the
+    completed model} for the report). The segments' corrections hold the effects' torques;
+    consistent: per segment the consistent model's corrections."""
+    completed, corrections = {}, [seg.correction.copy() for seg in segments]
     for j, mode in enumerate(modes):
         if mode == CONSISTENT:
-            for seg, c in zip(segments, consistent):
-                seg.correction[:, j] = c[:, j]
+            for out, c in zip(corrections, consistent):
+                out[:, j] = c[:, j]
         elif mode in (SIMPLE, TIED):
-            for seg in segments:
-                seg.correction[:, j] = baseline.predict(simple, seg)[:, j]
+            for out, seg in zip(corrections, segments):
+                out[:, j] = baseline.predict(simple, seg)[:, j]
         elif mode == COMPLETED:
             values = _completed_fit(context, chosen, x, segments, j)
             completed[j + 1] = values.tolist()
-            for seg in segments:
-                seg.correction[:, j] = _completed_predict(context, chosen, x, values, seg, j)
-    return completed
+            for out, seg in zip(corrections, segments):
+                out[:, j] = _completed_predict(context, chosen, x, values, seg, j)
+    return [dataclasses.replace(seg, correction=c) for seg, c in zip(segments, corrections)], completed

@@ -29,8 +29,8 @@ def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
     for name in ("vc", "es", "ed"):
         f[:, FRICTION_FIELDS.index(name)] = sign_velocity
     for e in diagnosis.selected:
-        for name, value in effect_class(e["effect"]).friction_terms(e["values"], e["variant"]).items():
-            f[e["joints"][0] - 1, FRICTION_FIELDS.index(name)] = value
+        for name, value in effect_class(e.effect).friction_terms(e.values, e.variant).items():
+            f[e.joints[0] - 1, FRICTION_FIELDS.index(name)] = value
     return f.ravel()
 
 
@@ -39,10 +39,10 @@ def joint_dynamics(diagnosis) -> list[dict]:
     effect's simulator attribute)."""
     out = [{} for _ in range(diagnosis.joints)]
     for e in diagnosis.selected:
-        simulator = effect_class(e["effect"]).simulator
+        simulator = effect_class(e.effect).simulator
         if simulator:
             key, value = simulator
-            out[e["joints"][0] - 1][key] = float(e["values"][value])
+            out[e.joints[0] - 1][key] = float(e.values[value])
     return out
 
 
@@ -51,7 +51,7 @@ def with_payload(diagnosis, p: np.ndarray) -> np.ndarray:
     are all determined); otherwise p unchanged."""
     s = None
     for e in diagnosis.selected:
-        added = effect_class(e["effect"]).last_link(e["values"], e.get("variant"))
+        added = effect_class(e.effect).last_link(e.values, e.variant)
         if added is not None:
             s = standard_from_dynamic(p) if s is None else s
             s[-PER_LINK:] += added
@@ -67,8 +67,8 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
     doc = {
         "robot": diagnosis.robot,
         "parameters": sources.get("params"),
-        "effects": [{"effect": e["effect"], "joints": e["joints"], **({"variant": e["variant"]} if e["variant"] else {}),
-                     "values": e["values"], "std": e["std"], "units": e["units"]} for e in diagnosis.selected],
+        "effects": [{"effect": e.effect, "joints": list(e.joints), **({"variant": e.variant} if e.variant else {}),
+                     "values": e.values, "std": e.std, "units": e.units} for e in diagnosis.selected],
         "friction": {"layout": "per joint: " + ", ".join(FRICTION_FIELDS) + " (generated <robot>_friction)",
                      "f": [[float(x) for x in row] for row in f]},
     }

@@ -121,7 +121,7 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
             x = out
         return x * np.asarray(scale)[None, :, None] if scale is not None else x
 
-    key = ("columns", id(segment), effect.key, joint if part else None, delay, scale, effect.reads(context))
+    key = ("columns", id(segment.signals), effect.key, joint if part else None, delay, scale, effect.reads(context))
     return context.memo(key, compute)
 
 

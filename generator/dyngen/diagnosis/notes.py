@@ -44,19 +44,19 @@ def notes(d, model, s, fit_signals, select_signals, test_signals, used) -> list[
                        f"{', '.join(f'{predicted[j]:.3g}' for j in bad)} Nm of {', '.join(f'{d.rms_after[j]:.3g}' for j in bad)}"
                        " Nm): recorded velocities, or a lower --cutoff, would lower it")
     for e in d.selected:
-        out += effect_class(e["effect"]).warnings(e)
-        if e.get("suspect"):
-            out.append(f"{e['effect']} is a symptom, not a cause: {e['suspect']}")
+        out += effect_class(e.effect).warnings(e)
+        if e.suspect:
+            out.append(f"{e.effect} is a symptom, not a cause: {e.suspect}")
     for r in d.refused:
-        shown = ", ".join(f"{v:.3g}" for v in r["values"][:4])
-        because = "; ".join(x for x in (shown, r.get("reason", "")) if x)
-        what = "" if r.get("reason") else ", its fitted values are not physically possible"
-        out.append(f"{r['candidate']}: refused{what} ({because})")
+        shown = ", ".join(f"{v:.3g}" for v in r.values[:4])
+        because = "; ".join(x for x in (shown, r.reason) if x)
+        what = "" if r.reason else ", its fitted values are not physically possible"
+        out.append(f"{r.candidate}: refused{what} ({because})")
     if d.consistent:
         c = d.consistent
-        out.append("link parameters off: on joint(s) " + ", ".join(map(str, c["joints"])) + " physically consistent "
+        out.append("link parameters off: on joint(s) " + ", ".join(map(str, c.joints)) + " physically consistent "
                    "link parameters re-identified from the fit data (with friction, offsets, rotor inertia and a "
-                   f"tilted base; regularised toward the given parameters with weight {c['regularisation']:g}, chosen "
+                   f"tilted base; regularised toward the given parameters with weight {c.regularisation:g}, chosen "
                    "on selection data) did better than every effect and the simple model on selection data, and "
                    "are used there; they are written out (consistent/)")
     if d.simple_wins:

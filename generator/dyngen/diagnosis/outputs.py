@@ -46,7 +46,7 @@ def _consistent(diagnosis, robot, folder, sources: dict) -> dict:
     yaml = consistent_yaml(robot, c, fits, f"{sources.get('conditioning', 'as conditioned for the diagnosis')}; "
                            f"decimated to about {reidentify.RATE:g} Hz")
     table = (f"# {robot.name}: link parameters re-identified by the diagnosis (consistent, from {', '.join(fits)})\n\n"
-             f"Used on joint(s) {', '.join(map(str, diagnosis.consistent['joints']))}, where they did better than "
+             f"Used on joint(s) {', '.join(map(str, diagnosis.consistent.joints))}, where they did better than "
              "every effect and the simple model on selection data.\n\n"
              + "\n".join(summary_lines(robot, c)) + "\n\n" + consistent_table(c) + "\n")
     paths = {}

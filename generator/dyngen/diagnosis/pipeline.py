@@ -19,17 +19,19 @@ effects, test_signals are used for nothing but the reported held-out residual (r
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import simple_model
 from . import choose, findings_check, fit, joints, reidentify, roles, trust
 from .effects import Context, library
-from .findings import describe, fill_values, reported
+from .findings import describe, reported, with_values
 from .judge import judge, simple_mse
 from .notes import notes
 from .options import Options
-from .record import Diagnosis
+from .record import CandidateGain, Diagnosis, RecordingNote
 from .refine import restricted
 from .selection import forward, selection_mse, solve
 from .settle import settle
@@ -53,11 +55,9 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     design = fit.build(context, library(context, options.effects), segments, n)
 
     def correlation(chosen, fitted):
-        """Leaves each segment's correction at the chosen effects' values; the residual's
-        correlation time (the current context and design: the pipeline's own)."""
-        for seg in segments:
-            seg.correction = fit.predict(context, chosen, fitted.x, seg) if chosen else np.zeros_like(seg.residual)
-        return fit.correlation_time(segments, design.weights)
+        """The correlation time of what the chosen effects at the fitted values leave (the
+        current context and design: the pipeline's own)."""
+        return fit.correlation_time(fit.corrected(context, chosen, fitted.x, segments), design.weights)
 
     # 2. select
     selection = forward(design, options.min_gain, options.alpha)
@@ -70,75 +70,78 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
             context, segments, fit.reweighted(design, final), chosen, correlation, options)
         dropped += dropped_now
         refused += refused_now
-    correlation(chosen, final)  # each segment's correction: the effects at values from the fit samples
     # 4. choose, per joint: the effects, the simple model or both, all fitted on the fit samples
-    # only and compared on the selection samples (joints.py).
-    simple = simple_model.fit(segments)
+    # only and compared on the selection samples (joints.py). `selecting`: the segments with
+    # the effects' torques at the values from the fit samples.
+    selecting = fit.corrected(context, chosen, final.x, segments)
+    simple = simple_model.fit(selecting)
     sel_before = selection_mse(design, [])
     sel_effects = selection_mse(design, chosen)
-    sel_simple = simple_mse(segments, simple, "select", n)
+    sel_simple = simple_mse(selecting, simple, "select", n)
     if not design.select.count:
         modes = [joints.EFFECTS] * n
     elif select_signals:
-        modes = joints.decide(context, segments, chosen, final.x, simple, options.min_gain)
+        modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
-        modes = choose.on_folds(context, segments, design, chosen, final, options)
+        modes = choose.on_folds(context, selecting, design, chosen, final, options)
     reid, consistent = None, None
     # Without the re-identification its cheap gate still says where the rigid body's columns
     # explain what the effects leave: the link parameters may be off there.
     links_hint = []
-    if not options.reidentify and design.select.count and all(seg.correction is not None for seg in segments):
-        links_hint = reidentify.gate(model, segments, [seg.residual - seg.correction for seg in segments],
+    if not options.reidentify and design.select.count:
+        links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                      options.min_gain)
     if options.reidentify and design.select.count:
-        reid, consistent, modes = choose.reidentified(robot, model, p, context, segments, chosen, final.x, simple, modes,
-                                                      options.min_gain)
+        reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
+                                                      modes, options.min_gain)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
     # The choice made, every sample of the fit recordings sets the values (selection blocks
     # included; separate selection recordings stay out of it, as test recordings do).
+    fitting = selecting
     if not select_signals:
-        for seg in segments:
-            seg.fit = seg.fit | seg.select
-        simple = simple_model.fit(segments)
+        fitting = [replace(seg, fit=seg.fit | seg.select) for seg in selecting]
+        simple = simple_model.fit(fitting)
         # position laws now known over every fit sample's positions
-        context = fit.ranged(context, segments, chosen)
+        context = fit.ranged(context, fitting, chosen)
         if chosen:
-            design, chosen = restricted(context, segments, design, chosen)
+            design, chosen = restricted(context, fitting, design, chosen)
             final = solve(design, chosen)
         if reid is not None:
-            reid, consistent = choose.refit(robot, model, p, segments, reid, consistent)
-    tau_corr = correlation(chosen, final)  # also leaves each segment's correction at the final fit
-    fill_values(described, design, chosen, final, tau_corr, robot)
-    # 5. test
-    completed = joints.apply(context, segments, chosen, final.x, simple, modes, consistent)
-    judged = judge(design, segments, chosen, final, simple)
+            reid, consistent = choose.refit(robot, model, p, fitting, reid, consistent)
+    fitted = fit.corrected(context, chosen, final.x, fitting)  # the effects at the final values
+    tau_corr = fit.correlation_time(fitted, design.weights)
+    described = with_values(described, design, chosen, final, tau_corr, robot)
+    # 5. test: each joint's correction by the model it was given (the effects, the simple model, ...)
+    judged_segments, completed = joints.apply(context, fitted, chosen, final.x, simple, modes, consistent)
+    judged = judge(design, judged_segments, chosen, final, simple)
     # 6. report
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
     selected, superseded = reported(chosen, described, replaced)
+    selection_before = np.sqrt(sel_before).tolist()
+    # findings outside their range: marked suspect
+    selected, apart = findings_check.check(selected, selection_before, model, s, fit_signals)
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}
     result = Diagnosis(
         robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected,
         rms_before=rms["before"], rms_after=rms["after"], rms_effects=rms["effects"], rms_simple=rms["simple"],
-        selection_before=np.sqrt(sel_before).tolist(), selection_after=np.sqrt(sel_effects).tolist(),
+        selection_before=selection_before, selection_after=np.sqrt(sel_effects).tolist(),
         selection_simple=np.sqrt(sel_simple).tolist(),
         simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=simple.values.tolist(),
         peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
-        candidates=[{"candidate": k, "selection_gain": g}
-                    for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
+        candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
         steps=selection.steps, dropped=dropped, refused=refused, superseded=superseded, correlation_samples=tau_corr,
-        segments=segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
+        segments=judged_segments, joint_models=modes, within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(
             robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
         reidentified=reid,
-        conditioning=[{"recording": sig.name, "role": role, "note": sig.note, "trimmed_samples": sig.trim}
+        conditioning=[RecordingNote(sig.name, role, sig.note, sig.trim)
                       for role, group in (("fit", fit_signals), ("select", select_signals or []),
                                           ("test", test or [])) for sig in group])
-    apart = findings_check.check(result, model, s, fit_signals)  # findings outside their range: suspect
     if links_hint:
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)")
-    result.warnings = notes(result, model, s, fit_signals, select_signals or [], test or [], judged.used) + apart
-    return result
+    return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
+                                          judged.used) + apart)

@@ -1,17 +1,98 @@
-"""The diagnosis's result: one record, built by keyword at the end of the pipeline (pipeline.py)."""
+"""The diagnosis's result: the findings as types and one record (Diagnosis), built by keyword
+at the end of the pipeline (pipeline.py). Each type's `as_json()` is its diagnosis.json entry
+(docs/conventions.md, "Diagnosis JSON"); the record and the findings are frozen: a later step
+that changes a finding (findings_check marks it suspect) returns a new one."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 
-@dataclass
+@dataclass(frozen=True)
+class Finding:
+    """One selected effect: what it does on the selection data and the values the fit gave."""
+    effect: str  # Effect.name
+    joints: tuple  # 1-based joints it helps (its own joint for a per-joint effect)
+    variant: dict  # settings not fitted (Effect.fixed: e.g. a velocity scale)
+    values: dict  # parameter -> fitted value, None where the data do not determine it
+    std: dict  # parameter -> standard deviation (scaled for the residual's correlation), or None
+    units: dict  # parameter -> unit
+    derived: dict  # what follows from the values (Effect.derived: tilt angles, payload mass, ...)
+    selection_gain: float  # relative decrease of the selection data's mean square residual
+    rms_before: list  # per joint, selection data, the other selected effects without it
+    rms_after: list  # per joint, selection data, with it
+    suspect: str = ""  # why it is a symptom rather than a cause ("" if it is not)
+
+    def as_json(self) -> dict:
+        out = {"effect": self.effect, "joints": list(self.joints), "variant": self.variant, "values": self.values,
+               "std": self.std, "units": self.units, "derived": self.derived, "selection_gain": self.selection_gain,
+               "rms_before": self.rms_before, "rms_after": self.rms_after}
+        return out | ({"suspect": self.suspect} if self.suspect else {})
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """A selected effect refused once fitted with the others: values not physically possible."""
+    candidate: str  # Candidate.key, or what of it was refused
+    values: list
+    reason: str = ""  # "" when its values alone are impossible
+
+    def as_json(self) -> dict:
+        return {"candidate": self.candidate, "values": self.values} | ({"reason": self.reason} if self.reason else {})
+
+
+@dataclass(frozen=True)
+class CandidateGain:
+    """A candidate tried alone: its selection gain."""
+    candidate: str
+    selection_gain: float
+
+    def as_json(self) -> dict:
+        return {"candidate": self.candidate, "selection_gain": self.selection_gain}
+
+
+@dataclass(frozen=True)
+class RecordingNote:
+    """What conditioning did to one recording, and the role it played."""
+    recording: str
+    role: str  # "fit", "select" or "test"
+    note: str
+    trimmed_samples: int
+
+    def as_json(self) -> dict:
+        return {"recording": self.recording, "role": self.role, "note": self.note,
+                "trimmed_samples": self.trimmed_samples}
+
+
+@dataclass(frozen=True)
+class LinksOff:
+    """The finding "link parameters off": the joints where consistent link parameters,
+    re-identified from the fit data (reidentify.py), beat every effect and the simple model."""
+    joints: list  # 1-based
+    regularisation: float  # toward the given parameters, chosen on selection data
+    selection: list  # per regularisation tried: {"regularisation", "selection_weighted_ms"}
+    link_parameters: list  # per link, the standard parameters
+    friction: dict
+    smoothing: list
+    lambda_min: list
+    at_bounds: list
+    dropped_columns: list
+    fit_rms: list
+
+    def as_json(self) -> dict:
+        return {"joints": self.joints, "regularisation": self.regularisation, "selection": self.selection,
+                "link_parameters": self.link_parameters, "friction": self.friction, "smoothing": self.smoothing,
+                "lambda_min": self.lambda_min, "at_bounds": self.at_bounds, "dropped_columns": self.dropped_columns,
+                "fit_rms": self.fit_rms}
+
+
+@dataclass(frozen=True)
 class Diagnosis:
     robot: str
     joints: int
     split: str  # how selection data were obtained
     judged_on: str  # "test" (recordings used for nothing else) or "selection" (no test data given)
-    selected: list  # per chosen candidate: dict (see docs/conventions.md, diagnosis JSON)
+    selected: list[Finding]
     rms_before: list  # per joint, on the judged data, nominal model
     rms_after: list  # per joint, on the judged data, with the final model (effects; simple model where it won)
     rms_effects: list  # per joint, on the judged data, with the selected effects alone
@@ -25,19 +106,19 @@ class Diagnosis:
     peak_before: list
     noise_rms: list  # per joint estimate of the white part of the final judged residual
     where: list  # per joint: phases of the nominal judged residual (phases.by_phase), with rms_after
-    candidates: list  # every candidate: its selection gain when tried alone
+    candidates: list[CandidateGain]  # every candidate, the best alone first
     steps: list
     dropped: list  # selected forward, then dropped as not significant (correlated residual)
-    refused: list  # selected, then refused: implausible values once fitted with the others
-    superseded: list  # per-joint effects on joints the simple model won
+    refused: list[Refusal]  # selected, then refused: implausible values once fitted with the others
+    superseded: list[Finding]  # per-joint effects on joints the simple model won
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
     warnings: list = field(default_factory=list)
     joint_models: list = field(default_factory=list)
     completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
-    conditioning: list = field(default_factory=list)  # per recording: what was done to it
+    conditioning: list[RecordingNote] = field(default_factory=list)
     segments: list = field(default_factory=list)  # roles.Segment, for figures
     # per joint on the judged data at the joint velocities the fit data covered: share of samples
     # beyond them, RMS of the final and of the simple model there (velocity laws extrapolate beyond)
     within_fit_speeds: dict = field(default_factory=dict)
-    consistent: dict | None = None  # "link parameters off": reidentify.finding, where the consistent model won
+    consistent: LinksOff | None = None  # "link parameters off", where the consistent model won
     reidentified: object = None  # its identification.consistent.Consistent (for the written parameters)

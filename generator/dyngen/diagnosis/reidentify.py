@@ -33,6 +33,8 @@ import dataclasses
 
 import numpy as np
 
+from .record import LinksOff
+
 RATE = 200.0  # Hz: samples used by the re-identification (the motion's band is far below)
 GATE_RATE = 50.0  # Hz: samples used by the gate (a rough test; 0.1 s for 30 s of data)
 # regularisation toward the diagnosed parameters, chosen on selection data; 0 included: the
@@ -114,19 +116,15 @@ def corrections(result, model, segments) -> list:
     return [result.predict(model, seg.signals) - seg.tau_model for seg in segments]
 
 
-def finding(robot, result, joints: list) -> dict:
-    """The report's entry: joints where the consistent parameters won, and the parameters."""
+def finding(robot, result, joints: list) -> LinksOff:
+    """The finding: joints where the consistent parameters won, and the parameters."""
     from ..parameters import PER_LINK
 
     links = np.asarray(result.p).reshape(-1, PER_LINK)
     f = {k: [None if not np.isfinite(x) else float(x) for x in np.atleast_1d(v)] for k, v in result.friction.items()}
-    return {
-        "joints": [j + 1 for j in joints],
-        "regularisation": result.regularisation,
-        "selection": [{"regularisation": a, "selection_weighted_ms": b} for a, b in result.selection],
-        "link_parameters": [row.tolist() for row in links],
-        "friction": f, "smoothing": result.smoothing.tolist(),
-        "lambda_min": result.lambda_min.tolist(), "at_bounds": list(result.at_bounds),
-        "dropped_columns": list(result.dropped_columns),
-        "fit_rms": result.residual_rms.tolist(),
-    }
+    return LinksOff(
+        joints=[j + 1 for j in joints], regularisation=result.regularisation,
+        selection=[{"regularisation": a, "selection_weighted_ms": b} for a, b in result.selection],
+        link_parameters=[row.tolist() for row in links], friction=f, smoothing=result.smoothing.tolist(),
+        lambda_min=result.lambda_min.tolist(), at_bounds=list(result.at_bounds),
+        dropped_columns=list(result.dropped_columns), fit_rms=result.residual_rms.tolist())

@@ -4,6 +4,7 @@ docs/conventions.md, "Diagnosis JSON")."""
 from __future__ import annotations
 
 import json
+from dataclasses import is_dataclass
 
 import numpy as np
 
@@ -31,6 +32,8 @@ def to_json(d, sources: dict) -> str:
 
 
 def _plain(x):
+    if is_dataclass(x):  # the findings' types (record.py): their diagnosis.json entries
+        return _plain(x.as_json())
     if isinstance(x, dict):
         return {k: _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
@@ -44,22 +47,22 @@ def _plain(x):
 
 def _value_text(e) -> str:
     parts = []
-    for name, value in e["values"].items():
-        unit = e["units"][name]
+    for name, value in e.values.items():
+        unit = e.units[name]
         if value is None:
             parts.append(f"{name} not identifiable")
         else:
-            parts.append(f"{name} = {value:.4g} +- {e['std'][name]:.2g} {unit}")
+            parts.append(f"{name} = {value:.4g} +- {e.std[name]:.2g} {unit}")
     text = ", ".join(parts)
     if len(parts) > 4:  # the coefficient errors, the payload, the ripple: the largest ones only
-        shown = sorted(((abs(v / e["std"][n]) if e["std"][n] else 0, n) for n, v in e["values"].items()
+        shown = sorted(((abs(v / e.std[n]) if e.std[n] else 0, n) for n, v in e.values.items()
                         if v is not None), reverse=True)[:3]
         text = f"{len(parts)} values; most significant: " + ", ".join(
-            f"{n} = {e['values'][n]:.3g} +- {e['std'][n]:.2g}" for _, n in shown)
-    for key, value in e.get("variant", {}).items():
+            f"{n} = {e.values[n]:.3g} +- {e.std[n]:.2g}" for _, n in shown)
+    for key, value in e.variant.items():
         shown = f"({', '.join(f'{x:.3g}' for x in value)})" if isinstance(value, (list, tuple)) else f"{value:.3g}"
         text += f" (at {key} = {shown})"
-    derived = e.get("derived") or {}
+    derived = e.derived
     if "tilt_deg" in derived:
         (a1, a2), (s1, s2), (u1, u2) = derived["tilt_deg"], derived["tilt_std_deg"], derived["tilt_towards"]
         text += f" (gravity turned {a1:.2f} +- {s1:.2f} deg towards {u1} and {a2:.2f} +- {s2:.2f} deg towards {u2})"
@@ -76,7 +79,7 @@ def _value_text(e) -> str:
     if "mass_kg" in derived:
         com = ", ".join("?" if c is None else f"{c:.3g}" for c in derived["com_m"])
         text += f" (payload mass {derived['mass_kg']:.3g} kg, centre of mass ({com}) m in the last link's frame)"
-    if e.get("suspect"):
+    if e.suspect:
         text += " **suspect**"
     return text
 
@@ -94,7 +97,7 @@ def markdown(d, sources: dict) -> str:
              f"Model parameters: {sources.get('params')}. Fit on: {', '.join(sources.get('fit', []))}. "
              f"Selection: {', '.join(sources.get('select') or []) or d.split}. "
              f"Test (held out, used for nothing else): {', '.join(sources.get('test') or []) or 'none'}.", ""]
-    lines += ["Conditioning:", ""] + [f"- {c['recording']} ({c['role']}): {c['note']}; {c['trimmed_samples']} samples "
+    lines += ["Conditioning:", ""] + [f"- {c.recording} ({c.role}): {c.note}; {c.trimmed_samples} samples "
                                       "trimmed at each end" for c in d.conditioning] + [""]
     if d.warnings:
         lines += ["## Warnings", ""] + [f"- {w}" for w in d.warnings] + [""]
@@ -141,16 +144,16 @@ def markdown(d, sources: dict) -> str:
         lines += ["| effect | joints | fitted values (+- std) | selection gain | selection RMS without -> with, "
                   "on its joints |", "|---|---|---|---:|---|"]
         for e in d.selected:
-            joints = ", ".join(map(str, e["joints"])) or "-"
-            change = ", ".join(f"J{j}: {e['rms_before'][j - 1]:.3f} -> {e['rms_after'][j - 1]:.3f}" for j in e["joints"])
-            lines.append(f"| {e['effect']} | {joints} | {_value_text(e)} | {e['selection_gain']:.3f} | {change} |")
+            joints = ", ".join(map(str, e.joints)) or "-"
+            change = ", ".join(f"J{j}: {e.rms_before[j - 1]:.3f} -> {e.rms_after[j - 1]:.3f}" for j in e.joints)
+            lines.append(f"| {e.effect} | {joints} | {_value_text(e)} | {e.selection_gain:.3f} | {change} |")
         lines += ["", "Selection gain: the decrease of the selection data's mean square residual relative to its value "
                   "without this effect (all other selected effects kept), on its joint (per-joint effects) or summed "
                   "over joints (arm-wide effects). Standard deviations "
                   f"are scaled for the residual's correlation in time ({d.correlation_samples:.0f} samples).", ""]
     if d.superseded:
         lines += ["Not kept (the simple model did better on these joints' selection data): "
-                  + ", ".join(f"{e['effect']} on joint {e['joints'][0]}" for e in d.superseded) + ".", ""]
+                  + ", ".join(f"{e.effect} on joint {e.joints[0]}" for e in d.superseded) + ".", ""]
     tied = [j + 1 for j, m in enumerate(d.joint_models) if m == TIED]
     if tied:
         lines += [f"On joint(s) {', '.join(map(str, tied))} the simple model predicts the torque: on the selection "
@@ -158,18 +161,18 @@ def markdown(d, sources: dict) -> str:
                   "stay findings; the data cannot tell the two apart, and beyond the fit data they may "
                   "extrapolate differently.", ""]
     if d.refused:
-        lines += ["Refused as physically impossible once fitted: " + ", ".join(r["candidate"] for r in d.refused)
+        lines += ["Refused as physically impossible once fitted: " + ", ".join(r.candidate for r in d.refused)
                   + ".", ""]
     if d.dropped:
         lines += [f"Selected at first, then dropped as not significant: {', '.join(d.dropped)}.", ""]
     if d.consistent:
         c = d.consistent
         lines += ["## Link parameters off", "",
-                  f"On joint(s) {', '.join(map(str, c['joints']))}, physically consistent link parameters "
+                  f"On joint(s) {', '.join(map(str, c.joints))}, physically consistent link parameters "
                   "re-identified from the fit data (every link's pseudo-inertia positive definite; with per-joint "
                   "Coulomb, viscous, offset, rotor inertia, position ripple and a tilted base; regularised toward the "
-                  f"given parameters with weight {c['regularisation']:g}, chosen on selection data from "
-                  + ", ".join(f"{s['regularisation']:g}" for s in c["selection"])
+                  f"given parameters with weight {c.regularisation:g}, chosen on selection data from "
+                  + ", ".join(f"{s['regularisation']:g}" for s in c.selection)
                   + ") did better than every effect and the simple model on selection data, and are used there. "
                   "The parameters are in consistent/identified.yaml (URDF and MJCF beside it).", ""]
         if d.reidentified is not None:
@@ -180,7 +183,7 @@ def markdown(d, sources: dict) -> str:
             lines += ["```"] + consistent_summary(SimpleNamespace(name=d.robot, dof=d.joints), d.reidentified) \
                 + ["```", ""]
     lines += ["## Candidates tried alone (selection gain; Stribeck beside its Coulomb term)", "",
-              ", ".join(f"{c['candidate']} {c['selection_gain']:+.3f}" for c in d.candidates[:15]), ""]
+              ", ".join(f"{c.candidate} {c.selection_gain:+.3f}" for c in d.candidates[:15]), ""]
     return "\n".join(lines)
 
 
@@ -216,10 +219,10 @@ def summary_lines(d) -> list[str]:
     if not d.selected:
         out.append("  no significant unmodelled effect")
     for e in d.selected:
-        joints = ",".join(map(str, e["joints"])) or "-"
-        out.append(f"  {e['effect']:<12} joints {joints:<14} gain {e['selection_gain']:.3f}  {_value_text(e)}")
+        joints = ",".join(map(str, e.joints)) or "-"
+        out.append(f"  {e.effect:<12} joints {joints:<14} gain {e.selection_gain:.3f}  {_value_text(e)}")
     if d.consistent:
         out.append(f"  link parameters off: consistent re-identified parameters used on joint(s) "
-                   f"{', '.join(map(str, d.consistent['joints']))} (consistent/identified.yaml)")
+                   f"{', '.join(map(str, d.consistent.joints))} (consistent/identified.yaml)")
     out += [f"  warning: {w}" for w in d.warnings]
     return out

@@ -27,9 +27,10 @@ from ..catalogue import RNEA
 REPEATED_SHARE = 0.02  # RMS position difference below this share of the motion's range: same trajectory
 
 
-@dataclass
+@dataclass(frozen=True)
 class Segment:
-    """One recording with the model's torques, its residual and its samples' roles."""
+    """One recording with the model's torques, its residual and its samples' roles. Frozen: a
+    stage that changes the roles or the correction returns new segments (dataclasses.replace)."""
 
     signals: object
     tau_model: np.ndarray
@@ -44,11 +45,11 @@ class Segment:
 def segments(model, s, fit_signals, select_signals, test_signals, block_seconds: float) -> tuple[list, str]:
     out = []
 
-    def segment(sig, fit, select, test):
+    def segment(sig, fit, select, test, groups=None):
         # The filtered motion's torque is the filtered torque's model (filtering it again
         # would smooth twice what the recording smoothed once).
         tau_model = model.batch(RNEA.name, sig.q, sig.qd, sig.qdd, s)
-        return Segment(sig, tau_model, sig.tau - tau_model, fit, select, test)
+        return Segment(sig, tau_model, sig.tau - tau_model, fit, select, test, groups=groups)
 
     none = lambda sig: np.zeros(sig.t.size, dtype=bool)  # noqa: E731
     if select_signals:
@@ -60,8 +61,7 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
     else:
         for sig in fit_signals:
             fit, select = blocks(sig, block_seconds)
-            out.append(segment(sig, fit, select, none(sig)))
-            out[-1].groups = [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]
+            out.append(segment(sig, fit, select, none(sig), [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]))
         split = f"selection on blocks of {block_seconds:g} s of the fit data (each third of them in turn)"
     for sig in test_signals or []:
         out.append(segment(sig, none(sig), none(sig), sig.inner()))

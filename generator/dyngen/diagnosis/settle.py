@@ -5,6 +5,7 @@ impossible ones simplified (a payload whose inertia is no body's)."""
 from __future__ import annotations
 
 from . import moments as dz
+from .record import Refusal
 from .refine import refine, restricted
 from .selection import bases, prune, selection_mse, solve, without
 
@@ -58,10 +59,9 @@ def _plausible(design, chosen):
         if not bad:
             return chosen, final, refused
         worst = bad[0]
-        refused.append({"candidate": worst.key, "values": values[id(worst)].tolist()}
-                       | ({"reason": reasons[id(worst)]} if reasons[id(worst)] else {}))
+        refused.append(Refusal(worst.key, values[id(worst)].tolist(), reasons[id(worst)]))
         chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
-        refused += [{"candidate": c.key, "values": [], "reason": f"{worst.key} refused"} for c in gone[1:]]
+        refused += [Refusal(c.key, [], f"{worst.key} refused") for c in gone[1:]]
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):

@@ -32,7 +32,7 @@ from scipy.optimize import minimize
 
 from ..errors import InputError
 from ..options import option
-from ..terms import Armature, Coulomb, Offset, RigidBody, Viscous
+from ..terms import RigidBody, joint_columns
 from ..terms.body import armature_identifiable
 from ..terms.friction import EXCITATION_SCALE
 from ..validation.excitation import FourierTrajectory
@@ -163,19 +163,16 @@ def _inside(points, box) -> np.ndarray:
 
 def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, armature=None) -> np.ndarray:
     """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major:
-    the terms' columns (terms/), each on its own joint's rows."""
+    identify's default columns (terms.joint_columns), each on its own joint's rows."""
     T, n = q.shape
     Y = RigidBody.columns(model, q, qd, qdd).reshape(T * n, -1)
-    per_joint = {"coulomb": lambda j: Coulomb.columns(qd[:, j], coulomb_velocity)[:, 0],
-                 "viscous": lambda j: Viscous.columns(qd[:, j])[:, 0], "offset": lambda j: Offset.columns((T,))[:, 0],
-                 "armature": lambda j: Armature.columns(qdd[:, j])[:, 0]}
     cols = []
     for j in range(n):
-        for kind, column in per_joint.items():
+        for kind in joint_columns.DEFAULT_KINDS:
             if kind == "armature" and not (armature and armature[j]):
                 continue
             col = np.zeros((T, n))
-            col[:, j] = column(j)
+            col[:, j] = joint_columns.column(kind, q[:, j], qd[:, j], qdd[:, j], coulomb_velocity)
             cols.append(col.reshape(-1))
     return np.hstack([Y, np.column_stack(cols)])
 

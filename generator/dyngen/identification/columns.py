@@ -24,12 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from .. import terms
+from ..terms import joint_columns
 from ..terms.friction import coulomb
+from ..terms.joint_columns import TERM_OF
 
-PER_JOINT = ("coulomb", "viscous", "offset", "armature", "ripple_cos", "ripple_sin")
-TERM_OF = {"coulomb": terms.Coulomb, "viscous": terms.Viscous, "offset": terms.Offset, "armature": terms.Armature,
-           "ripple_cos": terms.Ripple, "ripple_sin": terms.Ripple}  # each kind's term (terms/)
+PER_JOINT = tuple(TERM_OF)
 GROUPS = {"ripple": ("ripple_cos", "ripple_sin"), "tilt": ("tilt",)}  # optional groups and their kinds
 # kinds whose value is held >= 0 (see consistent.py): the terms whose range is the positive values
 BOUNDED = tuple(k for k in PER_JOINT if TERM_OF[k].values[0].low == 0.0)
@@ -86,18 +85,11 @@ def coulomb_matrix(signals, smoothing, lags) -> np.ndarray:
 
 
 def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
-    """(T,): the column of (kind, j) in joint j's rows (coulomb: from coulomb_matrix)."""
+    """(T,): the column of (kind, j) in joint j's rows (coulomb: from coulomb_matrix, filtered
+    and lagged; the others as terms.joint_columns has them)."""
     if kind == "coulomb":
         return coulomb[:, j]
-    if kind == "viscous":
-        return signals.qd[:, j]
-    if kind == "offset":
-        return np.ones(len(signals.t))
-    if kind == "armature":
-        return signals.qdd[:, j]
-    if kind in ("ripple_cos", "ripple_sin"):  # the first harmonic, over every position
-        return terms.Ripple.harmonic(signals.q[:, j], 1, kind[-3:])
-    raise ValueError(kind)
+    return joint_columns.column(kind, signals.q[:, j], signals.qd[:, j], signals.qdd[:, j])
 
 
 @dataclass

@@ -11,6 +11,7 @@ from ..arguments import real
 from ..description.extraction_options import Options as ExtractOptions
 from ..options import option
 from ..terms.friction import SCALE_GRID
+from ..terms.joint_columns import DEFAULT_KINDS
 
 KINDS = ("full", "gravity", "inertia")
 
@@ -22,7 +23,6 @@ class Options:
     consistent: bool = option(False, "the consistent identification (the default for --kind full; kept for scripts)")
 
 
-DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")
 CHOICES = ("coulomb", "viscous", "offset", "armature", "ripple")  # what options.friction may name
 CANDIDATES = ("ripple", "tilt", "falling")  # optional groups, decided on held-out data
 BOUNDS = ("viscous", "dissipative")

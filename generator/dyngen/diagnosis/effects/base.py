@@ -46,7 +46,7 @@ class Effect:
     What the diagnosis needs to know of an effect lives here, as attributes and methods with
     plain defaults: an effect says what it needs (a context-built effect is made by `of`), what
     follows from its values (`derived`), what the updated model takes from it (`friction_terms`,
-    `simulator`, `last_link`, read from a report entry: classmethods) and when it is reported
+    `simulator`, `last_link`, read from a finding (record.Finding): classmethods) and when it is reported
     with a warning (`suspect`, `warnings`)."""
 
     term = None  # the terms.Term it is: its name, scope, parameters, units and physical range
@@ -151,8 +151,8 @@ class Effect:
         return {}
 
     @classmethod
-    def warnings(cls, entry: dict) -> list[str]:
-        """Warnings on a selected effect's report entry (diagnosis.json's `selected`)."""
+    def warnings(cls, finding) -> list[str]:
+        """Warnings on a selected effect's finding (record.Finding)."""
         return []
 
     @classmethod
@@ -162,7 +162,7 @@ class Effect:
 
     @classmethod
     def last_link(cls, values: dict, variant: dict | None = None) -> np.ndarray | None:
-        """Standard parameters this effect adds to the last link (a payload; its report entry's
+        """Standard parameters this effect adds to the last link (a payload; its finding's
         values and variant); else None."""
         return None
 

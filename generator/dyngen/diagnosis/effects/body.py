@@ -13,6 +13,7 @@ import numpy as np
 
 from ... import terms
 from ...parameters import PER_LINK
+from ..record import Refusal
 from .base import Effect
 
 
@@ -57,10 +58,9 @@ class Payload(Effect):
         encoder none), so the selection data choose."""
         if consistent_inertia(values):
             return None
-        refusal = {"candidate": "the payload's inertia about its centre of mass (not a body's; the payload keeps its "
-                                "fitted centre, with the nearest body's inertia per kg or none, whichever does "
-                                "better on selection data)",
-                   "values": values[4:].tolist()}
+        refusal = Refusal("the payload's inertia about its centre of mass (not a body's; the payload keeps its "
+                          "fitted centre, with the nearest body's inertia per kg or none, whichever does better on "
+                          "selection data)", values[4:].tolist())
         m, c = values[0], values[1:4] / values[0]
         nearest = nearest_body_inertia(_matrix(values[4:10]) - m * _point(c))
         return refusal, [FixedShapePayload(c, J, self.max_mass, values[:4]) for J in (nearest / m, np.zeros((3, 3)))]

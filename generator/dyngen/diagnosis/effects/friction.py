@@ -97,11 +97,11 @@ class Ripple(Effect):
                 "separable": bool(sum(amplitudes) <= RIPPLE_SEPARABLE * np.sqrt(2) * rms)}
 
     @classmethod
-    def warnings(cls, entry):
-        d = entry["derived"]
+    def warnings(cls, finding):
+        d = finding.derived
         if d.get("separable", True):
             return []
-        return [f"ripple on joint {entry['joints'][0]}: its harmonics are not separable over the positions the fit "
+        return [f"ripple on joint {finding.joints[0]}: its harmonics are not separable over the positions the fit "
                 f"data cover (amplitudes {', '.join(f'{a:.3g}' for a in d['amplitude_Nm'])} Nm for "
                 f"a torque of {d['torque_rms_Nm']:.3g} Nm RMS): only their sum is a finding"]
 
