@@ -51,7 +51,10 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="only the gap of every --data recording and the simple model, per recording and pooled, "
                              "and which recordings stand out; each recording read in blocks, on all cores "
                              "(recordings.md, recordings.json)")
-    add_arguments(parser.add_argument_group("diagnosis"), Options)
+    group = parser.add_argument_group("diagnosis")
+    add_arguments(group, Options)
+    group.add_argument("--no-reidentify", dest="reidentify", action="store_const", const=False,
+                       default=argparse.SUPPRESS, help="never re-identify the link parameters (see --reidentify)")
     return parser
 
 

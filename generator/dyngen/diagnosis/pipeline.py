@@ -87,11 +87,15 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     reid, consistent = None, None
     # Without the re-identification its cheap gate still says where the rigid body's columns
     # explain what the effects leave: the link parameters may be off there.
-    links_hint = []
-    if not options.reidentify and design.select.count:
+    links_hint, excitation = [], None
+    run_reid = options.reidentify
+    if run_reid is None and design.select.count:  # by default where the fit data excite the link parameters
+        excitation = reidentify.excitation(model, selecting)
+        run_reid = excitation <= reidentify.EXCITED
+    if not run_reid and design.select.count:
         links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                      options.min_gain)
-    if options.reidentify and design.select.count:
+    if run_reid and design.select.count:
         reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
                                                       modes, options.min_gain)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
@@ -142,6 +146,9 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
-                     "parameters as an alternative (or identify them first: dyngen identify)")
+                     "parameters as an alternative (or identify them first: dyngen identify)"
+                     + ("" if excitation is None else f"; not tried by default: the fit data excite the link parameters "
+                        f"weakly (condition number {excitation:.3g} of their scaled columns, above "
+                        f"{reidentify.EXCITED:g})"))
     return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
                                           judged.used) + apart)
