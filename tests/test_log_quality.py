@@ -199,3 +199,21 @@ def test_a_franka_like_log_with_recorded_velocities(arm, exact, tmp_path):
     assert r["problems"] == [], "\n".join(r["problems"])
     assert all(c is not None and c < 20 for c in r["cutoff"])
     assert _below_the_torques(r, out, doc["cases"][0], arm)
+
+
+@pytest.fixture(scope="module")
+def composed(tmp_path_factory):
+    out = tmp_path_factory.mktemp("log1k_composed") / "clean"
+    case = next(c for c in CASES if c.name == "gain_viscous")
+    return out, write_cases(out, rate_hz=1000.0, cases=[case], encoder=Encoder())
+
+
+@pytest.mark.parametrize("name", ["polled", "repeated"])
+def test_a_sensor_gain_beside_friction_fitted_on_table_v_from_a_logger(arm, composed, tmp_path, name):
+    """A second case of bench/bench_log_pathologies.py, the other direction: a 5 % gain on joint 2
+    beside viscous friction on joint 6, fitted on Table V and tested on the Fourier excitation."""
+    folder, doc = _variant(*composed, name, tmp_path / name)
+    r = run(*arm, folder, doc, "gain_viscous", "backward")
+    assert r["problems"] == [], "\n".join(r["problems"])
+    sig = condition(read_recording(folder / doc["cases"][0]["fit"], arm[0].dof))
+    assert log_variants.below_the_torques(r["before"], sig)
