@@ -58,13 +58,15 @@ def test_injected_offsets_are_not_flagged():
 def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
     """The LWR in MuJoCo with link 3's mass, first moments and inertia 10 % above the model's
     (tests/simulation/withheld_cases.py, 200 Hz, 20-bit encoder positions, 0.05 Nm torque noise),
-    once without and once with the 1.5 kg payload. With default options both runs warn that the
-    link parameters may be off (the re-identification's gate); with --reidentify the payload is
-    found only where it is (within 5 %), and both runs say that the link parameters are off
-    instead of naming friction or ripple for them."""
-    import sys
+    once without and once with the 1.5 kg payload. With default options (the Fourier excitation
+    excites the link parameters, so the re-identification runs) the payload is found only where
+    it is (within 5 %), and both runs say that the link parameters are off instead of naming
+    a gain, friction or ripple for them; with --no-reidentify both warn that the link
+    parameters may be off (the re-identification's gate), and compared with the unloaded run as
+    its control (diagnosis/across.py, `dyngen diagnose --control`) every finding of the loaded
+    run that the unloaded run has too is reported as the model's error, the payload not."""
+    from dyngen.diagnosis.across import DIFFERS, compared
 
-    sys.path.insert(0, str(ROOT / "bench"))
     from simulation.mujoco_measurements import Effects, Encoder
     from simulation.withheld_cases import PAYLOAD, Case, case_files, nominal_model, trajectories
 
@@ -73,14 +75,15 @@ def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
     p_true = p_model.copy()
     p_true[20:30] *= 1.10
     trajs = trajectories(robot, 200.0)
-    found = {}
+    found, plain_runs = {}, {}
     for k, case in enumerate([Case("unloaded"), Case("loaded", Effects(payload=PAYLOAD))]):
         for name, text in case_files(case, k, robot, p_true, trajs, 0.05, 0, Encoder()).items():
             (tmp_path / name).write_text(text)
         fit, test = (condition(read_recording(tmp_path / f"{case.name}.{r}.csv", 7)) for r in ("fit", "holdout"))
-        plain = diagnose(robot, model, p_model, [fit], None, test=[test])
+        plain = diagnose(robot, model, p_model, [fit], None, Options(reidentify=False), test=[test])
         assert any(w.startswith("the link parameters may be off") for w in plain.warnings), case.name
-        d = diagnose(robot, model, p_model, [fit], None, Options(reidentify=True), test=[test])
+        plain_runs[case.name] = plain
+        d = diagnose(robot, model, p_model, [fit], None, test=[test])
         found[case.name] = d
         assert d.consistent and {2, 3} <= set(d.consistent.joints), case.name
         assert any(w.startswith("link parameters off") for w in d.warnings)
@@ -89,3 +92,14 @@ def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
     assert not any(e.effect == "payload" for e in found["unloaded"].selected)
     payload = next(e for e in found["loaded"].selected if e.effect == "payload")
     assert abs(payload.values["m"] - 1.5) < 0.075
+    loaded = compared(plain_runs["loaded"], plain_runs["unloaded"], "unloaded.fit.csv")
+    shared = {(e.effect, e.joints) for e in plain_runs["unloaded"].selected}
+    for e in loaded.selected:  # the unloaded run has no gain, payload or gravity scale here
+        assert ("also found in the control run" in e.suspect) == (e.effect in DIFFERS and (e.effect, e.joints) in shared)
+    assert any(e.effect == "payload" and not e.suspect for e in loaded.selected)
+    # a control run that carries the same payload and gravity scale (the loaded run itself): they
+    # are the model's error; the friction and ripple the arm has in both runs are not
+    same = compared(plain_runs["loaded"], plain_runs["loaded"], "loaded.fit.csv")
+    assert {e.effect for e in same.selected if e.suspect.startswith("also found")} == \
+        {e.effect for e in plain_runs["loaded"].selected} & set(DIFFERS) >= {"payload"}
+    assert any(w.startswith("found also in the control run loaded.fit.csv") for w in same.warnings)

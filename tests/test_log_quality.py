@@ -22,7 +22,7 @@ import sys
 import numpy as np
 import pytest
 from conftest import ROOT
-from simulation import logger
+from simulation import log_variants, logger
 from simulation.mujoco_measurements import Encoder
 from simulation.withheld_cases import CASES, nominal_model, write_cases
 from simulation.withheld_run import run
@@ -35,23 +35,10 @@ from dyngen.runtime import load
 
 LWR = ROOT / "examples" / "lwr.yaml"
 CASE = next(c for c in CASES if c.name == "coulomb")
-PATHOLOGIES = {
-    "repeated": lambda text, seed: logger.repeated(text, 0.055, seed),
-    "polled": lambda text, seed: logger.polled(text, seed),
-    "dropped": lambda text, seed: logger.dropped(text, 0.05, seed),
-    "jittered": lambda text, seed: logger.jittered(text, 0.4e-3, seed),
-    "held": lambda text, seed: logger.held(text, "tau", 10),
-}
 
 
 def _variant(folder, doc, name, out):
-    out.mkdir(exist_ok=True)
-    for f in folder.iterdir():
-        if f.suffix == ".csv":
-            (out / f.name).write_text(PATHOLOGIES[name](f.read_text(), len(f.name)))
-        else:
-            shutil.copy(f, out / f.name)
-    return out, doc
+    return log_variants.variant(folder, name, out), doc
 
 
 @pytest.fixture(scope="module")
@@ -72,16 +59,10 @@ def slow(tmp_path_factory):
 
 
 def _below_the_torques(r, folder, entry, arm) -> bool:
-    """The nominal test residual at most the measured torque (RMS) on every joint carrying torque
-    (5 % of the largest; joint 7 carries 0.01 Nm); a joint whose torque is all friction, which
-    the nominal model lacks, has a residual as large as its torque."""
-    sig = condition(read_recording(folder / entry["holdout"], arm[0].dof))
-    torque = np.sqrt(np.mean(sig.tau[sig.inner()] ** 2, axis=0))
-    judged = torque > 0.05 * torque.max()
-    return bool(np.all(np.array(r["before"])[judged] <= 1.02 * torque[judged]))
+    return log_variants.below_the_torques(r["before"], condition(read_recording(folder / entry["holdout"], arm[0].dof)))
 
 
-@pytest.mark.parametrize("name", ["clean", *PATHOLOGIES])
+@pytest.mark.parametrize("name", ["clean", *log_variants.PATHOLOGIES])
 def test_a_1khz_log_as_loggers_write_it_gives_the_clean_result(arm, khz, tmp_path, name):
     folder, doc = khz if name == "clean" else _variant(*khz, name, tmp_path / name)
     r = run(*arm, folder, doc, CASE.name, "forward")
@@ -218,3 +199,21 @@ def test_a_franka_like_log_with_recorded_velocities(arm, exact, tmp_path):
     assert r["problems"] == [], "\n".join(r["problems"])
     assert all(c is not None and c < 20 for c in r["cutoff"])
     assert _below_the_torques(r, out, doc["cases"][0], arm)
+
+
+@pytest.fixture(scope="module")
+def composed(tmp_path_factory):
+    out = tmp_path_factory.mktemp("log1k_composed") / "clean"
+    case = next(c for c in CASES if c.name == "gain_viscous")
+    return out, write_cases(out, rate_hz=1000.0, cases=[case], encoder=Encoder())
+
+
+@pytest.mark.parametrize("name", ["polled", "repeated"])
+def test_a_sensor_gain_beside_friction_fitted_on_table_v_from_a_logger(arm, composed, tmp_path, name):
+    """A second case of bench/bench_log_pathologies.py, the other direction: a 5 % gain on joint 2
+    beside viscous friction on joint 6, fitted on Table V and tested on the Fourier excitation."""
+    folder, doc = _variant(*composed, name, tmp_path / name)
+    r = run(*arm, folder, doc, "gain_viscous", "backward")
+    assert r["problems"] == [], "\n".join(r["problems"])
+    sig = condition(read_recording(folder / doc["cases"][0]["fit"], arm[0].dof))
+    assert log_variants.below_the_torques(r["before"], sig)

@@ -42,6 +42,10 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="recording(s) used for nothing but the reported held-out residual; best a different "
                              "trajectory (default: none, and the report says that nothing was held out)")
     parser.add_argument("--holdout", action="append", metavar="CSV", help="the same as --test")
+    parser.add_argument("--control", action="append", metavar="CSV",
+                        help="a control run of the same arm without what is looked for (e.g. unloaded beside a loaded "
+                             "--data run): diagnosed apart with the same options; a finding also found there is "
+                             "reported as the nominal model's error (diagnosis/across.py)")
     parser.add_argument("--split", metavar="F,S,T",
                         help="cut every --data recording in time into fit, select and test pieces of these "
                              "fractions (e.g. 0.6,0.2,0.2), each conditioned on its own")
@@ -57,7 +61,10 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
                         help="a --data recording of more samples is diagnosed on evenly spread 6-s windows of at most "
                              "N samples in all, its gap and simple model reported over every sample (read in blocks: "
                              f"memory independent of its length; default {MAX_ROWS})")
-    add_arguments(parser.add_argument_group("diagnosis"), Options)
+    group = parser.add_argument_group("diagnosis")
+    add_arguments(group, Options)
+    group.add_argument("--no-reidentify", dest="reidentify", action="store_const", const=False,
+                       default=argparse.SUPPRESS, help="never re-identify the link parameters (see --reidentify)")
     return parser
 
 
@@ -91,7 +98,8 @@ def main(argv, prog="dyngen diagnose") -> int:
     out = Path(args.out) if args.out else Path("out") / robot.name / "diagnosis"
     from ..output_paths import check_folder, results_folder, shown
 
-    check_folder(out, [args.robot, args.params, *args.data, *(args.select or []), *tests, args.model], args.force)
+    check_folder(out, [args.robot, args.params, *args.data, *(args.select or []), *tests, *(args.control or []),
+                       args.model], args.force)
     # bad input fails before anything is announced or written
     if args.split:
         if args.select or tests:
@@ -141,6 +149,16 @@ def main(argv, prog="dyngen diagnose") -> int:
         if not args.quiet:
             print(f"  written: {', '.join(str(v) for v in paths.values())}")
         return EXIT_UNUSABLE
+    for path in args.control or []:  # findings also found in a control run: the model's error
+        from ..diagnosis.across import compared
+
+        control = read_all([path], robot, args)
+        check_enough(Path(path).name, control[0].t)
+        try:
+            with progress.step(f"control run {control[0].name}"):
+                result = compared(result, diagnose(robot, model, p, control, None, options), control[0].name)
+        except Unusable as err:
+            result = replace(result, warnings=[*result.warnings, f"control run {control[0].name}: {err.line}"])
     with progress.step("report, JSON, figures, updated model"):
         with results_folder(out) as staging:  # the folder is written as one unit
             paths = write_outputs(result, robot, p, staging, sources, options.sign_velocity)

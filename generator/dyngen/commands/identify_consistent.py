@@ -35,7 +35,7 @@ def run_consistent(args, robot, model, signals, progress) -> int:
 
     prior = options.prior if options.prior is not None else (
         np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
-    sanity, sanity_table = check(robot, model, result, signals, select, prior)
+    sanity, sanity_table, result = check(robot, model, result, signals, select, prior)
     # ---
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
     sources = [s.name for s in signals]  # printable: data/recording.py

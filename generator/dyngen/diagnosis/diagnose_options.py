@@ -23,7 +23,8 @@ class Options:
                                   "V in rad/s (Coulomb's own scale is fitted)", metavar="V", bounds=(0.0, 1e3),
                                   above=True)
     block_seconds: float = 2.0  # without selection recordings: blocks of this length, each third selects in turn
-    reidentify: bool = option(False, "also re-identify physically consistent link parameters (with friction and a "
-                              "tilted base) from the fit data, and use them on the joints where they beat every "
-                              "effect and the simple model on selection data; says 'link parameters off' and writes "
-                              "them to consistent/ (experimental: see README)")
+    reidentify: bool | None = option(
+        None, "always re-identify physically consistent link parameters (with friction and a tilted base) from the fit "
+        "data, and use them on the joints where they beat every effect and the simple model on selection data; says "
+        "'link parameters off' and writes them to consistent/. By default this is done where the fit data excite the "
+        "link parameters (diagnosis/reidentify.py EXCITED); --no-reidentify never", const=True)

@@ -5,8 +5,11 @@ A per-joint effect explains part of its joint's nominal residual. A constant or 
 larger than that whole residual (its RMS on the selection data) is not a finding about the
 robot: it is making up for another term of the same joint (on the real LWR4+, joint 6 once got
 a +1.90 Nm offset beside a 2.31 Nm ripple where the whole nominal residual is 0.645 Nm). A
-rotor inertia more than ROTOR_RATIO times the arm's own inertia about the joint (the median of
-M_jj over the fit data) is outside its physical range. Such entries are marked `suspect` (the
+rotor inertia is outside its physical range when its torque (Ia qdd_j, RMS over the fit data)
+is larger than LARGER x that whole residual, as for the offset, or when it is more than
+ROTOR_RATIO times the arm's own inertia about the joint (the median of M_jj over the fit data):
+a reflected rotor inertia (gear ratio squared times the rotor's) may well be ten times a wrist
+link's own inertia (identification/sanity.py uses the same two rules). Such entries are marked `suspect` (the
 report prints them so, and the terminal and report.md carry the reason as a warning), and where
 two terms of one joint are both too large a warning says that the data cannot tell them apart.
 
@@ -21,7 +24,7 @@ from dataclasses import replace
 import numpy as np
 
 LARGER = 1.5  # a term whose torque exceeds this many times its joint's whole nominal residual (RMS)
-ROTOR_RATIO = 10.0
+ROTOR_RATIO = 100.0
 
 
 def _size(e) -> float | None:
@@ -54,9 +57,13 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
             if inertia is None:
                 inertia = _inertia_about_joints(model, s, fit_signals, n)
             ia = e.values["Ia"]
+            qdd = np.sqrt(np.mean(np.vstack([sig.qdd[sig.inner(), j] for sig in fit_signals]) ** 2))
             if ia > ROTOR_RATIO * inertia[j]:
                 reason = (f"on joint {j + 1}, {ia:.3g} kg m^2 is {ia / inertia[j]:.0f} x the arm's own inertia about the joint "
                           f"({inertia[j]:.3g} kg m^2): outside a rotor inertia's range")
+            elif ia * qdd > LARGER * before[j]:
+                reason = (f"on joint {j + 1}, its torque ({ia * qdd:.3g} Nm) is larger than the joint's whole nominal "
+                          f"residual ({before[j]:.3g} Nm on the selection data): it makes up for another term")
         if reason:
             checked[-1] = replace(e, suspect=reason)
             large.setdefault(j, []).append(e.effect)

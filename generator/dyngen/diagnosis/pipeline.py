@@ -114,6 +114,7 @@ class Choice:
     reidentified: object  # identification.consistent.Consistent where it won a joint, else None
     consistent: list | None  # per segment its corrections (T, N), with reidentified
     links_hint: list  # 0-based joints where the rigid body's columns explain what the effects leave
+    excitation: float | None  # condition number of the link parameters' scaled columns, where it decided
     described: list  # record.Finding per chosen effect, values not yet filled in
     selection_mse: dict  # "before", "effects", "simple": per joint, on the selection samples
 
@@ -133,17 +134,22 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
         modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
         modes = choose.on_folds(context, selecting, design, chosen, final, options)
-    reid, consistent, links_hint = None, None, []
-    if design.select.count and not options.reidentify:
-        # Without the re-identification its cheap gate still says where the rigid body's
-        # columns explain what the effects leave: the link parameters may be off there.
+    reid, consistent = None, None
+    # Without the re-identification its cheap gate still says where the rigid body's columns
+    # explain what the effects leave: the link parameters may be off there.
+    links_hint, excitation = [], None
+    run_reid = options.reidentify
+    if run_reid is None and design.select.count:  # by default where the fit data excite the link parameters
+        excitation = reidentify.excitation(model, selecting)
+        run_reid = excitation <= reidentify.EXCITED
+    if not run_reid and design.select.count:
         links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                      options.min_gain)
-    if design.select.count and options.reidentify:
+    if run_reid and design.select.count:
         reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
                                                       modes, options.min_gain)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
-    return Choice(selecting, simple, modes, reid, consistent, links_hint, described, mse)
+    return Choice(selecting, simple, modes, reid, consistent, links_hint, excitation, described, mse)
 
 
 @dataclass(frozen=True)
@@ -196,7 +202,10 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in choice.links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
-                     "parameters as an alternative (or identify them first: dyngen identify)")
+                     "parameters as an alternative (or identify them first: dyngen identify)"
+                     + ("" if choice.excitation is None else f"; not tried by default: the fit data excite the link "
+                        f"parameters weakly (condition number {choice.excitation:.3g} of their scaled columns, above "
+                        f"{reidentify.EXCITED:g})"))
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}
     reid = final.reidentified

@@ -41,6 +41,9 @@ class Consistent:
     lags: np.ndarray | None = None  # (N,) lag of the Coulomb term behind the velocity [s]
     groups: list = field(default_factory=list)  # (group, joint or None, gain, its se, kept) decided on held-out data
     notes: list = field(default_factory=list)  # what a user must know (e.g. a tilt refused)
+    # joints the simple model predicts instead (identification/sanity.py): {"joints": 0-based,
+    # "values": (N, 3) b, Fc, Fv, "prior": the prior's 10N parameters, "standard": its standard ones}
+    simple: dict | None = None
 
     def joint_dynamics(self) -> list:
         """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
@@ -66,6 +69,13 @@ class Consistent:
         if self.tilt_model is not None:
             robot, p = self.tilt_model
             out = out + tilt.torque(robot, p, signals.q, tilt.gravity_of(robot), self.friction["tilt"])
+        if self.simple:  # the prior's rigid body + b + Fc tanh(qd / 0.02) + Fv qd there
+            from ..terms import simple_model
+
+            j = list(self.simple["joints"])
+            rigid = model.batch("rnea", signals.q, signals.qd, signals.qdd, self.simple["standard"])
+            terms = np.einsum("tjk,jk->tj", simple_model.columns(signals), self.simple["values"])
+            out[:, j] = (rigid + terms)[:, j]
         return out
 
 
@@ -109,6 +119,16 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
                      f"ripple: [{_f(c.friction['ripple_cos'][j])}, {_f(c.friction['ripple_sin'][j])}], "
                      f"sigma: {_f(c.sigma[j])}}}   # joint {j + 1}; std Fc {std('coulomb')}, Fv {std('viscous')}, "
                      f"offset {std('offset')}, Ia {std('armature')}")
+    if c.simple:
+        lines.append("simple_model:   # joints the simple model predicted the --select recordings better on; there "
+                     "tau_j = Y_j(q, qd, qdd) pi(prior_links) + b + Fc tanh(qd / 0.02) + Fv qd [Nm, Nm, Nm s/rad] "
+                     "(the URDF and MJCF carry the links and friction above)")
+        lines.append("  joints:")
+        for j in c.simple["joints"]:
+            b, fc, fv = c.simple["values"][j]
+            lines.append(f"    - {{joint: {j + 1}, b: {_f(b)}, Fc: {_f(fc)}, Fv: {_f(fv)}}}")
+        lines.append("  prior_links:")
+        lines.append("\n".join("  " + x for x in links_yaml(c.simple["prior"]).rstrip("\n").splitlines()))
     if c.tilt_model is not None:
         dg = tilt_change(c)
         lines.append(f"tilt: {{dg: [{_f(dg[0])}, {_f(dg[1])}, {_f(dg[2])}], angle_deg: {_f(c.tilt_deg())}}}   "
