@@ -61,7 +61,7 @@ def snapped_copy(path, snaps, out):
     import sympy
 
     root = ET.fromstring(path.read_text())
-    joints = {j.get("name"): j for j in root.iter("joint")}
+    joints = {j.get("name"): j for j in root.findall("joint")}  # not <transmission>s
     for snap in snaps:
         joint = joints[snap.joint]
         if snap.field == "axis":
