@@ -39,3 +39,43 @@ def pinocchio_chain(path: Path, links, base=None):
         model = pin.buildReducedModel(model, lock, pin.neutral(model))
     assert model.nv == len(links)
     return model, model.createData()
+
+
+def mujoco_inverse(urdf_path: Path, joint_names, q, qd, qdd, tmp_path: Path):
+    """MuJoCo's inverse dynamics of a URDF, per state (rows of q, qd, qdd) for the named joints
+    in that order (others at 0). Visuals and collisions are dropped first: the meshes are not
+    in the tests and geometry does not enter the dynamics; joint limits are switched off."""
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+    import numpy as np
+
+    root = ET.fromstring(urdf_path.read_text())
+    for link in root.iter("link"):
+        for tag in ("visual", "collision"):
+            for e in link.findall(tag):
+                link.remove(e)
+    stripped = tmp_path / f"stripped_{urdf_path.name}"
+    stripped.write_text(ET.tostring(root, encoding="unicode"))
+    model = mujoco.MjModel.from_xml_path(str(stripped))
+    model.opt.gravity[:] = [0, 0, -9.81]
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT  # joint limits: rnea has none
+    data = mujoco.MjData(model)
+    order = [model.joint(name).id for name in joint_names]
+    tau = np.zeros(np.shape(q))
+    for row, (a, b, c) in enumerate(zip(q, qd, qdd)):
+        data.qpos[:], data.qvel[:], data.qacc[:] = 0, 0, 0
+        for k, j in enumerate(order):
+            data.qpos[model.jnt_qposadr[j]], data.qvel[model.jnt_dofadr[j]], data.qacc[model.jnt_dofadr[j]] = \
+                a[k], b[k], c[k]
+        mujoco.mj_inverse(model, data)
+        tau[row] = [data.qfrc_inverse[model.jnt_dofadr[j]] for j in order]
+    return tau
+
+
+def chain_joint_names(urdf_path: Path, robot):
+    """The URDF joints that move the robot's chain links, in chain order."""
+    import xml.etree.ElementTree as ET
+
+    by_child = {j.find("child").get("link"): j.get("name") for j in ET.fromstring(urdf_path.read_text()).findall("joint")}
+    return [by_child[link] for link in robot.links]
