@@ -43,6 +43,16 @@ CASES = {
                          'name="arm"', 'name="&c;"'), "declares a DTD"),
     "external_entity": (arm(prolog='<?xml version="1.0"?><!DOCTYPE robot [<!ENTITY x SYSTEM "file:///etc/passwd">]>')
                         .replace('name="arm"', 'name="&x;"'), "declares a DTD"),
+    "floating": (arm(joints=[JOINT.format(name=f"j{i}", type="floating" if i == 2 else "revolute", rpy="0 0 0",
+                                          parent=f"l{i - 1}", child=f"l{i}", extra="") for i in range(1, 4)]),
+                 'joint "j2": a floating joint'),
+    "closed_loop": (arm(joints=[JOINT.format(name=f"j{i}", type="revolute", rpy="0 0 0", parent=f"l{p}", child=f"l{c}",
+                                             extra="") for i, p, c in ((1, 0, 1), (2, 1, 2), (3, 2, 3), (4, 1, 3))]),
+                    'joint "j4": link "l3" has a second parent'),
+    "zero_axis": (arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1), 'joint "j1".axis: the axis has zero'),
+    "xacro_inside": (arm(links=_links(l1=LINK.format(name="l1", mass="${2*m}", extra=""))), "a xacro file is a program"),
+    "xacro_macro": (arm().replace('<robot name="arm">', '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                                  '<xacro:include filename="other.xacro"/>'), "xacro:include: a xacro file is a program"),
 }
 
 
@@ -59,6 +69,16 @@ def test_bad_urdf_is_one_line_and_writes_nothing(case, tmp_path):
     assert len(lines) == 1 and lines[0].startswith(f"dyngen: error: {case}.urdf: "), run.stderr
     assert expected in lines[0], lines[0]
     assert not out.exists()
+
+
+def test_a_xacro_file_is_not_run(tmp_path):
+    """Refused by its name before it is read: expanding it would evaluate its Python expressions."""
+    (tmp_path / "arm.urdf.xacro").write_text(arm().replace('name="arm"', 'name="${__import__(\'os\').system(\'touch '
+                                                           + str(tmp_path / "ran") + '\')}"'))
+    run = subprocess.run([sys.executable, "-m", "dyngen", "generate", str(tmp_path / "arm.urdf.xacro"), "-o",
+                          str(tmp_path / "out"), "-q"], capture_output=True, text=True, timeout=120)
+    assert run.returncode != 0 and not (tmp_path / "out").exists() and not (tmp_path / "ran").exists()
+    assert run.stderr.strip().startswith("dyngen: error: arm.urdf.xacro: a xacro file is a program"), run.stderr
 
 
 def test_the_good_arm_of_these_cases_generates(tmp_path):

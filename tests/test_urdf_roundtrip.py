@@ -10,25 +10,21 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from cbuild import compile_folder
 from oracles.random_params import random_parameters
-from test_urdf import DATA, configuration, pinocchio_chain, rel_err
+from test_urdf import configuration, pinocchio_chain, rel_err
+from urdf_built import built_urdf
 
-from dyngen.atomic import write_folder
-from dyngen.description.urdf import load_urdf
 from dyngen.export.urdf_copy import urdf_copy
-from dyngen.generate import build
 
 
-@pytest.fixture(scope="module", params=["ur5_robot.urdf", "kinova.urdf"])
+@pytest.fixture(scope="module", params=["ur5", "kinova"])
 def arm(request, tmp_path_factory):
     out = tmp_path_factory.mktemp("roundtrip")
-    robot = load_urdf(DATA / request.param)
-    write_folder(out / robot.name, build(robot)[1].files)
+    robot, _, c, path = built_urdf(request.param, tmp_path_factory)
     p = random_parameters(robot.dof, seed=7)
     copy = out / "copy.urdf"
     copy.write_text(urdf_copy(robot, p))
-    return robot, compile_folder(out / robot.name, out / "build"), p, DATA / request.param, copy
+    return robot, c, p, path, copy
 
 
 def test_copy_keeps_what_the_user_wrote(arm):

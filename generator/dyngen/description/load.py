@@ -50,7 +50,7 @@ def load_robot(path, **urdf_options) -> Robot:
     """A robot description: a YAML file, or a URDF (by its suffix; description/urdf.py, which
     takes urdf_options base_link, tip_link, snap)."""
     path = Path(path)
-    if path.suffix.lower() == ".urdf":
+    if path.suffix.lower() in (".urdf", ".xacro"):  # a .xacro is refused there, by name (docs/urdf.md)
         from .urdf import load_urdf
 
         return load_urdf(path, **urdf_options)

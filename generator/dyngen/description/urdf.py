@@ -78,7 +78,7 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
                  "chain (choose tip_link before it)")
         origin = _origin(joint, snaps, snap)
         if body is not None:
-            body = body + _subtree(urdf, joint.parent, children, on_path, fixed, source, notes, tip, snap)
+            body = body + _subtree(urdf, joint.parent, children, on_path, fixed, source, notes, tip, snap, snaps)
         if joint.type == "fixed":
             fixed = fixed * origin
             continue
@@ -95,7 +95,7 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
         body, body_link = Body.empty(), joint.child
     if not models:
         fail("tip_link", f"no revolute, continuous or prismatic joint between {shorten(base)!r} and {shorten(tip)!r}")
-    body = body + _subtree(urdf, tip, children, on_path, fixed, source, notes, tip, snap)
+    body = body + _subtree(urdf, tip, children, on_path, fixed, source, notes, tip, snap, snaps)
     bodies.append((body_link, body))
     models, bodies, lambdas = slide(models, bodies)
     link_frames = [Rigid.trans(z=-lam) * frame for lam, frame in zip(lambdas, link_frames)]
@@ -139,10 +139,11 @@ def _unique_leaf(urdf, base, children, fail):
     return next(iter(ends))
 
 
-def _subtree(urdf, link, children, on_path, to_body: Rigid, source, notes, tip, snap) -> Body:
+def _subtree(urdf, link, children, on_path, to_body: Rigid, source, notes, tip, snap, snaps) -> Body:
     """Link `link`'s own inertial and every off-chain link below it (locked at q = 0), in the
     body's frame (to_body: link's frame in it). A moving joint off the chain is allowed only
-    beyond the tip: mid-chain it would be a branch."""
+    beyond the tip: mid-chain it would be a branch. Their placements' snaps are reported too
+    (a gripper's rpy written 1.5708 moves the lumped centre of mass)."""
     total = _inertial(urdf.links[link])
     R, p = _floats(to_body.R), _floats(to_body.p)[:, 0]
     total = total.moved(R, p)
@@ -154,8 +155,8 @@ def _subtree(urdf, link, children, on_path, to_body: Rigid, source, notes, tip, 
                 raise InputError(source, f'joint "{shorten(joint.name)}"', "moves a branch off the chain; a "
                                  "branching tree needs tip_link set to one branch's end")
             notes.append(f'joint "{joint.name}" beyond the tip is locked at 0 and its links lumped into the tip')
-        total = total + _subtree(urdf, joint.child, children, on_path, to_body * _origin(joint, [], snap),
-                                 source, notes, tip, snap)
+        total = total + _subtree(urdf, joint.child, children, on_path, to_body * _origin(joint, snaps, snap),
+                                 source, notes, tip, snap, snaps)
     return total
 
 

@@ -23,6 +23,10 @@ MAX_URDF_BYTES = 8 << 20
 MAX_LINKS = 200
 MAX_VALUE = 1e5  # lengths [m], masses [kg], inertias [kg m^2]: far beyond any serial arm
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+XACRO_NAMESPACE = "{http://www.ros.org/wiki/xacro}"
+XACRO_REFUSED = ("a xacro file is a program (its ${...} are Python expressions; $(find ...), $(env ...) and "
+                 "xacro:include read other files and the environment), which dyngen does not run: expand it where "
+                 "you trust it (xacro arm.urdf.xacro > arm.urdf) and give dyngen the URDF")
 
 
 @dataclass(frozen=True)
@@ -102,6 +106,8 @@ class _Reader:
 def read_urdf(path) -> UrdfFile:
     path = Path(path)
     reader = _Reader(path.name)
+    if path.suffix.lower() == ".xacro":
+        reader.fail("", XACRO_REFUSED)
     text = read_text(path, MAX_URDF_BYTES)
     try:
         root = SafeET.fromstring(text, forbid_dtd=True, forbid_entities=True, forbid_external=True)
@@ -110,7 +116,10 @@ def read_urdf(path) -> UrdfFile:
     except SafeET.ParseError as err:
         reader.fail(f"line {err.position[0]}", f"not well-formed XML ({shorten(str(err))})")
     if root.tag != "robot":
-        reader.fail(root.tag, "expected a <robot> element at the top")
+        reader.fail(shorten(root.tag), "expected a <robot> element at the top")
+    for element in root.iter():
+        if str(element.tag).startswith(XACRO_NAMESPACE) or any("${" in v or "$(" in v for v in element.attrib.values()):
+            reader.fail(shorten(str(element.tag).replace(XACRO_NAMESPACE, "xacro:")), XACRO_REFUSED)
     links = {}
     for element in root.findall("link"):
         name = element.get("name")

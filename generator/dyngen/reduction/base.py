@@ -84,7 +84,7 @@ def _reduce_in(kind, sampled, field) -> BaseSet:
     used = sorted(field.used)
     if not used:
         K = tuple(tuple(exact.rational(v, field) for v in row) for row in first)
-        _check(kind, sampled, pivots, K)
+        _check(kind, sampled, pivots, K, exact.check_field(field.P))
         return BaseSet(kind, tuple(pivots), K)
     embeddings = {}
     for signs in itertools.product((1, -1), repeat=len(used)):
@@ -113,8 +113,9 @@ def _reduce_in(kind, sampled, field) -> BaseSet:
             K_row.append(sp.Add(*total))
         K.append(tuple(K_row))
     K = tuple(K)
+    check = exact.check_field(field.P)
     for signs in embeddings:
-        _check(kind, sampled, pivots, K, field.embedding(dict(zip(used, signs))))
+        _check(kind, sampled, pivots, K, check.embedding(dict(zip(used, signs))))
     return BaseSet(kind, tuple(pivots), K)
 
 
@@ -131,7 +132,8 @@ def _echelon(sampled, field):
 
 
 def _check(kind, sampled, pivots, K, field=None):
-    """Y == Y_b K exactly at fresh states (a wrong rational reconstruction fails here)."""
+    """Y == Y_b K exactly at fresh states, in another prime's field than the reconstruction's
+    (exact.check_field: a wrong rational reconstruction fails here, and the next field is tried)."""
     field = field or sampled.field
     sampled.field = field
     P = field.P

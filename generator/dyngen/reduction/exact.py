@@ -65,6 +65,20 @@ def ladder_field(bits: int, k: int) -> Field:
     return Field(prime, math.isqrt(prime >> 1), {b: int(sp.sqrt_mod(b, prime)) for b in (2, 3)})
 
 
+@functools.lru_cache(maxsize=None)
+def check_field(P: int) -> Field:
+    """A second field, with another prime, in which a reconstructed K is checked: rational
+    reconstruction returns a rational congruent to the true one mod P, so a check in the same
+    field cannot fail, even when the true numerator or denominator exceeded sqrt(P/2) and the
+    rational is wrong (the SO-ARM101's 0.0304-type lengths gave -1.04*m5 for a 0.06 m lever)."""
+    bits, k = LADDER[0]
+    while True:
+        k += 1
+        prime = 24 * ((1 << bits) // 24 + k) + 1
+        if prime != P and sp.isprime(prime):
+            return Field(prime, math.isqrt(prime >> 1), {b: int(sp.sqrt_mod(b, prime)) for b in (2, 3)})
+
+
 def fields():
     """The fields to try, smallest first: the first that holds the constants and reconstructs
     every coefficient is used."""
