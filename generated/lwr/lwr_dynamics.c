@@ -4,6 +4,7 @@
  * Conventions, shapes and parameter orders: lwr.h.
  *
  *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
+ *   lwr_rnea_nominal             256 mul, 249 add, 0 div, 6 sin/cos
  *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
  *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
  *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
@@ -296,6 +297,245 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
     tau[4] = x210;
     tau[5] = -x200;
     tau[6] = x191;
+}
+
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p). */
+void lwr_rnea_nominal(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *tau)
+{
+    /* joint angles */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
+    /* link 2: velocities and accelerations */
+    const lwr_real x0 = qd[0]*s2;
+    const lwr_real x1 = c2*qd[0];
+    const lwr_real x2 = qdd[0]*s2;
+    const lwr_real x3 = c2*qdd[0];
+    const lwr_real x4 = LWR_K(9.81)*s2;
+    const lwr_real x5 = LWR_K(9.81)*c2;
+    const lwr_real x6 = qd[1]*x1 + x2;
+    const lwr_real x7 = -qd[1]*x0 + x3;
+    const lwr_real x8 = x0*x0;
+    const lwr_real x9 = -qd[1]*x0;
+    const lwr_real x10 = x0*x1;
+    const lwr_real x11 = qd[1]*qd[1];
+    const lwr_real x12 = -qd[1]*x1;
+    const lwr_real x13 = x1*x1;
+    /* link 3: velocities and accelerations */
+    const lwr_real x14 = c3*x0 - qd[1]*s3;
+    const lwr_real x15 = -c3*qd[1] - s3*x0;
+    const lwr_real x16 = c3*x6 - qdd[1]*s3;
+    const lwr_real x17 = -c3*qdd[1] - s3*x6;
+    const lwr_real x18 = c3*x4;
+    const lwr_real x19 = -s3*x4;
+    const lwr_real x20 = -qd[2] - x1;
+    const lwr_real x21 = qd[2]*x15 + x16;
+    const lwr_real x22 = -qdd[2] - x7;
+    const lwr_real x23 = -qd[2]*x14 + x17;
+    const lwr_real x24 = x14*x14;
+    const lwr_real x25 = x14*x20;
+    const lwr_real x26 = x14*x15;
+    const lwr_real x27 = x20*x20;
+    const lwr_real x28 = x15*x20;
+    const lwr_real x29 = x15*x15;
+    const lwr_real x30 = -x27 - x29;
+    const lwr_real x31 = -x24 - x29;
+    const lwr_real x32 = -x23 + x25;
+    const lwr_real x33 = -x22 + x26;
+    const lwr_real x34 = x21 + x28;
+    const lwr_real x35 = x18 - LWR_K(0.4)*x32;
+    const lwr_real x36 = -LWR_K(0.4)*x31 - x5;
+    const lwr_real x37 = x19 - LWR_K(0.4)*x34;
+    /* link 4: velocities and accelerations */
+    const lwr_real x38 = c4*x14 + s4*x20;
+    const lwr_real x39 = -c4*x20 + s4*x14;
+    const lwr_real x40 = c4*x21 + s4*x22;
+    const lwr_real x41 = -c4*x22 + s4*x21;
+    const lwr_real x42 = c4*x35 + s4*x36;
+    const lwr_real x43 = -c4*x36 + s4*x35;
+    const lwr_real x44 = qd[3] + x15;
+    const lwr_real x45 = -qd[3]*x39 + x40;
+    const lwr_real x46 = qdd[3] + x23;
+    const lwr_real x47 = qd[3]*x38 + x41;
+    const lwr_real x48 = x38*x38;
+    const lwr_real x49 = x38*x44;
+    const lwr_real x50 = x38*x39;
+    const lwr_real x51 = x44*x44;
+    const lwr_real x52 = x39*x44;
+    const lwr_real x53 = x39*x39;
+    const lwr_real x54 = -x51 - x53;
+    const lwr_real x55 = -x48 - x51;
+    const lwr_real x56 = x46 + x50;
+    const lwr_real x57 = x47 + x49;
+    const lwr_real x58 = -x45 + x52;
+    const lwr_real x59 = -x46 + x50;
+    /* link 5: velocities and accelerations */
+    const lwr_real x60 = c5*x38 + s5*x44;
+    const lwr_real x61 = -c5*x44 + s5*x38;
+    const lwr_real x62 = c5*x45 + s5*x46;
+    const lwr_real x63 = -c5*x46 + s5*x45;
+    const lwr_real x64 = c5*x42 + s5*x37;
+    const lwr_real x65 = -c5*x37 + s5*x42;
+    const lwr_real x66 = qd[4] + x39;
+    const lwr_real x67 = -qd[4]*x61 + x62;
+    const lwr_real x68 = qdd[4] + x47;
+    const lwr_real x69 = qd[4]*x60 + x63;
+    const lwr_real x70 = x60*x60;
+    const lwr_real x71 = x60*x66;
+    const lwr_real x72 = x60*x61;
+    const lwr_real x73 = x66*x66;
+    const lwr_real x74 = x61*x66;
+    const lwr_real x75 = x61*x61;
+    const lwr_real x76 = -x73 - x75;
+    const lwr_real x77 = -x70 - x75;
+    const lwr_real x78 = -x70 - x73;
+    const lwr_real x79 = -x69 + x71;
+    const lwr_real x80 = x68 + x72;
+    const lwr_real x81 = x69 + x71;
+    const lwr_real x82 = -x67 + x74;
+    const lwr_real x83 = -x68 + x72;
+    const lwr_real x84 = x67 + x74;
+    const lwr_real x85 = x64 + LWR_K(0.39)*x79;
+    const lwr_real x86 = x43 + LWR_K(0.39)*x77;
+    const lwr_real x87 = LWR_K(0.39)*x84 + x65;
+    /* link 6: velocities and accelerations */
+    const lwr_real x88 = c6*x60 + s6*x66;
+    const lwr_real x89 = c6*x66 - s6*x60;
+    const lwr_real x90 = c6*x67 + s6*x68;
+    const lwr_real x91 = c6*x68 - s6*x67;
+    const lwr_real x92 = c6*x85 + s6*x86;
+    const lwr_real x93 = c6*x86 - s6*x85;
+    const lwr_real x94 = -qd[5] - x61;
+    const lwr_real x95 = qd[5]*x89 + x90;
+    const lwr_real x96 = -qdd[5] - x69;
+    const lwr_real x97 = -qd[5]*x88 + x91;
+    const lwr_real x98 = x88*x88;
+    const lwr_real x99 = x88*x94;
+    const lwr_real x100 = x88*x89;
+    const lwr_real x101 = x94*x94;
+    const lwr_real x102 = x89*x94;
+    const lwr_real x103 = x89*x89;
+    const lwr_real x104 = -x101 - x103;
+    const lwr_real x105 = -x98 - x101;
+    const lwr_real x106 = x96 + x100;
+    const lwr_real x107 = x97 + x99;
+    const lwr_real x108 = -x95 + x102;
+    const lwr_real x109 = -x96 + x100;
+    /* link 7: velocities and accelerations */
+    const lwr_real x110 = c7*x88 + s7*x94;
+    const lwr_real x111 = c7*x94 - s7*x88;
+    const lwr_real x112 = c7*x95 + s7*x96;
+    const lwr_real x113 = qd[6] + x89;
+    const lwr_real x114 = qd[6]*x111 + x112;
+    const lwr_real x115 = qdd[6] + x97;
+    const lwr_real x116 = x110*x111;
+    const lwr_real x117 = x110*x113;
+    const lwr_real x118 = x111*x113;
+    /* link 1: link wrench */
+    const lwr_real x119 = LWR_K(0.0174961336)*qdd[0];
+    /* link 2: link wrench */
+    const lwr_real x120 = LWR_K(0.000632077186)*(-x9 - x7) + (LWR_K(0.00018901396)*(-qdd[1] - x10) + (LWR_K(0.015961084938)*(x11 - x13) + (-LWR_K(1.3659973055766)*x12 + LWR_K(1.3611206093366)*x6)));
+    const lwr_real x121 = LWR_K(0.000632077186)*(-x13 + x8) + (LWR_K(0.00018901396)*(x12 + x6) + (LWR_K(0.015961084938)*(-x9 + x7) + (-LWR_K(1.3659973055766)*qdd[1] + LWR_K(1.3611206093366)*x10 + LWR_K(3.6)*x4 - LWR_K(0.003618)*x5)));
+    const lwr_real x122 = LWR_K(0.000632077186)*(x12 - x6) + ((LWR_K(0.00487669624)*x9 + LWR_K(0.015961084938)*(-qdd[1] + x10)) + LWR_K(0.00018901396)*(-x11 + x8));
+    /* link 3: link wrench */
+    const lwr_real x123 = -LWR_K(0.003618)*x30;
+    const lwr_real x124 = -LWR_K(0.003618)*x33;
+    const lwr_real x125 = LWR_K(0.000632077186)*(x22 - x26) + (LWR_K(0.008895084938)*(x27 - x29) + ((-LWR_K(0.01951356264)*x21 - LWR_K(0.0174961336)*x28) + LWR_K(0.00019043596)*(-x23 - x25)));
+    const lwr_real x126 = LWR_K(0.000632077186)*(x21 + x28) + (LWR_K(0.008895084938)*(x23 - x25) + (LWR_K(0.00019043596)*(x24 - x29) + (LWR_K(0.0174961336)*x22 - LWR_K(0.01951356264)*x26 + LWR_K(0.003618)*x37)));
+    const lwr_real x127 = LWR_K(0.000632077186)*(x24 - x27) + (LWR_K(0.008895084938)*(x22 + x26) + (LWR_K(0.00019043596)*(-x21 + x28) + (LWR_K(0.03700969624)*x25 - LWR_K(0.003618)*x36)));
+    /* link 4: link wrench */
+    const lwr_real x128 = -LWR_K(0.003618)*x54 + LWR_K(1.4511929)*x56;
+    const lwr_real x129 = -LWR_K(0.003618)*x57 + LWR_K(1.4511929)*x58;
+    const lwr_real x130 = LWR_K(1.4511929)*x55 - LWR_K(0.003618)*x59;
+    const lwr_real x131 = LWR_K(0.003532915062)*(x51 - x53) + (LWR_K(0.000632127186)*(x47 + x49) + (LWR_K(0.00018901396)*(x46 - x50) + (-LWR_K(1.4511929)*x37 + LWR_K(0.5016166210816)*x45 - LWR_K(0.5085133173216)*x52)));
+    const lwr_real x132 = LWR_K(0.003532915062)*(x47 - x49) + (LWR_K(0.000632127186)*(-x48 + x53) + (LWR_K(0.00018901396)*(x45 + x52) + (LWR_K(1.4511929)*x42 + LWR_K(0.003618)*x43 + LWR_K(0.5085133173216)*x46 + LWR_K(0.5016166210816)*x50)));
+    const lwr_real x133 = LWR_K(0.003532915062)*(x46 + x50) + (LWR_K(0.000632127186)*(x45 - x52) + ((-LWR_K(0.003618)*x37 + LWR_K(0.00689669624)*x49) + LWR_K(0.00018901396)*(x48 - x51)));
+    /* link 5: link wrench */
+    const lwr_real x134 = -LWR_K(0.0016881)*x76 - LWR_K(0.036299)*x80;
+    const lwr_real x135 = -LWR_K(0.0016881)*x81 - LWR_K(0.036299)*x82;
+    const lwr_real x136 = -LWR_K(0.0016881)*x83 - LWR_K(0.036299)*x78;
+    const lwr_real x137 = LWR_K(0.0000902477998)*(-x69 - x71) + (LWR_K(0.00713976319)*(-x73 + x75) + (LWR_K(0.000378276365)*(-x68 + x72) + (LWR_K(0.036299)*x86 + LWR_K(0.0067606367427)*x67 - LWR_K(0.0097089893093)*x74)));
+    const lwr_real x138 = LWR_K(0.0000902477998)*(x70 - x75) + (LWR_K(0.00713976319)*(-x69 + x71) + (LWR_K(0.000378276365)*(-x67 - x74) + (-LWR_K(0.036299)*x85 + LWR_K(0.0016881)*x87 + LWR_K(0.0097089893093)*x68 + LWR_K(0.0067606367427)*x72)));
+    const lwr_real x139 = LWR_K(0.0000902477998)*(-x67 + x74) + (LWR_K(0.00713976319)*(-x68 - x72) + ((-LWR_K(0.0016881)*x86 + LWR_K(0.0029483525666)*x71) + LWR_K(0.000378276365)*(-x70 + x73)));
+    /* link 6: link wrench */
+    const lwr_real x140 = -LWR_K(0.0004144)*x104 + LWR_K(0.0103752)*x106;
+    const lwr_real x141 = -LWR_K(0.0004144)*x107 + LWR_K(0.0103752)*x108;
+    const lwr_real x142 = LWR_K(0.0103752)*x105 - LWR_K(0.0004144)*x109;
+    const lwr_real x143 = LWR_K(0.0000045309232)*(-x97 - x99) + (LWR_K(0.0001208537088)*(-x101 + x103) + (LWR_K(0.0000049311664)*(-x96 + x100) + (LWR_K(0.0103752)*x87 + LWR_K(0.0020580128048)*x95 - LWR_K(0.005596227464)*x102)));
+    const lwr_real x144 = LWR_K(0.0000045309232)*(x98 - x103) + (LWR_K(0.0001208537088)*(-x97 + x99) + (LWR_K(0.0000049311664)*(-x95 - x102) + (LWR_K(0.0103752)*x92 + LWR_K(0.0004144)*x93 + LWR_K(0.005596227464)*x96 + LWR_K(0.0020580128048)*x100)));
+    const lwr_real x145 = LWR_K(0.0000045309232)*(-x95 + x102) + (LWR_K(0.0001208537088)*(-x96 - x100) + ((LWR_K(0.0004144)*x87 + LWR_K(0.0035382146592)*x99) + LWR_K(0.0000049311664)*(-x98 + x101)));
+    /* link 7: link wrench */
+    const lwr_real x146 = LWR_K(0.002178)*x114 + LWR_K(0.0001584)*x118;
+    const lwr_real x147 = LWR_K(0.0020196)*x117;
+    const lwr_real x148 = LWR_K(0.0001584)*x115 - LWR_K(0.002178)*x116;
+    /* link 7: forces */
+    const lwr_real x149 = c7*x146 - s7*x147;
+    const lwr_real x150 = c7*x147 + s7*x146;
+    /* link 6: forces */
+    const lwr_real x151 = x143 + x149;
+    const lwr_real x152 = x144 + x150;
+    const lwr_real x153 = x145 + x148;
+    const lwr_real x154 = c6*x140 - s6*x142;
+    const lwr_real x155 = c6*x142 + s6*x140;
+    const lwr_real x156 = c6*x151 - s6*x153;
+    const lwr_real x157 = c6*x153 + s6*x151;
+    /* link 5: forces */
+    const lwr_real x158 = x134 + x154;
+    const lwr_real x159 = x135 + x155;
+    const lwr_real x160 = x136 - x141;
+    const lwr_real x161 = x137 + x156;
+    const lwr_real x162 = x138 + x157;
+    const lwr_real x163 = x139 - x152;
+    const lwr_real x164 = LWR_K(0.39)*x160 + x161;
+    const lwr_real x165 = -LWR_K(0.39)*x158 + x163;
+    const lwr_real x166 = c5*x158 + s5*x160;
+    const lwr_real x167 = -c5*x160 + s5*x158;
+    const lwr_real x168 = c5*x164 + s5*x165;
+    const lwr_real x169 = -c5*x165 + s5*x164;
+    /* link 4: forces */
+    const lwr_real x170 = x128 + x166;
+    const lwr_real x171 = x129 + x167;
+    const lwr_real x172 = x130 + x159;
+    const lwr_real x173 = x131 + x168;
+    const lwr_real x174 = x132 + x169;
+    const lwr_real x175 = x133 + x162;
+    const lwr_real x176 = c4*x170 + s4*x172;
+    const lwr_real x177 = c4*x173 + s4*x175;
+    const lwr_real x178 = -c4*x175 + s4*x173;
+    /* link 3: forces */
+    const lwr_real x179 = x123 + x176;
+    const lwr_real x180 = x124 + x171;
+    const lwr_real x181 = x125 + x177;
+    const lwr_real x182 = x126 + x178;
+    const lwr_real x183 = x127 + x174;
+    const lwr_real x184 = -LWR_K(0.4)*x180 + x181;
+    const lwr_real x185 = LWR_K(0.4)*x179 + x183;
+    const lwr_real x186 = c3*x184 - s3*x185;
+    const lwr_real x187 = c3*x185 + s3*x184;
+    /* link 2: forces */
+    const lwr_real x188 = x120 + x186;
+    const lwr_real x189 = x121 + x187;
+    const lwr_real x190 = x122 - x182;
+    const lwr_real x191 = c2*x190 + s2*x188;
+    /* link 1: forces */
+    const lwr_real x192 = x119 + x191;
+    /* tau */
+    tau[0] = x192;
+    tau[1] = -x189;
+    tau[2] = -x182;
+    tau[3] = x174;
+    tau[4] = x162;
+    tau[5] = -x152;
+    tau[6] = x148;
 }
 
 /* Gravity vector g(q). */

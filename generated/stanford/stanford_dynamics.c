@@ -4,6 +4,7 @@
  * Conventions, shapes and parameter orders: stanford.h.
  *
  *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
+ *   stanford_rnea_nominal        134 mul, 102 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
  *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
  *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
@@ -241,6 +242,170 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
     tau[3] = -x171;
     tau[4] = x161;
     tau[5] = x150;
+}
+
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p). */
+void stanford_rnea_nominal(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *tau)
+{
+    /* joint angles */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
+    /* link 2: velocities and accelerations */
+    const stanford_real x0 = -qd[0]*s2;
+    const stanford_real x1 = c2*qd[0];
+    const stanford_real x2 = -qdd[0]*s2;
+    const stanford_real x3 = c2*qdd[0];
+    const stanford_real x4 = -STANFORD_K(9.81)*s2;
+    const stanford_real x5 = STANFORD_K(9.81)*c2;
+    const stanford_real x6 = -qd[1]*x1 + x2;
+    const stanford_real x7 = qd[1]*x0 + x3;
+    const stanford_real x8 = x0*x0;
+    const stanford_real x9 = qd[1]*x0;
+    const stanford_real x10 = x0*x1;
+    const stanford_real x11 = qd[1]*qd[1];
+    const stanford_real x12 = qd[1]*x1;
+    const stanford_real x13 = x1*x1;
+    const stanford_real x14 = -x13 - x8;
+    const stanford_real x15 = -x11 - x8;
+    const stanford_real x16 = x9 - x7;
+    const stanford_real x17 = qdd[1] + x10;
+    const stanford_real x18 = x12 - x6;
+    const stanford_real x19 = x12 + x6;
+    const stanford_real x20 = STANFORD_K(0.154)*x16 + x4;
+    const stanford_real x21 = STANFORD_K(0.154)*x14;
+    const stanford_real x22 = STANFORD_K(0.154)*x19 + x5;
+    /* link 3: velocities and accelerations */
+    const stanford_real x23 = -q[2]*x18 + 2*qd[2]*x0 - x21;
+    const stanford_real x24 = q[2]*x17 + 2*qd[1]*qd[2] + x20;
+    const stanford_real x25 = q[2]*x15 + qdd[2] + x22;
+    /* link 4: velocities and accelerations */
+    const stanford_real x26 = -c4*qd[1] + s4*x0;
+    const stanford_real x27 = c4*x0 + qd[1]*s4;
+    const stanford_real x28 = -c4*qdd[1] + s4*x6;
+    const stanford_real x29 = c4*x6 + qdd[1]*s4;
+    const stanford_real x30 = c4*x23 + s4*x24;
+    const stanford_real x31 = c4*x24 - s4*x23;
+    const stanford_real x32 = -qd[3] - x1;
+    const stanford_real x33 = qd[3]*x27 + x28;
+    const stanford_real x34 = -qdd[3] - x7;
+    const stanford_real x35 = -qd[3]*x26 + x29;
+    const stanford_real x36 = x26*x26;
+    const stanford_real x37 = x26*x32;
+    const stanford_real x38 = x26*x27;
+    const stanford_real x39 = x32*x32;
+    const stanford_real x40 = x27*x32;
+    const stanford_real x41 = x27*x27;
+    const stanford_real x42 = -x36 - x39;
+    const stanford_real x43 = x34 + x38;
+    const stanford_real x44 = -x33 + x40;
+    /* link 5: velocities and accelerations */
+    const stanford_real x45 = c5*x26 + s5*x32;
+    const stanford_real x46 = -c5*x32 + s5*x26;
+    const stanford_real x47 = c5*x33 + s5*x34;
+    const stanford_real x48 = -c5*x34 + s5*x33;
+    const stanford_real x49 = c5*x30 - s5*x25;
+    const stanford_real x50 = qd[4] + x27;
+    const stanford_real x51 = -qd[4]*x46 + x47;
+    const stanford_real x52 = qdd[4] + x35;
+    const stanford_real x53 = qd[4]*x45 + x48;
+    const stanford_real x54 = x45*x45;
+    const stanford_real x55 = x45*x50;
+    const stanford_real x56 = x45*x46;
+    const stanford_real x57 = x50*x50;
+    const stanford_real x58 = x46*x50;
+    const stanford_real x59 = x46*x46;
+    const stanford_real x60 = -x54 - x57;
+    const stanford_real x61 = x52 + x56;
+    const stanford_real x62 = -x51 + x58;
+    /* link 6: velocities and accelerations */
+    const stanford_real x63 = c6*x45 + s6*x50;
+    const stanford_real x64 = c6*x50 - s6*x45;
+    const stanford_real x65 = qd[5] + x46;
+    const stanford_real x66 = qdd[5] + x53;
+    const stanford_real x67 = x63*x65;
+    const stanford_real x68 = x64*x65;
+    /* link 1: link wrench */
+    const stanford_real x69 = -STANFORD_K(4.5325332225)*qdd[0];
+    /* link 2: link wrench */
+    const stanford_real x70 = -STANFORD_K(179.18432937)*x12 + STANFORD_K(179.16832937)*x6;
+    const stanford_real x71 = STANFORD_K(179.18432937)*qdd[1] + STANFORD_K(179.16832937)*x10;
+    const stanford_real x72 = STANFORD_K(0.016)*x9;
+    /* link 3: link wrench */
+    const stanford_real x73 = STANFORD_K(27.49911)*x18 + STANFORD_K(6.47)*x23;
+    const stanford_real x74 = -STANFORD_K(27.49911)*x17 + STANFORD_K(6.47)*x24;
+    const stanford_real x75 = -STANFORD_K(27.49911)*x15 + STANFORD_K(6.47)*x25;
+    const stanford_real x76 = STANFORD_K(27.49911)*x24;
+    const stanford_real x77 = -STANFORD_K(27.49911)*x23;
+    /* link 4: link wrench */
+    const stanford_real x78 = STANFORD_K(0.29826)*x43;
+    const stanford_real x79 = STANFORD_K(0.29826)*x44;
+    const stanford_real x80 = STANFORD_K(0.29826)*x42;
+    const stanford_real x81 = (STANFORD_K(0.29826)*x25 + STANFORD_K(0.20597356)*(x33 - x40)) + STANFORD_K(0.00536544)*(x39 - x41);
+    const stanford_real x82 = (STANFORD_K(0.29826)*x30 + STANFORD_K(0.20597356)*(x34 + x38)) + STANFORD_K(0.00536544)*(x35 - x37);
+    const stanford_real x83 = STANFORD_K(0.00536544)*(x34 + x38);
+    /* link 5: link wrench */
+    const stanford_real x84 = STANFORD_K(0.92856)*x61;
+    const stanford_real x85 = STANFORD_K(0.92856)*x62;
+    const stanford_real x86 = STANFORD_K(0.92856)*x60;
+    const stanford_real x87 = STANFORD_K(0.00106974)*(-x57 + x59) + (-STANFORD_K(0.92856)*x31 + STANFORD_K(1.69976506)*x51 - STANFORD_K(1.69716506)*x58);
+    const stanford_real x88 = STANFORD_K(0.00106974)*(-x53 + x55) + (STANFORD_K(0.92856)*x49 + STANFORD_K(1.69716506)*x52 + STANFORD_K(1.69976506)*x56);
+    const stanford_real x89 = -STANFORD_K(0.0026)*x55 + STANFORD_K(0.00106974)*(-x52 - x56);
+    /* link 6: link wrench */
+    const stanford_real x90 = STANFORD_K(0.0003)*x68;
+    const stanford_real x91 = -STANFORD_K(0.0003)*x67;
+    const stanford_real x92 = STANFORD_K(0.0003)*x66;
+    /* link 6: forces */
+    const stanford_real x93 = c6*x90 - s6*x91;
+    const stanford_real x94 = c6*x91 + s6*x90;
+    /* link 5: forces */
+    const stanford_real x95 = x87 + x93;
+    const stanford_real x96 = x88 + x94;
+    const stanford_real x97 = x89 + x92;
+    const stanford_real x98 = c5*x84 + s5*x86;
+    const stanford_real x99 = -c5*x86 + s5*x84;
+    const stanford_real x100 = c5*x95 + s5*x97;
+    const stanford_real x101 = -c5*x97 + s5*x95;
+    /* link 4: forces */
+    const stanford_real x102 = x78 + x98;
+    const stanford_real x103 = x79 + x99;
+    const stanford_real x104 = x80 + x85;
+    const stanford_real x105 = x81 + x100;
+    const stanford_real x106 = x82 + x101;
+    const stanford_real x107 = x83 + x96;
+    const stanford_real x108 = c4*x102 - s4*x104;
+    const stanford_real x109 = c4*x104 + s4*x102;
+    const stanford_real x110 = c4*x105 - s4*x107;
+    const stanford_real x111 = c4*x107 + s4*x105;
+    /* link 3: forces */
+    const stanford_real x112 = x73 + x108;
+    const stanford_real x113 = x74 + x109;
+    const stanford_real x114 = x75 - x103;
+    const stanford_real x115 = x76 + x110;
+    const stanford_real x116 = x77 + x111;
+    const stanford_real x117 = -q[2]*x113 + x115;
+    const stanford_real x118 = q[2]*x112 + x116;
+    /* link 2: forces */
+    const stanford_real x119 = x70 + x118;
+    const stanford_real x120 = x71 - x117;
+    const stanford_real x121 = x72 - x106;
+    const stanford_real x122 = STANFORD_K(0.154)*x114 + x119;
+    const stanford_real x123 = -STANFORD_K(0.154)*x113 + x121;
+    const stanford_real x124 = -c2*x123 + s2*x122;
+    /* link 1: forces */
+    const stanford_real x125 = x69 + x124;
+    /* tau */
+    tau[0] = -x125;
+    tau[1] = x120;
+    tau[2] = x114;
+    tau[3] = -x106;
+    tau[4] = x96;
+    tau[5] = x92;
 }
 
 /* Gravity vector g(q). */

@@ -86,6 +86,19 @@ class Derivation:
                      tau, (self.n,), "inverse dynamics tau = M(q) qdd + c(q, qd) + g(q) (Newton-Euler)",
                      program, sym.trig)
 
+    def rnea_nominal(self, base, p_values) -> Model:
+        """rnea with fixed dynamic parameters p_values folded in as exact numbers (what a
+        controller with fixed parameters, or CasADi with baked parameters, runs): the YAML's
+        decimals as written, s(p) and pi = K s computed here in rationals, so every product with
+        a zero coefficient drops out and differences like ZZ - YY are one constant."""
+        program, sym, chain = self._start()
+        exact = [sp.Rational(repr(float(v))) for v in p_values]
+        s = [x for i in range(self.n) for x in standard_from_dynamic_link(exact[PER_LINK * i: PER_LINK * (i + 1)])]
+        params = self._placed(base, [sp.Add(*(k * v for k, v in zip(row, s) if k != 0)) for row in base.K])
+        tau = self._tau(program, chain, chain.forward(sym.qd, sym.qdd, self.robot.gravity), params)
+        return Model("rnea_nominal", self._joint_inputs(sym, "q", "qd", "qdd") + self._gravity_inputs(),
+                     tau, (self.n,), "inverse dynamics at fixed parameters (Newton-Euler)", program, sym.trig)
+
     def inverse_dynamics(self, base) -> Model:
         """tau = Y_b(q, qd, qdd) pi_full from the base coefficients themselves (full kind)."""
         program, sym, chain = self._start()

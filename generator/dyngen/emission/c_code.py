@@ -41,7 +41,10 @@ class Printer(C99CodePrinter):
         return self.names.get(expr, expr.name)
 
     def _print_Rational(self, expr):
-        return f"{self.macro}_K({decimal_text(expr)})"
+        text = decimal_text(expr)
+        if len(text) > 24:  # a folded-in parameter product (rnea_nominal): the nearest double
+            text = repr(float(expr))
+        return f"{self.macro}_K({text})"
 
     def _print_Integer(self, expr):
         return str(int(expr))
