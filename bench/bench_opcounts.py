@@ -49,6 +49,7 @@ def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
     from oracles.random_params import random_parameters
 
     from dyngen.runtime import load
+    from dyngen.terms.friction import FRICTION_FIELDS
 
     double = load(folder, cache_dir=tmp / "double")
     single = load(folder, cache_dir=tmp / "float", real="float")
@@ -84,9 +85,10 @@ def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
                        "qr_d": f32(rng.uniform(-2, 2, (T, n))), "qr_dd": f32(rng.uniform(-5, 5, (T, n))),
                        "tau": f32(rng.uniform(-20, 20, (T, n))),
                        "gravity": f32(9.81 * rng.standard_normal((T, n_gravity))),
-                       "f": f32(np.column_stack([rng.uniform(0, 2, (T * n)), rng.uniform(0, 1, T * n),
-                                                 rng.uniform(0, 1, T * n), rng.uniform(0.01, 0.5, T * n),
-                                                 rng.uniform(1e-3, 0.05, T * n)]).reshape(T, -1))}
+                       # friction: per joint its terms' fields (terms/friction.py): values and velocity scales
+                       "f": f32(np.column_stack([rng.uniform(0, 2, T * n) if field.kind == "value" else
+                                                 rng.uniform(1e-3, 0.5, T * n)
+                                                 for field in FRICTION_FIELDS]).reshape(T, -1))}
             for fn in manifest["functions"]:
                 names = [i["name"] for i in fn["inputs"]]
                 if set(names) <= {"p"} and done:
