@@ -93,7 +93,9 @@ class Derivation:
         program, sym, chain = self._start()
         exact = [sp.Rational(repr(float(v))) for v in p_values]
         s = [x for i in range(self.n) for x in standard_from_dynamic_link(exact[PER_LINK * i: PER_LINK * (i + 1)])]
-        params = self._placed(base, [sp.Add(*(k * v for k, v in zip(row, s) if k != 0)) for row in base.K])
+        params = s  # where K has a large entry, the grouped form cancels in float (_grouped)
+        if not any(abs(k) > GROUPING_LIMIT for row in base.K for k in row):
+            params = self._placed(base, [sp.Add(*(k * v for k, v in zip(row, s) if k != 0)) for row in base.K])
         tau = self._interleaved(program, chain, sym.qd, sym.qdd, params)
         return Model("rnea_nominal", self._joint_inputs(sym, "q", "qd", "qdd") + self._gravity_inputs(),
                      tau, (self.n,), "inverse dynamics at fixed parameters (Newton-Euler)", program, sym.trig)
