@@ -49,6 +49,7 @@ def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
     from oracles.random_params import random_parameters
 
     from dyngen.runtime import load
+    from dyngen.terms.friction import FRICTION_FIELDS
 
     double = load(folder, cache_dir=tmp / "double")
     single = load(folder, cache_dir=tmp / "float", real="float")
@@ -61,9 +62,14 @@ def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
     def f32(a):
         return np.asarray(a, dtype=np.float32).astype(np.float64)
 
+    def flat(out, rows):  # a function with several outputs (control): each state's outputs side by side
+        outs = out if isinstance(out, tuple) else (out,)
+        return np.concatenate([np.asarray(o, dtype=np.float64).reshape(rows, -1) for o in outs], axis=1)
+
     def compare(name, inputs):
-        d = double.batch(name, *inputs).reshape(len(inputs[0]) if inputs[0].ndim == 2 else 1, -1)
-        f = single.batch(name, *inputs).astype(np.float64).reshape(d.shape)
+        rows = len(inputs[0]) if inputs[0].ndim == 2 else 1
+        d = flat(double.batch(name, *inputs), rows)
+        f = flat(single.batch(name, *inputs), rows)
         scale = np.max(np.abs(d), axis=1)
         err = np.max(np.abs(f - d), axis=1) / np.where(scale > 0, scale, 1.0)
         worst[name] = max(worst.get(name, 0.0), float(err.max()))
@@ -76,10 +82,13 @@ def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
             T = min(CHUNK, per_set - done)
             q = np.where(revolute, rng.uniform(-np.pi, np.pi, (T, n)), rng.uniform(0.2, 1.0, (T, n)))
             values |= {"q": f32(q), "qd": f32(rng.uniform(-2, 2, (T, n))), "qdd": f32(rng.uniform(-5, 5, (T, n))),
+                       "qr_d": f32(rng.uniform(-2, 2, (T, n))), "qr_dd": f32(rng.uniform(-5, 5, (T, n))),
+                       "tau": f32(rng.uniform(-20, 20, (T, n))),
                        "gravity": f32(9.81 * rng.standard_normal((T, n_gravity))),
-                       "f": f32(np.column_stack([rng.uniform(0, 2, (T * n)), rng.uniform(0, 1, T * n),
-                                                 rng.uniform(0, 1, T * n), rng.uniform(0.01, 0.5, T * n),
-                                                 rng.uniform(1e-3, 0.05, T * n)]).reshape(T, -1))}
+                       # friction: per joint its terms' fields (terms/friction.py): values and velocity scales
+                       "f": f32(np.column_stack([rng.uniform(0, 2, T * n) if field.kind == "value" else
+                                                 rng.uniform(1e-3, 0.5, T * n)
+                                                 for field in FRICTION_FIELDS]).reshape(T, -1))}
             for fn in manifest["functions"]:
                 names = [i["name"] for i in fn["inputs"]]
                 if set(names) <= {"p"} and done:

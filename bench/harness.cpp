@@ -23,6 +23,7 @@
 //   mass_matrix  <arm>_mass_matrix                         vs crba
 //   ym_pim       <arm>_regressor_inertia, then Y_m pi_m    vs crba
 //   regressor    <arm>_regressor (n x base coefficients)   vs computeJointTorqueRegressor (n x 10n)
+//   rnea_nominal <arm>_rnea_nominal (the nominal p folded in) vs pinocchio::rnea (CasADi: as for rnea)
 // pi_g and pi_m are computed once from p (<arm>_pi_gravity / _pi_inertia): they are constants
 // of the robot; the matrix-vector product is part of the timed work.
 #include "pinocchio_side.hpp"
@@ -45,11 +46,13 @@ volatile double g_sink;  // every call's result feeds this, so no call can be dr
 
 const double kTolerance = 1e-9;  // |dyngen - pinocchio| / max(1, |pinocchio|)
 
-enum Fn { RNEA, GRAVITY, YG_PIG, MASS_MATRIX, YM_PIM, REGRESSOR, N_FN };
+enum Fn { RNEA, GRAVITY, YG_PIG, MASS_MATRIX, YM_PIM, REGRESSOR, RNEA_NOMINAL, N_FN };
 enum Side { DYNGEN, PINOCCHIO, CASADI, CASADI_BAKED, N_SIDE };
 const char *const kSideNames[N_SIDE] = {"dyngen", "pinocchio", "casadi", "casadi_baked"};
-constexpr bool has_side(int f, int side) { return side < CASADI || f == RNEA || f == GRAVITY || f == MASS_MATRIX; }
-const char *const kFnNames[N_FN] = {"rnea", "gravity", "yg_pig", "mass_matrix", "ym_pim", "regressor"};
+constexpr bool has_side(int f, int side) {
+  return side < CASADI || f == RNEA || f == GRAVITY || f == MASS_MATRIX || f == RNEA_NOMINAL;
+}
+const char *const kFnNames[N_FN] = {"rnea", "gravity", "yg_pig", "mass_matrix", "ym_pim", "regressor", "rnea_nominal"};
 
 int fn_from_name(const std::string &name) {
   for (int f = 0; f < N_FN; ++f)
@@ -141,6 +144,9 @@ inline double dyngen_call(Setup<A> &S, int k) {
   if constexpr (F == RNEA) {
     A::rnea(S.Q(k), S.QD(k), S.QDD(k), S.s.data(), S.out.data());
     for (int i = 0; i < n; ++i) acc += S.out[i];
+  } else if constexpr (F == RNEA_NOMINAL) {
+    A::rnea_nominal(S.Q(k), S.QD(k), S.QDD(k), S.out.data());
+    for (int i = 0; i < n; ++i) acc += S.out[i];
   } else if constexpr (F == GRAVITY) {
     A::gravity(S.Q(k), S.s.data(), S.out.data());
     for (int i = 0; i < n; ++i) acc += S.out[i];
@@ -169,7 +175,7 @@ template <class A, int F, bool Baked>
 inline double casadi_call(Setup<A> &S, int k) {
   const int n = A::n;
   double acc = 0.0;
-  if constexpr (F == RNEA) {
+  if constexpr (F == RNEA || F == RNEA_NOMINAL) {
     if constexpr (Baked) A::casb_rnea(S.Q(k), S.QD(k), S.QDD(k), S.out.data());
     else A::cas_rnea(S.Q(k), S.QD(k), S.QDD(k), S.pin_params.data(), S.out.data());
     for (int i = 0; i < n; ++i) acc += S.out[i];
@@ -193,7 +199,7 @@ template <class A, int F>
 inline double pinocchio_call(Setup<A> &S, int k) {
   const int n = A::n;
   double acc = 0.0;
-  if constexpr (F == RNEA) {
+  if constexpr (F == RNEA || F == RNEA_NOMINAL) {
     const double *t = pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k));
     for (int i = 0; i < n; ++i) acc += t[i];
   } else if constexpr (F == GRAVITY || F == YG_PIG) {
@@ -228,6 +234,8 @@ bool verify(Setup<A> &S, int count, bool print) {
     std::copy(t, t + n, tau.begin());
     A::rnea(S.Q(k), S.QD(k), S.QDD(k), S.s.data(), v.data());
     for (int i = 0; i < n; ++i) err[RNEA] = std::max(err[RNEA], rel_err(v[i], tau[i]));
+    A::rnea_nominal(S.Q(k), S.QD(k), S.QDD(k), v.data());
+    for (int i = 0; i < n; ++i) err[RNEA_NOMINAL] = std::max(err[RNEA_NOMINAL], rel_err(v[i], tau[i]));
     A::regressor(S.Q(k), S.QD(k), S.QDD(k), S.Y.data());
     matvec(S.Y.data(), S.pi_f.data(), n, A::n_pi_full, v.data());
     for (int i = 0; i < n; ++i) err[REGRESSOR] = std::max(err[REGRESSOR], rel_err(v[i], tau[i]));
@@ -379,6 +387,7 @@ int run(const Config &cfg) {
     time_pair<A, MASS_MATRIX>(cfg, S);
     time_pair<A, YM_PIM>(cfg, S);
     time_pair<A, REGRESSOR>(cfg, S);
+    time_pair<A, RNEA_NOMINAL>(cfg, S);
   } else {
     int dyn = 0;
     while (dyn < N_SIDE && cfg.side != kSideNames[dyn]) ++dyn;
@@ -388,6 +397,7 @@ int run(const Config &cfg) {
       case YG_PIG: g_sink = call_many<A, YG_PIG>(S, dyn, cfg.calls); break;
       case MASS_MATRIX: g_sink = call_many<A, MASS_MATRIX>(S, dyn, cfg.calls); break;
       case YM_PIM: g_sink = call_many<A, YM_PIM>(S, dyn, cfg.calls); break;
+      case RNEA_NOMINAL: g_sink = call_many<A, RNEA_NOMINAL>(S, dyn, cfg.calls); break;
       default: g_sink = call_many<A, REGRESSOR>(S, dyn, cfg.calls); break;
     }
   }
@@ -399,7 +409,7 @@ int usage() {
   std::fprintf(stderr,
                "usage: harness time MODELS_DIR STATES BATCHES WARMUP\n"
                "       harness callgrind MODELS_DIR STATES ARM "
-               "{rnea|gravity|yg_pig|mass_matrix|ym_pim|regressor} {dyngen|pinocchio|casadi|casadi_baked} CALLS\n");
+               "{rnea|gravity|yg_pig|mass_matrix|ym_pim|regressor|rnea_nominal} {dyngen|pinocchio|casadi|casadi_baked} CALLS\n");
   return 1;
 }
 

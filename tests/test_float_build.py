@@ -57,6 +57,7 @@ def test_float_build_agrees_with_double(built, tmp_path_factory):
             q, qd, qdd = float_inputs(rng.uniform(-np.pi, np.pi, n), rng.uniform(-2, 2, n), rng.uniform(-5, 5, n))
             g = float_inputs(*gravity)
             compare("rnea", q, qd, qdd, s, *g)
+            compare("rnea_nominal", q, qd, qdd, *g)
             compare("gravity", q, s, *g)
             compare("mass_matrix", q, s)
             compare("regressor_gravity", q, *g)

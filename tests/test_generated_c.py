@@ -108,6 +108,21 @@ def test_inverse_dynamics_over_base_coefficients(built):
     assert all(err < TOL for err in worst.values()), worst
 
 
+def test_rnea_nominal_is_rnea_at_the_nominal_parameters(built):
+    """rnea_nominal (the YAML's nominal parameters folded in as numbers) against rnea with s(p)
+    and Pinocchio's rnea at the same p, oracles' reading of the YAML, 1000 random states."""
+    rng = np.random.default_rng(12)
+    p = built.nominal
+    s = built.c("standard_from_dynamic", p)
+    worst = {"rnea": 0.0, "pinocchio": 0.0}
+    for _ in range(1000):
+        q, qd, qdd = random_state(built, rng)
+        tau = built.c("rnea_nominal", q, qd, qdd)
+        worst["rnea"] = max(worst["rnea"], rel_err(tau, built.c("rnea", q, qd, qdd, s)))
+        worst["pinocchio"] = max(worst["pinocchio"], rel_err(tau, pin_arm.rnea(built.arm, p, q, qd, qdd)))
+    assert all(err < TOL for err in worst.values()), worst
+
+
 def test_joint_angles_far_from_zero_and_on_quadrant_edges(lwr):
     """The generated sincos (reduction by pi/2, then polynomials, libm's beyond |q| = 1e5) at
     angles of every size and next to the edges between its quadrants, against numpy's sin and

@@ -30,6 +30,7 @@
  *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 6 sin/cos
  *   lwr_regressor                696 mul, 420 add, 0 div, 6 sin/cos
  *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
+ *   lwr_rnea_nominal             256 mul, 249 add, 0 div, 6 sin/cos
  *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
  *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
  *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
@@ -207,6 +208,15 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
  * 299 mul, 339 add, 0 div, 6 sin/cos
  */
 void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *tau);
+
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p).
+ *   q        [7]  joint positions [rad or m]
+ *   qd       [7]  joint velocities
+ *   qdd      [7]  joint accelerations
+ *   tau      [7]  joint torques/forces (written)
+ * 256 mul, 249 add, 0 div, 6 sin/cos
+ */
+void lwr_rnea_nominal(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *tau);
 
 /* Gravity vector g(q).
  *   q        [7]  joint positions [rad or m]

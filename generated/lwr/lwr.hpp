@@ -282,6 +282,22 @@ inline Joints rnea(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &
     return tau;
 }
 
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p).
+ * lwr_rnea_nominal(q: Joints, qd: Joints, qdd: Joints, tau: Joints written) */
+template <typename A0, typename A1, typename A2, typename Out0>
+inline void rnea_nominal(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd, const Eigen::MatrixBase<Out0> &tau)
+{
+    lwr_rnea_nominal(detail::in<Joints>(q), detail::in<Joints>(qd), detail::in<Joints>(qdd), detail::out<Joints>(tau));
+}
+
+template <typename A0, typename A1, typename A2>
+inline Joints rnea_nominal(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &qdd)
+{
+    Joints tau;
+    rnea_nominal(q, qd, qdd, tau);
+    return tau;
+}
+
 /* Gravity vector g(q).
  * lwr_gravity(q: Joints, s: Parameters, g: Joints written) */
 template <typename A0, typename A1, typename Out0>

@@ -11,19 +11,6 @@
 /* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once. */
 void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c)
 {
-    /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
     /* base coefficients pi_gravity = K s */
     const lwr_real x0 = s[20] + s[30] + s[40] + s[50] + s[60];
     const lwr_real x1 = LWR_K(0.4)*x0;
@@ -35,74 +22,86 @@ void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_r
     const lwr_real x7 = -s[52] + s[43];
     const lwr_real x8 = s[53] + s[63];
     /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x9 = LWR_K(9.81)*s2;
     const lwr_real x10 = LWR_K(9.81)*c2;
-    /* link 3: velocities and accelerations */
-    const lwr_real x11 = c3*x9;
-    const lwr_real x12 = -s3*x9;
-    /* link 4: velocities and accelerations */
-    const lwr_real x13 = c4*x11 - s4*x10;
-    const lwr_real x14 = c4*x10 + s4*x11;
-    /* link 5: velocities and accelerations */
-    const lwr_real x15 = c5*x13 + s5*x12;
-    const lwr_real x16 = -c5*x12 + s5*x13;
-    /* link 6: velocities and accelerations */
-    const lwr_real x17 = c6*x15 + s6*x14;
-    const lwr_real x18 = c6*x14 - s6*x15;
-    /* link 7: velocities and accelerations */
-    const lwr_real x19 = c7*x17 - s7*x16;
-    const lwr_real x20 = -c7*x16 - s7*x17;
     /* link 2: link wrench */
-    const lwr_real x21 = -s[11]*x10 + x2*x9;
+    const lwr_real x11 = -s[11]*x10 + x2*x9;
+    /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
+    const lwr_real x12 = c3*x9;
+    const lwr_real x13 = -s3*x9;
     /* link 3: link wrench */
-    const lwr_real x22 = x10*x3;
-    const lwr_real x23 = -s[21]*x12 + x11*x3;
-    const lwr_real x24 = -s[21]*x10;
+    const lwr_real x14 = x10*x3;
+    const lwr_real x15 = -s[21]*x13 + x12*x3;
+    const lwr_real x16 = -s[21]*x10;
+    /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
+    const lwr_real x17 = c4*x12 - s4*x10;
+    const lwr_real x18 = c4*x10 + s4*x12;
     /* link 4: link wrench */
-    const lwr_real x25 = -x12*x6;
-    const lwr_real x26 = -s[31]*x14 + x13*x6;
-    const lwr_real x27 = s[31]*x12;
+    const lwr_real x19 = -x13*x6;
+    const lwr_real x20 = -s[31]*x18 + x17*x6;
+    const lwr_real x21 = s[31]*x13;
+    /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
+    const lwr_real x22 = c5*x17 + s5*x13;
+    const lwr_real x23 = -c5*x13 + s5*x17;
     /* link 5: link wrench */
-    const lwr_real x28 = -x14*x7;
-    const lwr_real x29 = -s[41]*x16 + x15*x7;
-    const lwr_real x30 = s[41]*x14;
+    const lwr_real x24 = -x18*x7;
+    const lwr_real x25 = -s[41]*x23 + x22*x7;
+    const lwr_real x26 = s[41]*x18;
+    /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
+    const lwr_real x27 = c6*x22 + s6*x18;
+    const lwr_real x28 = c6*x18 - s6*x22;
     /* link 6: link wrench */
-    const lwr_real x31 = x16*x8;
-    const lwr_real x32 = -s[51]*x18 + x17*x8;
-    const lwr_real x33 = -s[51]*x16;
+    const lwr_real x29 = x23*x8;
+    const lwr_real x30 = -s[51]*x28 + x27*x8;
+    const lwr_real x31 = -s[51]*x23;
+    /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
+    const lwr_real x32 = c7*x27 - s7*x23;
+    const lwr_real x33 = -c7*x23 - s7*x27;
     /* link 7: link wrench */
-    const lwr_real x34 = s[62]*x18;
-    const lwr_real x35 = -s[61]*x18;
-    const lwr_real x36 = s[61]*x20 - s[62]*x19;
+    const lwr_real x34 = s[62]*x28;
+    const lwr_real x35 = -s[61]*x28;
+    const lwr_real x36 = s[61]*x33 - s[62]*x32;
     /* link 7: forces */
     const lwr_real x37 = c7*x34 - s7*x35;
     const lwr_real x38 = c7*x35 + s7*x34;
     /* link 6: forces */
-    const lwr_real x39 = x31 + x37;
-    const lwr_real x40 = x32 + x38;
-    const lwr_real x41 = x33 + x36;
+    const lwr_real x39 = x29 + x37;
+    const lwr_real x40 = x30 + x38;
+    const lwr_real x41 = x31 + x36;
     const lwr_real x42 = c6*x39 - s6*x41;
     const lwr_real x43 = c6*x41 + s6*x39;
     /* link 5: forces */
-    const lwr_real x44 = x28 + x42;
-    const lwr_real x45 = x29 + x43;
-    const lwr_real x46 = x30 - x40;
+    const lwr_real x44 = x24 + x42;
+    const lwr_real x45 = x25 + x43;
+    const lwr_real x46 = x26 - x40;
     const lwr_real x47 = c5*x44 + s5*x46;
     const lwr_real x48 = -c5*x46 + s5*x44;
     /* link 4: forces */
-    const lwr_real x49 = x25 + x47;
-    const lwr_real x50 = x26 + x48;
-    const lwr_real x51 = x27 + x45;
+    const lwr_real x49 = x19 + x47;
+    const lwr_real x50 = x20 + x48;
+    const lwr_real x51 = x21 + x45;
     const lwr_real x52 = c4*x49 + s4*x51;
     const lwr_real x53 = -c4*x51 + s4*x49;
     /* link 3: forces */
-    const lwr_real x54 = x22 + x52;
-    const lwr_real x55 = x23 + x53;
-    const lwr_real x56 = x24 + x50;
+    const lwr_real x54 = x14 + x52;
+    const lwr_real x55 = x15 + x53;
+    const lwr_real x56 = x16 + x50;
     const lwr_real x57 = c3*x54 - s3*x56;
     const lwr_real x58 = c3*x56 + s3*x54;
     /* link 2: forces */
-    const lwr_real x59 = x21 + x58;
+    const lwr_real x59 = x11 + x58;
     const lwr_real x60 = -c2*x55 + s2*x57;
     /* base coefficients pi_inertia = K s */
     const lwr_real x61 = s[7] + s[19];
@@ -544,21 +543,6 @@ void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_r
 /* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call. */
 void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c, lwr_real *J, lwr_real *jdot_qd)
 {
-    /* joint angles */
-    lwr_real s1, c1;
-    LWR_SINCOS(q[0], &s1, &c1);
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
     /* base coefficients pi_gravity = K s */
     const lwr_real x0 = s[20] + s[30] + s[40] + s[50] + s[60];
     const lwr_real x1 = LWR_K(0.4)*x0;
@@ -570,74 +554,86 @@ void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_
     const lwr_real x7 = -s[52] + s[43];
     const lwr_real x8 = s[53] + s[63];
     /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x9 = LWR_K(9.81)*s2;
     const lwr_real x10 = LWR_K(9.81)*c2;
-    /* link 3: velocities and accelerations */
-    const lwr_real x11 = c3*x9;
-    const lwr_real x12 = -s3*x9;
-    /* link 4: velocities and accelerations */
-    const lwr_real x13 = c4*x11 - s4*x10;
-    const lwr_real x14 = c4*x10 + s4*x11;
-    /* link 5: velocities and accelerations */
-    const lwr_real x15 = c5*x13 + s5*x12;
-    const lwr_real x16 = -c5*x12 + s5*x13;
-    /* link 6: velocities and accelerations */
-    const lwr_real x17 = c6*x15 + s6*x14;
-    const lwr_real x18 = c6*x14 - s6*x15;
-    /* link 7: velocities and accelerations */
-    const lwr_real x19 = c7*x17 - s7*x16;
-    const lwr_real x20 = -c7*x16 - s7*x17;
     /* link 2: link wrench */
-    const lwr_real x21 = -s[11]*x10 + x2*x9;
+    const lwr_real x11 = -s[11]*x10 + x2*x9;
+    /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
+    const lwr_real x12 = c3*x9;
+    const lwr_real x13 = -s3*x9;
     /* link 3: link wrench */
-    const lwr_real x22 = x10*x3;
-    const lwr_real x23 = -s[21]*x12 + x11*x3;
-    const lwr_real x24 = -s[21]*x10;
+    const lwr_real x14 = x10*x3;
+    const lwr_real x15 = -s[21]*x13 + x12*x3;
+    const lwr_real x16 = -s[21]*x10;
+    /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
+    const lwr_real x17 = c4*x12 - s4*x10;
+    const lwr_real x18 = c4*x10 + s4*x12;
     /* link 4: link wrench */
-    const lwr_real x25 = -x12*x6;
-    const lwr_real x26 = -s[31]*x14 + x13*x6;
-    const lwr_real x27 = s[31]*x12;
+    const lwr_real x19 = -x13*x6;
+    const lwr_real x20 = -s[31]*x18 + x17*x6;
+    const lwr_real x21 = s[31]*x13;
+    /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
+    const lwr_real x22 = c5*x17 + s5*x13;
+    const lwr_real x23 = -c5*x13 + s5*x17;
     /* link 5: link wrench */
-    const lwr_real x28 = -x14*x7;
-    const lwr_real x29 = -s[41]*x16 + x15*x7;
-    const lwr_real x30 = s[41]*x14;
+    const lwr_real x24 = -x18*x7;
+    const lwr_real x25 = -s[41]*x23 + x22*x7;
+    const lwr_real x26 = s[41]*x18;
+    /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
+    const lwr_real x27 = c6*x22 + s6*x18;
+    const lwr_real x28 = c6*x18 - s6*x22;
     /* link 6: link wrench */
-    const lwr_real x31 = x16*x8;
-    const lwr_real x32 = -s[51]*x18 + x17*x8;
-    const lwr_real x33 = -s[51]*x16;
+    const lwr_real x29 = x23*x8;
+    const lwr_real x30 = -s[51]*x28 + x27*x8;
+    const lwr_real x31 = -s[51]*x23;
+    /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
+    const lwr_real x32 = c7*x27 - s7*x23;
+    const lwr_real x33 = -c7*x23 - s7*x27;
     /* link 7: link wrench */
-    const lwr_real x34 = s[62]*x18;
-    const lwr_real x35 = -s[61]*x18;
-    const lwr_real x36 = s[61]*x20 - s[62]*x19;
+    const lwr_real x34 = s[62]*x28;
+    const lwr_real x35 = -s[61]*x28;
+    const lwr_real x36 = s[61]*x33 - s[62]*x32;
     /* link 7: forces */
     const lwr_real x37 = c7*x34 - s7*x35;
     const lwr_real x38 = c7*x35 + s7*x34;
     /* link 6: forces */
-    const lwr_real x39 = x31 + x37;
-    const lwr_real x40 = x32 + x38;
-    const lwr_real x41 = x33 + x36;
+    const lwr_real x39 = x29 + x37;
+    const lwr_real x40 = x30 + x38;
+    const lwr_real x41 = x31 + x36;
     const lwr_real x42 = c6*x39 - s6*x41;
     const lwr_real x43 = c6*x41 + s6*x39;
     /* link 5: forces */
-    const lwr_real x44 = x28 + x42;
-    const lwr_real x45 = x29 + x43;
-    const lwr_real x46 = x30 - x40;
+    const lwr_real x44 = x24 + x42;
+    const lwr_real x45 = x25 + x43;
+    const lwr_real x46 = x26 - x40;
     const lwr_real x47 = c5*x44 + s5*x46;
     const lwr_real x48 = -c5*x46 + s5*x44;
     /* link 4: forces */
-    const lwr_real x49 = x25 + x47;
-    const lwr_real x50 = x26 + x48;
-    const lwr_real x51 = x27 + x45;
+    const lwr_real x49 = x19 + x47;
+    const lwr_real x50 = x20 + x48;
+    const lwr_real x51 = x21 + x45;
     const lwr_real x52 = c4*x49 + s4*x51;
     const lwr_real x53 = -c4*x51 + s4*x49;
     /* link 3: forces */
-    const lwr_real x54 = x22 + x52;
-    const lwr_real x55 = x23 + x53;
-    const lwr_real x56 = x24 + x50;
+    const lwr_real x54 = x14 + x52;
+    const lwr_real x55 = x15 + x53;
+    const lwr_real x56 = x16 + x50;
     const lwr_real x57 = c3*x54 - s3*x56;
     const lwr_real x58 = c3*x56 + s3*x54;
     /* link 2: forces */
-    const lwr_real x59 = x21 + x58;
+    const lwr_real x59 = x11 + x58;
     const lwr_real x60 = -c2*x55 + s2*x57;
     /* base coefficients pi_inertia = K s */
     const lwr_real x61 = s[7] + s[19];
@@ -1009,6 +1005,8 @@ void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_
     const lwr_real x381 = x305 - x373;
     const lwr_real x382 = c2*x381 + s2*x379;
     /* link 2: pose */
+    lwr_real s1, c1;
+    LWR_SINCOS(q[0], &s1, &c1);
     const lwr_real x383 = c1*c2;
     const lwr_real x384 = -c1*s2;
     const lwr_real x385 = c2*s1;

@@ -12,19 +12,6 @@
 void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *C)
 {
     /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* joint angles */
     const lwr_real x0 = LWR_K(0.5)*qd[0];
     const lwr_real x1 = LWR_K(0.5)*qd[1];
     const lwr_real x2 = LWR_K(0.5)*qd[2];
@@ -33,6 +20,8 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
     const lwr_real x5 = LWR_K(0.5)*qd[5];
     const lwr_real x6 = LWR_K(0.5)*qd[6];
     /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x7 = s2*x0;
     const lwr_real x8 = c2*x0;
     const lwr_real x9 = c2*x1;
@@ -41,6 +30,8 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
     const lwr_real x12 = c2*x7 + s2*x8;
     const lwr_real x13 = 2*c2*x8;
     /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x14 = c3*x7 - s3*x1;
     const lwr_real x15 = -c3*x1 - s3*x7;
     const lwr_real x16 = c3*s2;
@@ -67,6 +58,8 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
     const lwr_real x37 = -LWR_K(0.4)*x30;
     const lwr_real x38 = -LWR_K(0.4)*x35;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x39 = c4*x14 + s4*x20;
     const lwr_real x40 = -c4*x20 + s4*x14;
     const lwr_real x41 = -c2*s4 + c4*x16;
@@ -94,6 +87,8 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
     const lwr_real x63 = -x22 + x52;
     const lwr_real x64 = x48 + x54;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x65 = c5*x39 + s5*x47;
     const lwr_real x66 = -c5*x47 + s5*x39;
     const lwr_real x67 = c5*x41 + s5*x17;
@@ -124,6 +119,8 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
     const lwr_real x92 = x46 + LWR_K(0.39)*x83;
     const lwr_real x93 = x72 + LWR_K(0.39)*x90;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x94 = c6*x65 + s6*x73;
     const lwr_real x95 = c6*x73 - s6*x65;
     const lwr_real x96 = c6*x67 + s6*x42;
@@ -151,6 +148,8 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
     const lwr_real x118 = x107 + x75;
     const lwr_real x119 = x103 + x109;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x120 = c7*x94 + s7*x102;
     const lwr_real x121 = c7*x102 - s7*x94;
     const lwr_real x122 = c7*x96 - s7*x68;
@@ -1060,19 +1059,6 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
 void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *Mdot)
 {
     /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* joint angles */
     const lwr_real x0 = LWR_K(0.5)*qd[0];
     const lwr_real x1 = LWR_K(0.5)*qd[1];
     const lwr_real x2 = LWR_K(0.5)*qd[2];
@@ -1081,6 +1067,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x5 = LWR_K(0.5)*qd[5];
     const lwr_real x6 = LWR_K(0.5)*qd[6];
     /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x7 = s2*x0;
     const lwr_real x8 = c2*x0;
     const lwr_real x9 = c2*x1;
@@ -1089,6 +1077,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x12 = c2*x7 + s2*x8;
     const lwr_real x13 = 2*c2*x8;
     /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x14 = c3*x7 - s3*x1;
     const lwr_real x15 = -c3*x1 - s3*x7;
     const lwr_real x16 = c3*s2;
@@ -1115,6 +1105,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x37 = -LWR_K(0.4)*x30;
     const lwr_real x38 = -LWR_K(0.4)*x35;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x39 = c4*x14 + s4*x20;
     const lwr_real x40 = -c4*x20 + s4*x14;
     const lwr_real x41 = -c2*s4 + c4*x16;
@@ -1142,6 +1134,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x63 = -x22 + x52;
     const lwr_real x64 = x48 + x54;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x65 = c5*x39 + s5*x47;
     const lwr_real x66 = -c5*x47 + s5*x39;
     const lwr_real x67 = c5*x41 + s5*x17;
@@ -1172,6 +1166,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x92 = x46 + LWR_K(0.39)*x83;
     const lwr_real x93 = x72 + LWR_K(0.39)*x90;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x94 = c6*x65 + s6*x73;
     const lwr_real x95 = c6*x73 - s6*x65;
     const lwr_real x96 = c6*x67 + s6*x42;
@@ -1199,6 +1195,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x118 = x107 + x75;
     const lwr_real x119 = x103 + x109;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x120 = c7*x94 + s7*x102;
     const lwr_real x121 = c7*x102 - s7*x94;
     const lwr_real x122 = c7*x96 - s7*x68;

@@ -11,20 +11,9 @@
 /* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd). */
 void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *D)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 2: velocities and accelerations */
     const lwr_real x0 = qd[0]*s2;
     const lwr_real x1 = c2*qd[0];
     const lwr_real x2 = qdd[0]*s2;
@@ -40,6 +29,8 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x12 = -qd[1]*x1;
     const lwr_real x13 = x1*x1;
     /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x14 = c3*x0 - qd[1]*s3;
     const lwr_real x15 = -c3*qd[1] - s3*x0;
     const lwr_real x16 = c3*x6 - qdd[1]*s3;
@@ -67,6 +58,8 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x38 = -LWR_K(0.4)*x31 - x5;
     const lwr_real x39 = x19 - LWR_K(0.4)*x36;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x40 = c4*x14 + s4*x20;
     const lwr_real x41 = -c4*x20 + s4*x14;
     const lwr_real x42 = c4*x21 + s4*x22;
@@ -93,6 +86,8 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x63 = -x48 + x52;
     const lwr_real x64 = x47 + x54;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x65 = c5*x40 + s5*x46;
     const lwr_real x66 = -c5*x46 + s5*x40;
     const lwr_real x67 = c5*x47 + s5*x48;
@@ -122,6 +117,8 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x91 = x45 + LWR_K(0.39)*x82;
     const lwr_real x92 = LWR_K(0.39)*x89 + x70;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x93 = c6*x65 + s6*x71;
     const lwr_real x94 = c6*x71 - s6*x65;
     const lwr_real x95 = c6*x72 + s6*x73;
@@ -148,6 +145,8 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x116 = -x101 + x105;
     const lwr_real x117 = x100 + x107;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x118 = c7*x93 + s7*x99;
     const lwr_real x119 = c7*x99 - s7*x93;
     const lwr_real x120 = c7*x100 + s7*x101;
@@ -1967,30 +1966,25 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
 /* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1). */
 void lwr_forward_dynamics_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *D)
 {
-    /* joint angles */
+    /* link 3: velocities and accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
     lwr_real s3, c3;
     LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 3: velocities and accelerations */
     const lwr_real x0 = c3*s2;
     const lwr_real x1 = -s2*s3;
     const lwr_real x2 = LWR_K(0.4)*x1;
     const lwr_real x3 = -LWR_K(0.4)*x0;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x4 = -c2*s4 + c4*x0;
     const lwr_real x5 = c2*c4 + s4*x0;
     const lwr_real x6 = c4*x2;
     const lwr_real x7 = s4*x2;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x8 = c5*x4 + s5*x1;
     const lwr_real x9 = -c5*x1 + s5*x4;
     const lwr_real x10 = c5*x6 + s5*x3;
@@ -1998,11 +1992,15 @@ void lwr_forward_dynamics_derivatives(const lwr_real *q, const lwr_real *qd, con
     const lwr_real x12 = x10 - LWR_K(0.39)*x9;
     const lwr_real x13 = x11 + LWR_K(0.39)*x8;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x14 = c6*x8 + s6*x5;
     const lwr_real x15 = c6*x5 - s6*x8;
     const lwr_real x16 = c6*x12 + s6*x7;
     const lwr_real x17 = c6*x7 - s6*x12;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x18 = c7*x14 - s7*x9;
     const lwr_real x19 = -c7*x9 - s7*x14;
     const lwr_real x20 = c7*x16 - s7*x13;

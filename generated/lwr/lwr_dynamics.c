@@ -4,6 +4,7 @@
  * Conventions, shapes and parameter orders: lwr.h.
  *
  *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
+ *   lwr_rnea_nominal             256 mul, 249 add, 0 div, 6 sin/cos
  *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
  *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
  *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
@@ -13,19 +14,6 @@
 /* Inverse dynamics tau = M(q) qdd + c(q, qd) + g(q), recursive Newton-Euler. */
 void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *tau)
 {
-    /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
     /* base coefficients pi_full = K s */
     const lwr_real x0 = s[7] + s[19];
     const lwr_real x1 = s[20] + s[30] + s[40] + s[50] + s[60];
@@ -52,209 +40,221 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
     const lwr_real x22 = s[54] + s[67] - s[59];
     const lwr_real x23 = s[57] + s[67];
     const lwr_real x24 = s[64] - s[67];
-    /* link 2: velocities and accelerations */
-    const lwr_real x25 = qd[0]*s2;
-    const lwr_real x26 = c2*qd[0];
-    const lwr_real x27 = qdd[0]*s2;
-    const lwr_real x28 = c2*qdd[0];
-    const lwr_real x29 = LWR_K(9.81)*s2;
-    const lwr_real x30 = LWR_K(9.81)*c2;
-    const lwr_real x31 = qd[1]*x26 + x27;
-    const lwr_real x32 = -qd[1]*x25 + x28;
-    const lwr_real x33 = x25*x25;
-    const lwr_real x34 = -qd[1]*x25;
-    const lwr_real x35 = x25*x26;
-    const lwr_real x36 = qd[1]*qd[1];
-    const lwr_real x37 = -qd[1]*x26;
-    const lwr_real x38 = x26*x26;
-    /* link 3: velocities and accelerations */
-    const lwr_real x39 = c3*x25 - qd[1]*s3;
-    const lwr_real x40 = -c3*qd[1] - s3*x25;
-    const lwr_real x41 = c3*x31 - qdd[1]*s3;
-    const lwr_real x42 = -c3*qdd[1] - s3*x31;
-    const lwr_real x43 = c3*x29;
-    const lwr_real x44 = -s3*x29;
-    const lwr_real x45 = -qd[2] - x26;
-    const lwr_real x46 = qd[2]*x40 + x41;
-    const lwr_real x47 = -qdd[2] - x32;
-    const lwr_real x48 = -qd[2]*x39 + x42;
-    const lwr_real x49 = x39*x39;
-    const lwr_real x50 = x39*x45;
-    const lwr_real x51 = x39*x40;
-    const lwr_real x52 = x45*x45;
-    const lwr_real x53 = x40*x45;
-    const lwr_real x54 = x40*x40;
-    const lwr_real x55 = -x52 - x54;
-    const lwr_real x56 = -x49 - x54;
-    const lwr_real x57 = -x49 - x52;
-    const lwr_real x58 = -x48 + x50;
-    const lwr_real x59 = x47 + x51;
-    const lwr_real x60 = -x47 + x51;
-    const lwr_real x61 = x46 + x53;
-    const lwr_real x62 = x43 - LWR_K(0.4)*x58;
-    const lwr_real x63 = -x30 - LWR_K(0.4)*x56;
-    const lwr_real x64 = x44 - LWR_K(0.4)*x61;
-    /* link 4: velocities and accelerations */
-    const lwr_real x65 = c4*x39 + s4*x45;
-    const lwr_real x66 = -c4*x45 + s4*x39;
-    const lwr_real x67 = c4*x46 + s4*x47;
-    const lwr_real x68 = -c4*x47 + s4*x46;
-    const lwr_real x69 = c4*x62 + s4*x63;
-    const lwr_real x70 = -c4*x63 + s4*x62;
-    const lwr_real x71 = qd[3] + x40;
-    const lwr_real x72 = -qd[3]*x66 + x67;
-    const lwr_real x73 = qdd[3] + x48;
-    const lwr_real x74 = qd[3]*x65 + x68;
-    const lwr_real x75 = x65*x65;
-    const lwr_real x76 = x65*x71;
-    const lwr_real x77 = x65*x66;
-    const lwr_real x78 = x71*x71;
-    const lwr_real x79 = x66*x71;
-    const lwr_real x80 = x66*x66;
-    const lwr_real x81 = -x78 - x80;
-    const lwr_real x82 = -x75 - x78;
-    const lwr_real x83 = x73 + x77;
-    const lwr_real x84 = x74 + x76;
-    const lwr_real x85 = -x72 + x79;
-    const lwr_real x86 = -x73 + x77;
-    /* link 5: velocities and accelerations */
-    const lwr_real x87 = c5*x65 + s5*x71;
-    const lwr_real x88 = -c5*x71 + s5*x65;
-    const lwr_real x89 = c5*x72 + s5*x73;
-    const lwr_real x90 = -c5*x73 + s5*x72;
-    const lwr_real x91 = c5*x69 + s5*x64;
-    const lwr_real x92 = -c5*x64 + s5*x69;
-    const lwr_real x93 = qd[4] + x66;
-    const lwr_real x94 = -qd[4]*x88 + x89;
-    const lwr_real x95 = qdd[4] + x74;
-    const lwr_real x96 = qd[4]*x87 + x90;
-    const lwr_real x97 = x87*x87;
-    const lwr_real x98 = x87*x93;
-    const lwr_real x99 = x87*x88;
-    const lwr_real x100 = x93*x93;
-    const lwr_real x101 = x88*x93;
-    const lwr_real x102 = x88*x88;
-    const lwr_real x103 = -x100 - x102;
-    const lwr_real x104 = -x97 - x102;
-    const lwr_real x105 = -x97 - x100;
-    const lwr_real x106 = -x96 + x98;
-    const lwr_real x107 = x95 + x99;
-    const lwr_real x108 = x96 + x98;
-    const lwr_real x109 = -x94 + x101;
-    const lwr_real x110 = -x95 + x99;
-    const lwr_real x111 = x94 + x101;
-    const lwr_real x112 = x91 + LWR_K(0.39)*x106;
-    const lwr_real x113 = LWR_K(0.39)*x104 + x70;
-    const lwr_real x114 = x92 + LWR_K(0.39)*x111;
-    /* link 6: velocities and accelerations */
-    const lwr_real x115 = c6*x87 + s6*x93;
-    const lwr_real x116 = c6*x93 - s6*x87;
-    const lwr_real x117 = c6*x94 + s6*x95;
-    const lwr_real x118 = c6*x95 - s6*x94;
-    const lwr_real x119 = c6*x112 + s6*x113;
-    const lwr_real x120 = c6*x113 - s6*x112;
-    const lwr_real x121 = -qd[5] - x88;
-    const lwr_real x122 = qd[5]*x116 + x117;
-    const lwr_real x123 = -qdd[5] - x96;
-    const lwr_real x124 = -qd[5]*x115 + x118;
-    const lwr_real x125 = x115*x115;
-    const lwr_real x126 = x115*x121;
-    const lwr_real x127 = x115*x116;
-    const lwr_real x128 = x121*x121;
-    const lwr_real x129 = x116*x121;
-    const lwr_real x130 = x116*x116;
-    const lwr_real x131 = -x128 - x130;
-    const lwr_real x132 = -x125 - x128;
-    const lwr_real x133 = x123 + x127;
-    const lwr_real x134 = x124 + x126;
-    const lwr_real x135 = -x122 + x129;
-    const lwr_real x136 = -x123 + x127;
-    /* link 7: velocities and accelerations */
-    const lwr_real x137 = c7*x115 + s7*x121;
-    const lwr_real x138 = c7*x121 - s7*x115;
-    const lwr_real x139 = c7*x122 + s7*x123;
-    const lwr_real x140 = c7*x123 - s7*x122;
-    const lwr_real x141 = c7*x119 - s7*x114;
-    const lwr_real x142 = -c7*x114 - s7*x119;
-    const lwr_real x143 = qd[6] + x116;
-    const lwr_real x144 = qd[6]*x138 + x139;
-    const lwr_real x145 = -qd[6]*x137 + x140;
-    const lwr_real x146 = qdd[6] + x124;
-    const lwr_real x147 = x137*x137;
-    const lwr_real x148 = x137*x138;
-    const lwr_real x149 = x137*x143;
-    const lwr_real x150 = x138*x138;
-    const lwr_real x151 = x138*x143;
-    const lwr_real x152 = x143*x143;
-    const lwr_real x153 = -x150 - x152;
-    const lwr_real x154 = -x147 - x152;
-    const lwr_real x155 = -x146 + x148;
-    const lwr_real x156 = x146 + x148;
-    const lwr_real x157 = -x145 + x149;
-    const lwr_real x158 = x144 + x151;
     /* link 1: link wrench */
-    const lwr_real x159 = qdd[0]*x0;
+    const lwr_real x25 = qdd[0]*x0;
+    /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
+    const lwr_real x26 = qd[0]*s2;
+    const lwr_real x27 = c2*qd[0];
+    const lwr_real x28 = qdd[0]*s2;
+    const lwr_real x29 = c2*qdd[0];
+    const lwr_real x30 = LWR_K(9.81)*s2;
+    const lwr_real x31 = LWR_K(9.81)*c2;
+    const lwr_real x32 = qd[1]*x27 + x28;
+    const lwr_real x33 = -qd[1]*x26 + x29;
+    const lwr_real x34 = x26*x26;
+    const lwr_real x35 = -qd[1]*x26;
+    const lwr_real x36 = x26*x27;
+    const lwr_real x37 = qd[1]*qd[1];
+    const lwr_real x38 = -qd[1]*x27;
+    const lwr_real x39 = x27*x27;
     /* link 2: link wrench */
-    const lwr_real x160 = s[15]*(-qdd[1] - x35) + (s[16]*(x32 + x34) + (s[18]*(x36 - x38) + x31*x6 - x37*x7));
-    const lwr_real x161 = s[15]*(x31 + x37) + (s[18]*(x32 - x34) + (s[16]*(-x33 + x38) - s[11]*x30 - qdd[1]*x7 + x3*x29 + x35*x6));
-    const lwr_real x162 = s[16]*(x31 - x37) + (s[18]*(-qdd[1] + x35) + (s[15]*(x33 - x36) + x34*(-x6 + x7)));
+    const lwr_real x40 = s[15]*(-qdd[1] - x36) + (s[16]*(x33 + x35) + (s[18]*(x37 - x39) + x32*x6 - x38*x7));
+    const lwr_real x41 = s[15]*(x32 + x38) + (s[18]*(x33 - x35) + (s[16]*(-x34 + x39) - s[11]*x31 - qdd[1]*x7 + x3*x30 + x36*x6));
+    const lwr_real x42 = s[16]*(x32 - x38) + (s[18]*(-qdd[1] + x36) + (s[15]*(x34 - x37) + x35*(-x6 + x7)));
+    /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
+    const lwr_real x43 = c3*x26 - qd[1]*s3;
+    const lwr_real x44 = -c3*qd[1] - s3*x26;
+    const lwr_real x45 = c3*x32 - qdd[1]*s3;
+    const lwr_real x46 = -c3*qdd[1] - s3*x32;
+    const lwr_real x47 = c3*x30;
+    const lwr_real x48 = -s3*x30;
+    const lwr_real x49 = -qd[2] - x27;
+    const lwr_real x50 = qd[2]*x44 + x45;
+    const lwr_real x51 = -qdd[2] - x33;
+    const lwr_real x52 = -qd[2]*x43 + x46;
+    const lwr_real x53 = x43*x43;
+    const lwr_real x54 = x43*x49;
+    const lwr_real x55 = x43*x44;
+    const lwr_real x56 = x49*x49;
+    const lwr_real x57 = x44*x49;
+    const lwr_real x58 = x44*x44;
+    const lwr_real x59 = -x56 - x58;
+    const lwr_real x60 = -x53 - x58;
+    const lwr_real x61 = -x53 - x56;
+    const lwr_real x62 = -x52 + x54;
+    const lwr_real x63 = x51 + x55;
+    const lwr_real x64 = -x51 + x55;
+    const lwr_real x65 = x50 + x57;
+    const lwr_real x66 = x47 - LWR_K(0.4)*x62;
+    const lwr_real x67 = -x31 - LWR_K(0.4)*x60;
+    const lwr_real x68 = x48 - LWR_K(0.4)*x65;
     /* link 3: link wrench */
-    const lwr_real x163 = s[21]*x55 + x59*x8;
-    const lwr_real x164 = s[21]*x60 + x57*x8;
-    const lwr_real x165 = s[25]*(x47 - x51) + (s[26]*(x48 + x50) + (s[28]*(x52 - x54) - x10*x53 + x46*x9 - x63*x8));
-    const lwr_real x166 = s[25]*(x46 + x53) + (s[28]*(x48 - x50) + (s[26]*(-x49 + x54) - s[21]*x64 + x10*x47 + x51*x9 + x62*x8));
-    const lwr_real x167 = s[26]*(x46 - x53) + (s[28]*(x47 + x51) + (s[25]*(x49 - x52) + s[21]*x63 + x50*(x10 - x9)));
+    const lwr_real x69 = s[21]*x59 + x63*x8;
+    const lwr_real x70 = s[21]*x64 + x61*x8;
+    const lwr_real x71 = s[25]*(x51 - x55) + (s[26]*(x52 + x54) + (s[28]*(x56 - x58) - x10*x57 + x50*x9 - x8*x67));
+    const lwr_real x72 = s[25]*(x50 + x57) + (s[28]*(x52 - x54) + (s[26]*(-x53 + x58) - s[21]*x68 + x10*x51 + x55*x9 + x8*x66));
+    const lwr_real x73 = s[26]*(x50 - x57) + (s[28]*(x51 + x55) + (s[25]*(x53 - x56) + s[21]*x67 + x54*(x10 - x9)));
+    /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
+    const lwr_real x74 = c4*x43 + s4*x49;
+    const lwr_real x75 = -c4*x49 + s4*x43;
+    const lwr_real x76 = c4*x50 + s4*x51;
+    const lwr_real x77 = -c4*x51 + s4*x50;
+    const lwr_real x78 = c4*x66 + s4*x67;
+    const lwr_real x79 = -c4*x67 + s4*x66;
+    const lwr_real x80 = qd[3] + x44;
+    const lwr_real x81 = -qd[3]*x75 + x76;
+    const lwr_real x82 = qdd[3] + x52;
+    const lwr_real x83 = qd[3]*x74 + x77;
+    const lwr_real x84 = x74*x74;
+    const lwr_real x85 = x74*x80;
+    const lwr_real x86 = x74*x75;
+    const lwr_real x87 = x80*x80;
+    const lwr_real x88 = x75*x80;
+    const lwr_real x89 = x75*x75;
+    const lwr_real x90 = -x87 - x89;
+    const lwr_real x91 = -x84 - x87;
+    const lwr_real x92 = x86 + x82;
+    const lwr_real x93 = x85 + x83;
+    const lwr_real x94 = x88 - x81;
+    const lwr_real x95 = x86 - x82;
     /* link 4: link wrench */
-    const lwr_real x168 = s[31]*x81 + x13*x83;
-    const lwr_real x169 = s[31]*x84 + x13*x85;
-    const lwr_real x170 = s[31]*x86 + x13*x82;
-    const lwr_real x171 = s[35]*(x73 - x77) + (s[36]*(x74 + x76) + (s[38]*(x78 - x80) - x13*x64 + x16*x72 - x17*x79));
-    const lwr_real x172 = s[35]*(x72 + x79) + (s[38]*(x74 - x76) + (s[36]*(-x75 + x80) - s[31]*x70 + x13*x69 + x16*x77 + x17*x73));
-    const lwr_real x173 = s[36]*(x72 - x79) + (s[38]*(x73 + x77) + (s[35]*(x75 - x78) + s[31]*x64 + x76*(-x16 + x17)));
+    const lwr_real x96 = s[31]*x90 + x92*x13;
+    const lwr_real x97 = s[31]*x93 + x94*x13;
+    const lwr_real x98 = s[31]*x95 + x91*x13;
+    const lwr_real x99 = s[35]*(-x86 + x82) + (s[36]*(x85 + x83) + (s[38]*(x87 - x89) - x88*x17 - x13*x68 + x16*x81));
+    const lwr_real x100 = s[35]*(x88 + x81) + (s[38]*(-x85 + x83) + (s[36]*(-x84 + x89) - s[31]*x79 + x86*x16 + x13*x78 + x17*x82));
+    const lwr_real x101 = s[36]*(-x88 + x81) + (s[38]*(x86 + x82) + (s[35]*(x84 - x87) + s[31]*x68 + x85*(-x16 + x17)));
+    /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
+    const lwr_real x102 = c5*x74 + s5*x80;
+    const lwr_real x103 = -c5*x80 + s5*x74;
+    const lwr_real x104 = c5*x81 + s5*x82;
+    const lwr_real x105 = -c5*x82 + s5*x81;
+    const lwr_real x106 = c5*x78 + s5*x68;
+    const lwr_real x107 = -c5*x68 + s5*x78;
+    const lwr_real x108 = qd[4] + x75;
+    const lwr_real x109 = -qd[4]*x103 + x104;
+    const lwr_real x110 = qdd[4] + x83;
+    const lwr_real x111 = qd[4]*x102 + x105;
+    const lwr_real x112 = x102*x102;
+    const lwr_real x113 = x102*x108;
+    const lwr_real x114 = x102*x103;
+    const lwr_real x115 = x108*x108;
+    const lwr_real x116 = x103*x108;
+    const lwr_real x117 = x103*x103;
+    const lwr_real x118 = -x115 - x117;
+    const lwr_real x119 = -x112 - x117;
+    const lwr_real x120 = -x112 - x115;
+    const lwr_real x121 = -x111 + x113;
+    const lwr_real x122 = x110 + x114;
+    const lwr_real x123 = x111 + x113;
+    const lwr_real x124 = -x109 + x116;
+    const lwr_real x125 = -x110 + x114;
+    const lwr_real x126 = x109 + x116;
+    const lwr_real x127 = x106 + LWR_K(0.39)*x121;
+    const lwr_real x128 = LWR_K(0.39)*x119 + x79;
+    const lwr_real x129 = x107 + LWR_K(0.39)*x126;
     /* link 5: link wrench */
-    const lwr_real x174 = s[41]*x103 + x107*x18;
-    const lwr_real x175 = s[41]*x108 + x109*x18;
-    const lwr_real x176 = s[41]*x110 + x105*x18;
-    const lwr_real x177 = s[45]*(x95 - x99) + (s[46]*(x96 + x98) + (s[48]*(x100 - x102) + x94*x19 - x101*x20 - x113*x18));
-    const lwr_real x178 = s[45]*(x94 + x101) + (s[48]*(x96 - x98) + (s[46]*(-x97 + x102) - s[41]*x114 + x95*x20 + x99*x19 + x112*x18));
-    const lwr_real x179 = s[46]*(x94 - x101) + (s[48]*(x95 + x99) + (s[45]*(x97 - x100) + s[41]*x113 + x98*(-x19 + x20)));
+    const lwr_real x130 = s[41]*x118 + x122*x18;
+    const lwr_real x131 = s[41]*x123 + x124*x18;
+    const lwr_real x132 = s[41]*x125 + x120*x18;
+    const lwr_real x133 = s[45]*(x110 - x114) + (s[46]*(x111 + x113) + (s[48]*(x115 - x117) + x109*x19 - x116*x20 - x128*x18));
+    const lwr_real x134 = s[45]*(x109 + x116) + (s[48]*(x111 - x113) + (s[46]*(-x112 + x117) - s[41]*x129 + x110*x20 + x114*x19 + x127*x18));
+    const lwr_real x135 = s[46]*(x109 - x116) + (s[48]*(x110 + x114) + (s[45]*(x112 - x115) + s[41]*x128 + x113*(-x19 + x20)));
+    /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
+    const lwr_real x136 = c6*x102 + s6*x108;
+    const lwr_real x137 = c6*x108 - s6*x102;
+    const lwr_real x138 = c6*x109 + s6*x110;
+    const lwr_real x139 = c6*x110 - s6*x109;
+    const lwr_real x140 = c6*x127 + s6*x128;
+    const lwr_real x141 = c6*x128 - s6*x127;
+    const lwr_real x142 = -qd[5] - x103;
+    const lwr_real x143 = qd[5]*x137 + x138;
+    const lwr_real x144 = -qdd[5] - x111;
+    const lwr_real x145 = -qd[5]*x136 + x139;
+    const lwr_real x146 = x136*x136;
+    const lwr_real x147 = x136*x142;
+    const lwr_real x148 = x136*x137;
+    const lwr_real x149 = x142*x142;
+    const lwr_real x150 = x137*x142;
+    const lwr_real x151 = x137*x137;
+    const lwr_real x152 = -x149 - x151;
+    const lwr_real x153 = -x146 - x149;
+    const lwr_real x154 = x144 + x148;
+    const lwr_real x155 = x145 + x147;
+    const lwr_real x156 = -x143 + x150;
+    const lwr_real x157 = -x144 + x148;
     /* link 6: link wrench */
-    const lwr_real x180 = s[51]*x131 + x133*x21;
-    const lwr_real x181 = s[51]*x134 + x135*x21;
-    const lwr_real x182 = s[51]*x136 + x132*x21;
-    const lwr_real x183 = s[55]*(x123 - x127) + (s[56]*(x124 + x126) + (s[58]*(x128 - x130) + x114*x21 + x122*x22 - x129*x23));
-    const lwr_real x184 = s[55]*(x122 + x129) + (s[58]*(x124 - x126) + (s[56]*(-x125 + x130) - s[51]*x120 + x119*x21 + x123*x23 + x127*x22));
-    const lwr_real x185 = s[56]*(x122 - x129) + (s[58]*(x123 + x127) + (s[55]*(x125 - x128) - s[51]*x114 + x126*(-x22 + x23)));
+    const lwr_real x158 = s[51]*x152 + x154*x21;
+    const lwr_real x159 = s[51]*x155 + x156*x21;
+    const lwr_real x160 = s[51]*x157 + x153*x21;
+    const lwr_real x161 = s[55]*(x144 - x148) + (s[56]*(x145 + x147) + (s[58]*(x149 - x151) + x129*x21 + x143*x22 - x150*x23));
+    const lwr_real x162 = s[55]*(x143 + x150) + (s[58]*(x145 - x147) + (s[56]*(-x146 + x151) - s[51]*x141 + x140*x21 + x144*x23 + x148*x22));
+    const lwr_real x163 = s[56]*(x143 - x150) + (s[58]*(x144 + x148) + (s[55]*(x146 - x149) - s[51]*x129 + x147*(-x22 + x23)));
+    /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
+    const lwr_real x164 = c7*x136 + s7*x142;
+    const lwr_real x165 = c7*x142 - s7*x136;
+    const lwr_real x166 = c7*x143 + s7*x144;
+    const lwr_real x167 = c7*x144 - s7*x143;
+    const lwr_real x168 = c7*x140 - s7*x129;
+    const lwr_real x169 = -c7*x129 - s7*x140;
+    const lwr_real x170 = qd[6] + x137;
+    const lwr_real x171 = qd[6]*x165 + x166;
+    const lwr_real x172 = -qd[6]*x164 + x167;
+    const lwr_real x173 = qdd[6] + x145;
+    const lwr_real x174 = x164*x164;
+    const lwr_real x175 = x164*x165;
+    const lwr_real x176 = x164*x170;
+    const lwr_real x177 = x165*x165;
+    const lwr_real x178 = x165*x170;
+    const lwr_real x179 = x170*x170;
+    const lwr_real x180 = -x177 - x179;
+    const lwr_real x181 = -x174 - x179;
+    const lwr_real x182 = -x173 + x175;
+    const lwr_real x183 = x173 + x175;
+    const lwr_real x184 = -x172 + x176;
+    const lwr_real x185 = x171 + x178;
     /* link 7: link wrench */
-    const lwr_real x186 = s[61]*x153 + s[62]*x155;
-    const lwr_real x187 = s[61]*x156 + s[62]*x154;
-    const lwr_real x188 = s[61]*x157 + s[62]*x158;
-    const lwr_real x189 = s[65]*(x145 - x149) + (s[66]*(x146 + x148) + (s[68]*(x150 - x152) + s[69]*x151 + s[62]*x120 + x144*x24));
-    const lwr_real x190 = s[65]*(x144 + x151) + (s[68]*(x146 - x148) + (s[66]*(-x147 + x152) - s[61]*x120 + x149*(-s[69] + x24)));
-    const lwr_real x191 = s[66]*(x144 - x151) + (s[68]*(x145 + x149) + (s[65]*(x147 - x150) + s[69]*x146 + s[61]*x142 - s[62]*x141 - x148*x24));
+    const lwr_real x186 = s[61]*x180 + s[62]*x182;
+    const lwr_real x187 = s[61]*x183 + s[62]*x181;
+    const lwr_real x188 = s[61]*x184 + s[62]*x185;
+    const lwr_real x189 = s[65]*(x172 - x176) + (s[66]*(x173 + x175) + (s[68]*(x177 - x179) + s[69]*x178 + s[62]*x141 + x171*x24));
+    const lwr_real x190 = s[65]*(x171 + x178) + (s[68]*(x173 - x175) + (s[66]*(-x174 + x179) - s[61]*x141 + x176*(-s[69] + x24)));
+    const lwr_real x191 = s[66]*(x171 - x178) + (s[68]*(x172 + x176) + (s[65]*(x174 - x177) + s[69]*x173 + s[61]*x169 - s[62]*x168 - x175*x24));
     /* link 7: forces */
     const lwr_real x192 = c7*x186 - s7*x187;
     const lwr_real x193 = c7*x187 + s7*x186;
     const lwr_real x194 = c7*x189 - s7*x190;
     const lwr_real x195 = c7*x190 + s7*x189;
     /* link 6: forces */
-    const lwr_real x196 = x180 + x192;
-    const lwr_real x197 = x181 + x193;
-    const lwr_real x198 = x182 + x188;
-    const lwr_real x199 = x183 + x194;
-    const lwr_real x200 = x184 + x195;
-    const lwr_real x201 = x185 + x191;
+    const lwr_real x196 = x158 + x192;
+    const lwr_real x197 = x159 + x193;
+    const lwr_real x198 = x160 + x188;
+    const lwr_real x199 = x161 + x194;
+    const lwr_real x200 = x162 + x195;
+    const lwr_real x201 = x163 + x191;
     const lwr_real x202 = c6*x196 - s6*x198;
     const lwr_real x203 = c6*x198 + s6*x196;
     const lwr_real x204 = c6*x199 - s6*x201;
     const lwr_real x205 = c6*x201 + s6*x199;
     /* link 5: forces */
-    const lwr_real x206 = x174 + x202;
-    const lwr_real x207 = x175 + x203;
-    const lwr_real x208 = x176 - x197;
-    const lwr_real x209 = x177 + x204;
-    const lwr_real x210 = x178 + x205;
-    const lwr_real x211 = x179 - x200;
+    const lwr_real x206 = x130 + x202;
+    const lwr_real x207 = x131 + x203;
+    const lwr_real x208 = x132 - x197;
+    const lwr_real x209 = x133 + x204;
+    const lwr_real x210 = x134 + x205;
+    const lwr_real x211 = x135 - x200;
     const lwr_real x212 = LWR_K(0.39)*x208 + x209;
     const lwr_real x213 = -LWR_K(0.39)*x206 + x211;
     const lwr_real x214 = c5*x206 + s5*x208;
@@ -262,32 +262,32 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
     const lwr_real x216 = c5*x212 + s5*x213;
     const lwr_real x217 = -c5*x213 + s5*x212;
     /* link 4: forces */
-    const lwr_real x218 = x168 + x214;
-    const lwr_real x219 = x169 + x215;
-    const lwr_real x220 = x170 + x207;
-    const lwr_real x221 = x171 + x216;
-    const lwr_real x222 = x172 + x217;
-    const lwr_real x223 = x173 + x210;
+    const lwr_real x218 = x96 + x214;
+    const lwr_real x219 = x97 + x215;
+    const lwr_real x220 = x98 + x207;
+    const lwr_real x221 = x99 + x216;
+    const lwr_real x222 = x100 + x217;
+    const lwr_real x223 = x101 + x210;
     const lwr_real x224 = c4*x218 + s4*x220;
     const lwr_real x225 = c4*x221 + s4*x223;
     const lwr_real x226 = -c4*x223 + s4*x221;
     /* link 3: forces */
-    const lwr_real x227 = x163 + x224;
-    const lwr_real x228 = x164 + x219;
-    const lwr_real x229 = x165 + x225;
-    const lwr_real x230 = x166 + x226;
-    const lwr_real x231 = x167 + x222;
+    const lwr_real x227 = x224 + x69;
+    const lwr_real x228 = x219 + x70;
+    const lwr_real x229 = x225 + x71;
+    const lwr_real x230 = x226 + x72;
+    const lwr_real x231 = x222 + x73;
     const lwr_real x232 = -LWR_K(0.4)*x228 + x229;
     const lwr_real x233 = LWR_K(0.4)*x227 + x231;
     const lwr_real x234 = c3*x232 - s3*x233;
     const lwr_real x235 = c3*x233 + s3*x232;
     /* link 2: forces */
-    const lwr_real x236 = x160 + x234;
-    const lwr_real x237 = x161 + x235;
-    const lwr_real x238 = x162 - x230;
+    const lwr_real x236 = x234 + x40;
+    const lwr_real x237 = x235 + x41;
+    const lwr_real x238 = -x230 + x42;
     const lwr_real x239 = c2*x238 + s2*x236;
     /* link 1: forces */
-    const lwr_real x240 = x159 + x239;
+    const lwr_real x240 = x25 + x239;
     /* tau */
     tau[0] = x240;
     tau[1] = -x237;
@@ -298,22 +298,247 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
     tau[6] = x191;
 }
 
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p). */
+void lwr_rnea_nominal(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *tau)
+{
+    /* link 1: link wrench */
+    const lwr_real x0 = LWR_K(0.0174961336)*qdd[0];
+    /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
+    const lwr_real x1 = qd[0]*s2;
+    const lwr_real x2 = c2*qd[0];
+    const lwr_real x3 = qdd[0]*s2;
+    const lwr_real x4 = c2*qdd[0];
+    const lwr_real x5 = LWR_K(9.81)*s2;
+    const lwr_real x6 = LWR_K(9.81)*c2;
+    const lwr_real x7 = qd[1]*x2 + x3;
+    const lwr_real x8 = -qd[1]*x1 + x4;
+    const lwr_real x9 = x1*x1;
+    const lwr_real x10 = -qd[1]*x1;
+    const lwr_real x11 = x1*x2;
+    const lwr_real x12 = qd[1]*qd[1];
+    const lwr_real x13 = -qd[1]*x2;
+    const lwr_real x14 = x2*x2;
+    /* link 2: link wrench */
+    const lwr_real x15 = LWR_K(0.000632077186)*(-x10 - x8) + (LWR_K(0.00018901396)*(-qdd[1] - x11) + (LWR_K(0.015961084938)*(x12 - x14) + (-LWR_K(1.3659973055766)*x13 + LWR_K(1.3611206093366)*x7)));
+    const lwr_real x16 = LWR_K(0.000632077186)*(x9 - x14) + (LWR_K(0.00018901396)*(x13 + x7) + (LWR_K(0.015961084938)*(-x10 + x8) + (-LWR_K(1.3659973055766)*qdd[1] + LWR_K(1.3611206093366)*x11 + LWR_K(3.6)*x5 - LWR_K(0.003618)*x6)));
+    const lwr_real x17 = LWR_K(0.000632077186)*(x13 - x7) + (LWR_K(0.00018901396)*(x9 - x12) + (LWR_K(0.00487669624)*x10 + LWR_K(0.015961084938)*(-qdd[1] + x11)));
+    /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
+    const lwr_real x18 = c3*x1 - qd[1]*s3;
+    const lwr_real x19 = -c3*qd[1] - s3*x1;
+    const lwr_real x20 = c3*x7 - qdd[1]*s3;
+    const lwr_real x21 = -c3*qdd[1] - s3*x7;
+    const lwr_real x22 = c3*x5;
+    const lwr_real x23 = -s3*x5;
+    const lwr_real x24 = -qd[2] - x2;
+    const lwr_real x25 = qd[2]*x19 + x20;
+    const lwr_real x26 = -qdd[2] - x8;
+    const lwr_real x27 = -qd[2]*x18 + x21;
+    const lwr_real x28 = x18*x18;
+    const lwr_real x29 = x18*x24;
+    const lwr_real x30 = x18*x19;
+    const lwr_real x31 = x24*x24;
+    const lwr_real x32 = x19*x24;
+    const lwr_real x33 = x19*x19;
+    const lwr_real x34 = -x31 - x33;
+    const lwr_real x35 = -x28 - x33;
+    const lwr_real x36 = -x27 + x29;
+    const lwr_real x37 = -x26 + x30;
+    const lwr_real x38 = x25 + x32;
+    const lwr_real x39 = x22 - LWR_K(0.4)*x36;
+    const lwr_real x40 = -LWR_K(0.4)*x35 - x6;
+    const lwr_real x41 = x23 - LWR_K(0.4)*x38;
+    /* link 3: link wrench */
+    const lwr_real x42 = -LWR_K(0.003618)*x34;
+    const lwr_real x43 = -LWR_K(0.003618)*x37;
+    const lwr_real x44 = LWR_K(0.000632077186)*(x26 - x30) + (LWR_K(0.008895084938)*(x31 - x33) + ((-LWR_K(0.01951356264)*x25 - LWR_K(0.0174961336)*x32) + LWR_K(0.00019043596)*(-x27 - x29)));
+    const lwr_real x45 = LWR_K(0.000632077186)*(x25 + x32) + (LWR_K(0.008895084938)*(x27 - x29) + (LWR_K(0.00019043596)*(x28 - x33) + (LWR_K(0.0174961336)*x26 - LWR_K(0.01951356264)*x30 + LWR_K(0.003618)*x41)));
+    const lwr_real x46 = LWR_K(0.000632077186)*(x28 - x31) + (LWR_K(0.008895084938)*(x26 + x30) + (LWR_K(0.00019043596)*(-x25 + x32) + (LWR_K(0.03700969624)*x29 - LWR_K(0.003618)*x40)));
+    /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
+    const lwr_real x47 = c4*x18 + s4*x24;
+    const lwr_real x48 = -c4*x24 + s4*x18;
+    const lwr_real x49 = c4*x25 + s4*x26;
+    const lwr_real x50 = -c4*x26 + s4*x25;
+    const lwr_real x51 = c4*x39 + s4*x40;
+    const lwr_real x52 = -c4*x40 + s4*x39;
+    const lwr_real x53 = qd[3] + x19;
+    const lwr_real x54 = -qd[3]*x48 + x49;
+    const lwr_real x55 = qdd[3] + x27;
+    const lwr_real x56 = qd[3]*x47 + x50;
+    const lwr_real x57 = x47*x47;
+    const lwr_real x58 = x47*x53;
+    const lwr_real x59 = x47*x48;
+    const lwr_real x60 = x53*x53;
+    const lwr_real x61 = x48*x53;
+    const lwr_real x62 = x48*x48;
+    const lwr_real x63 = -x60 - x62;
+    const lwr_real x64 = -x57 - x60;
+    const lwr_real x65 = x55 + x59;
+    const lwr_real x66 = x56 + x58;
+    const lwr_real x67 = -x54 + x61;
+    const lwr_real x68 = -x55 + x59;
+    /* link 4: link wrench */
+    const lwr_real x69 = -LWR_K(0.003618)*x63 + LWR_K(1.4511929)*x65;
+    const lwr_real x70 = -LWR_K(0.003618)*x66 + LWR_K(1.4511929)*x67;
+    const lwr_real x71 = LWR_K(1.4511929)*x64 - LWR_K(0.003618)*x68;
+    const lwr_real x72 = LWR_K(0.003532915062)*(x60 - x62) + (LWR_K(0.000632127186)*(x56 + x58) + (LWR_K(0.00018901396)*(x55 - x59) + (-LWR_K(1.4511929)*x41 + LWR_K(0.5016166210816)*x54 - LWR_K(0.5085133173216)*x61)));
+    const lwr_real x73 = LWR_K(0.003532915062)*(x56 - x58) + (LWR_K(0.000632127186)*(-x57 + x62) + (LWR_K(0.00018901396)*(x54 + x61) + (LWR_K(1.4511929)*x51 + LWR_K(0.003618)*x52 + LWR_K(0.5085133173216)*x55 + LWR_K(0.5016166210816)*x59)));
+    const lwr_real x74 = LWR_K(0.003532915062)*(x55 + x59) + (LWR_K(0.000632127186)*(x54 - x61) + ((-LWR_K(0.003618)*x41 + LWR_K(0.00689669624)*x58) + LWR_K(0.00018901396)*(x57 - x60)));
+    /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
+    const lwr_real x75 = c5*x47 + s5*x53;
+    const lwr_real x76 = -c5*x53 + s5*x47;
+    const lwr_real x77 = c5*x54 + s5*x55;
+    const lwr_real x78 = -c5*x55 + s5*x54;
+    const lwr_real x79 = c5*x51 + s5*x41;
+    const lwr_real x80 = -c5*x41 + s5*x51;
+    const lwr_real x81 = qd[4] + x48;
+    const lwr_real x82 = -qd[4]*x76 + x77;
+    const lwr_real x83 = qdd[4] + x56;
+    const lwr_real x84 = qd[4]*x75 + x78;
+    const lwr_real x85 = x75*x75;
+    const lwr_real x86 = x81*x75;
+    const lwr_real x87 = x75*x76;
+    const lwr_real x88 = x81*x81;
+    const lwr_real x89 = x81*x76;
+    const lwr_real x90 = x76*x76;
+    const lwr_real x91 = -x88 - x90;
+    const lwr_real x92 = -x85 - x90;
+    const lwr_real x93 = -x85 - x88;
+    const lwr_real x94 = -x84 + x86;
+    const lwr_real x95 = x83 + x87;
+    const lwr_real x96 = x84 + x86;
+    const lwr_real x97 = -x82 + x89;
+    const lwr_real x98 = -x83 + x87;
+    const lwr_real x99 = x82 + x89;
+    const lwr_real x100 = x79 + LWR_K(0.39)*x94;
+    const lwr_real x101 = LWR_K(0.39)*x92 + x52;
+    const lwr_real x102 = x80 + LWR_K(0.39)*x99;
+    /* link 5: link wrench */
+    const lwr_real x103 = -LWR_K(0.0016881)*x91 - LWR_K(0.036299)*x95;
+    const lwr_real x104 = -LWR_K(0.0016881)*x96 - LWR_K(0.036299)*x97;
+    const lwr_real x105 = -LWR_K(0.036299)*x93 - LWR_K(0.0016881)*x98;
+    const lwr_real x106 = LWR_K(0.0000902477998)*(-x84 - x86) + (LWR_K(0.00713976319)*(-x88 + x90) + (LWR_K(0.000378276365)*(-x83 + x87) + (LWR_K(0.0067606367427)*x82 - LWR_K(0.0097089893093)*x89 + LWR_K(0.036299)*x101)));
+    const lwr_real x107 = LWR_K(0.0000902477998)*(x85 - x90) + (LWR_K(0.00713976319)*(-x84 + x86) + (LWR_K(0.000378276365)*(-x82 - x89) + (LWR_K(0.0097089893093)*x83 + LWR_K(0.0067606367427)*x87 - LWR_K(0.036299)*x100 + LWR_K(0.0016881)*x102)));
+    const lwr_real x108 = LWR_K(0.0000902477998)*(-x82 + x89) + (LWR_K(0.00713976319)*(-x83 - x87) + (LWR_K(0.000378276365)*(-x85 + x88) + (LWR_K(0.0029483525666)*x86 - LWR_K(0.0016881)*x101)));
+    /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
+    const lwr_real x109 = c6*x75 + s6*x81;
+    const lwr_real x110 = c6*x81 - s6*x75;
+    const lwr_real x111 = c6*x82 + s6*x83;
+    const lwr_real x112 = c6*x83 - s6*x82;
+    const lwr_real x113 = c6*x100 + s6*x101;
+    const lwr_real x114 = c6*x101 - s6*x100;
+    const lwr_real x115 = -qd[5] - x76;
+    const lwr_real x116 = qd[5]*x110 + x111;
+    const lwr_real x117 = -qdd[5] - x84;
+    const lwr_real x118 = -qd[5]*x109 + x112;
+    const lwr_real x119 = x109*x109;
+    const lwr_real x120 = x109*x115;
+    const lwr_real x121 = x109*x110;
+    const lwr_real x122 = x115*x115;
+    const lwr_real x123 = x110*x115;
+    const lwr_real x124 = x110*x110;
+    const lwr_real x125 = -x122 - x124;
+    const lwr_real x126 = -x119 - x122;
+    const lwr_real x127 = x117 + x121;
+    const lwr_real x128 = x118 + x120;
+    const lwr_real x129 = -x116 + x123;
+    const lwr_real x130 = -x117 + x121;
+    /* link 6: link wrench */
+    const lwr_real x131 = -LWR_K(0.0004144)*x125 + LWR_K(0.0103752)*x127;
+    const lwr_real x132 = -LWR_K(0.0004144)*x128 + LWR_K(0.0103752)*x129;
+    const lwr_real x133 = LWR_K(0.0103752)*x126 - LWR_K(0.0004144)*x130;
+    const lwr_real x134 = LWR_K(0.0000045309232)*(-x118 - x120) + (LWR_K(0.0001208537088)*(-x122 + x124) + (LWR_K(0.0000049311664)*(-x117 + x121) + (LWR_K(0.0103752)*x102 + LWR_K(0.0020580128048)*x116 - LWR_K(0.005596227464)*x123)));
+    const lwr_real x135 = LWR_K(0.0000045309232)*(x119 - x124) + (LWR_K(0.0001208537088)*(-x118 + x120) + (LWR_K(0.0000049311664)*(-x116 - x123) + (LWR_K(0.0103752)*x113 + LWR_K(0.0004144)*x114 + LWR_K(0.005596227464)*x117 + LWR_K(0.0020580128048)*x121)));
+    const lwr_real x136 = LWR_K(0.0000045309232)*(-x116 + x123) + (LWR_K(0.0001208537088)*(-x117 - x121) + ((LWR_K(0.0004144)*x102 + LWR_K(0.0035382146592)*x120) + LWR_K(0.0000049311664)*(-x119 + x122)));
+    /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
+    const lwr_real x137 = c7*x109 + s7*x115;
+    const lwr_real x138 = c7*x115 - s7*x109;
+    const lwr_real x139 = c7*x116 + s7*x117;
+    const lwr_real x140 = qd[6] + x110;
+    const lwr_real x141 = qd[6]*x138 + x139;
+    const lwr_real x142 = qdd[6] + x118;
+    const lwr_real x143 = x137*x138;
+    const lwr_real x144 = x137*x140;
+    const lwr_real x145 = x138*x140;
+    /* link 7: link wrench */
+    const lwr_real x146 = LWR_K(0.002178)*x141 + LWR_K(0.0001584)*x145;
+    const lwr_real x147 = LWR_K(0.0020196)*x144;
+    const lwr_real x148 = LWR_K(0.0001584)*x142 - LWR_K(0.002178)*x143;
+    /* link 7: forces */
+    const lwr_real x149 = c7*x146 - s7*x147;
+    const lwr_real x150 = c7*x147 + s7*x146;
+    /* link 6: forces */
+    const lwr_real x151 = x134 + x149;
+    const lwr_real x152 = x135 + x150;
+    const lwr_real x153 = x136 + x148;
+    const lwr_real x154 = c6*x131 - s6*x133;
+    const lwr_real x155 = c6*x133 + s6*x131;
+    const lwr_real x156 = c6*x151 - s6*x153;
+    const lwr_real x157 = c6*x153 + s6*x151;
+    /* link 5: forces */
+    const lwr_real x158 = x103 + x154;
+    const lwr_real x159 = x104 + x155;
+    const lwr_real x160 = x105 - x132;
+    const lwr_real x161 = x106 + x156;
+    const lwr_real x162 = x107 + x157;
+    const lwr_real x163 = x108 - x152;
+    const lwr_real x164 = LWR_K(0.39)*x160 + x161;
+    const lwr_real x165 = -LWR_K(0.39)*x158 + x163;
+    const lwr_real x166 = c5*x158 + s5*x160;
+    const lwr_real x167 = -c5*x160 + s5*x158;
+    const lwr_real x168 = c5*x164 + s5*x165;
+    const lwr_real x169 = -c5*x165 + s5*x164;
+    /* link 4: forces */
+    const lwr_real x170 = x166 + x69;
+    const lwr_real x171 = x167 + x70;
+    const lwr_real x172 = x159 + x71;
+    const lwr_real x173 = x168 + x72;
+    const lwr_real x174 = x169 + x73;
+    const lwr_real x175 = x162 + x74;
+    const lwr_real x176 = c4*x170 + s4*x172;
+    const lwr_real x177 = c4*x173 + s4*x175;
+    const lwr_real x178 = -c4*x175 + s4*x173;
+    /* link 3: forces */
+    const lwr_real x179 = x176 + x42;
+    const lwr_real x180 = x171 + x43;
+    const lwr_real x181 = x177 + x44;
+    const lwr_real x182 = x178 + x45;
+    const lwr_real x183 = x174 + x46;
+    const lwr_real x184 = -LWR_K(0.4)*x180 + x181;
+    const lwr_real x185 = LWR_K(0.4)*x179 + x183;
+    const lwr_real x186 = c3*x184 - s3*x185;
+    const lwr_real x187 = c3*x185 + s3*x184;
+    /* link 2: forces */
+    const lwr_real x188 = x186 + x15;
+    const lwr_real x189 = x187 + x16;
+    const lwr_real x190 = -x182 + x17;
+    const lwr_real x191 = c2*x190 + s2*x188;
+    /* link 1: forces */
+    const lwr_real x192 = x0 + x191;
+    /* tau */
+    tau[0] = x192;
+    tau[1] = -x189;
+    tau[2] = -x182;
+    tau[3] = x174;
+    tau[4] = x162;
+    tau[5] = -x152;
+    tau[6] = x148;
+}
+
 /* Gravity vector g(q). */
 void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g)
 {
-    /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
     /* base coefficients pi_gravity = K s */
     const lwr_real x0 = s[20] + s[30] + s[40] + s[50] + s[60];
     const lwr_real x1 = LWR_K(0.4)*x0;
@@ -325,74 +550,86 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g)
     const lwr_real x7 = -s[52] + s[43];
     const lwr_real x8 = s[53] + s[63];
     /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x9 = LWR_K(9.81)*s2;
     const lwr_real x10 = LWR_K(9.81)*c2;
-    /* link 3: velocities and accelerations */
-    const lwr_real x11 = c3*x9;
-    const lwr_real x12 = -s3*x9;
-    /* link 4: velocities and accelerations */
-    const lwr_real x13 = c4*x11 - s4*x10;
-    const lwr_real x14 = c4*x10 + s4*x11;
-    /* link 5: velocities and accelerations */
-    const lwr_real x15 = c5*x13 + s5*x12;
-    const lwr_real x16 = -c5*x12 + s5*x13;
-    /* link 6: velocities and accelerations */
-    const lwr_real x17 = c6*x15 + s6*x14;
-    const lwr_real x18 = c6*x14 - s6*x15;
-    /* link 7: velocities and accelerations */
-    const lwr_real x19 = c7*x17 - s7*x16;
-    const lwr_real x20 = -c7*x16 - s7*x17;
     /* link 2: link wrench */
-    const lwr_real x21 = -s[11]*x10 + x2*x9;
+    const lwr_real x11 = -s[11]*x10 + x2*x9;
+    /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
+    const lwr_real x12 = c3*x9;
+    const lwr_real x13 = -s3*x9;
     /* link 3: link wrench */
-    const lwr_real x22 = x10*x3;
-    const lwr_real x23 = -s[21]*x12 + x11*x3;
-    const lwr_real x24 = -s[21]*x10;
+    const lwr_real x14 = x10*x3;
+    const lwr_real x15 = -s[21]*x13 + x12*x3;
+    const lwr_real x16 = -s[21]*x10;
+    /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
+    const lwr_real x17 = c4*x12 - s4*x10;
+    const lwr_real x18 = c4*x10 + s4*x12;
     /* link 4: link wrench */
-    const lwr_real x25 = -x12*x6;
-    const lwr_real x26 = -s[31]*x14 + x13*x6;
-    const lwr_real x27 = s[31]*x12;
+    const lwr_real x19 = -x13*x6;
+    const lwr_real x20 = -s[31]*x18 + x17*x6;
+    const lwr_real x21 = s[31]*x13;
+    /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
+    const lwr_real x22 = c5*x17 + s5*x13;
+    const lwr_real x23 = -c5*x13 + s5*x17;
     /* link 5: link wrench */
-    const lwr_real x28 = -x14*x7;
-    const lwr_real x29 = -s[41]*x16 + x15*x7;
-    const lwr_real x30 = s[41]*x14;
+    const lwr_real x24 = -x18*x7;
+    const lwr_real x25 = -s[41]*x23 + x22*x7;
+    const lwr_real x26 = s[41]*x18;
+    /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
+    const lwr_real x27 = c6*x22 + s6*x18;
+    const lwr_real x28 = c6*x18 - s6*x22;
     /* link 6: link wrench */
-    const lwr_real x31 = x16*x8;
-    const lwr_real x32 = -s[51]*x18 + x17*x8;
-    const lwr_real x33 = -s[51]*x16;
+    const lwr_real x29 = x23*x8;
+    const lwr_real x30 = -s[51]*x28 + x27*x8;
+    const lwr_real x31 = -s[51]*x23;
+    /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
+    const lwr_real x32 = c7*x27 - s7*x23;
+    const lwr_real x33 = -c7*x23 - s7*x27;
     /* link 7: link wrench */
-    const lwr_real x34 = s[62]*x18;
-    const lwr_real x35 = -s[61]*x18;
-    const lwr_real x36 = s[61]*x20 - s[62]*x19;
+    const lwr_real x34 = s[62]*x28;
+    const lwr_real x35 = -s[61]*x28;
+    const lwr_real x36 = s[61]*x33 - s[62]*x32;
     /* link 7: forces */
     const lwr_real x37 = c7*x34 - s7*x35;
     const lwr_real x38 = c7*x35 + s7*x34;
     /* link 6: forces */
-    const lwr_real x39 = x31 + x37;
-    const lwr_real x40 = x32 + x38;
-    const lwr_real x41 = x33 + x36;
+    const lwr_real x39 = x29 + x37;
+    const lwr_real x40 = x30 + x38;
+    const lwr_real x41 = x31 + x36;
     const lwr_real x42 = c6*x39 - s6*x41;
     const lwr_real x43 = c6*x41 + s6*x39;
     /* link 5: forces */
-    const lwr_real x44 = x28 + x42;
-    const lwr_real x45 = x29 + x43;
-    const lwr_real x46 = x30 - x40;
+    const lwr_real x44 = x24 + x42;
+    const lwr_real x45 = x25 + x43;
+    const lwr_real x46 = x26 - x40;
     const lwr_real x47 = c5*x44 + s5*x46;
     const lwr_real x48 = -c5*x46 + s5*x44;
     /* link 4: forces */
-    const lwr_real x49 = x25 + x47;
-    const lwr_real x50 = x26 + x48;
-    const lwr_real x51 = x27 + x45;
+    const lwr_real x49 = x19 + x47;
+    const lwr_real x50 = x20 + x48;
+    const lwr_real x51 = x21 + x45;
     const lwr_real x52 = c4*x49 + s4*x51;
     const lwr_real x53 = -c4*x51 + s4*x49;
     /* link 3: forces */
-    const lwr_real x54 = x22 + x52;
-    const lwr_real x55 = x23 + x53;
-    const lwr_real x56 = x24 + x50;
+    const lwr_real x54 = x14 + x52;
+    const lwr_real x55 = x15 + x53;
+    const lwr_real x56 = x16 + x50;
     const lwr_real x57 = c3*x54 - s3*x56;
     const lwr_real x58 = c3*x56 + s3*x54;
     /* link 2: forces */
-    const lwr_real x59 = x21 + x58;
+    const lwr_real x59 = x11 + x58;
     const lwr_real x60 = -c2*x55 + s2*x57;
     /* g */
     g[0] = x60;
@@ -407,19 +644,6 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g)
 /* Inertia matrix M(q). */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
 {
-    /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
     /* base coefficients pi_inertia = K s */
     const lwr_real x0 = s[7] + s[19];
     const lwr_real x1 = s[20] + s[30] + s[40] + s[50] + s[60];
@@ -448,6 +672,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x24 = s[57] + s[67];
     const lwr_real x25 = s[64] - s[67];
     /* link 6: composite body */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x26 = c7*s[61] - s[62]*s7;
     const lwr_real x27 = c7*s[62] + s[61]*s7;
     const lwr_real x28 = s[51] + x26;
@@ -457,6 +683,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x32 = s7*(2*s[65]*c7 + s7*x25) + x24;
     const lwr_real x33 = s[66]*s7 + s[58] + s[68]*c7;
     /* link 5: composite body */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x34 = c6*x28 - s6*x22;
     const lwr_real x35 = c6*x22 + s6*x28;
     const lwr_real x36 = s[41] + x34;
@@ -467,6 +695,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x41 = c6*(s[69]*c6 + s6*x31) + s6*(c6*x31 + s6*x29) + x21;
     const lwr_real x42 = s[48] - c6*x33 - s6*x30;
     /* link 4: composite body */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x43 = c5*x36 + s5*x37;
     const lwr_real x44 = -c5*x37 + s5*x36;
     const lwr_real x45 = s[31] + x43;
@@ -477,6 +707,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x50 = -c5*(-c5*x32 + s5*x40) + s5*(-c5*x40 + s5*x38) + x18 + LWR_K(0.78)*x35;
     const lwr_real x51 = s[38] - c5*x42 + s5*x39 - LWR_K(0.39)*x44;
     /* link 3: composite body */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x52 = c4*x45 + s4*x46;
     const lwr_real x53 = -c4*x46 + s4*x45;
     const lwr_real x54 = x52 + x7;
@@ -487,6 +719,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x59 = -c4*(-c4*x41 + s4*x49) + s4*(-c4*x49 + s4*x47) + x11;
     const lwr_real x60 = -c4*x51 + s4*x48;
     /* link 2: composite body */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x61 = c3*x54 - s3*x55;
     const lwr_real x62 = c3*x55 + s3*x54;
     const lwr_real x63 = c3*(c3*x56 - s3*x58) - s3*(c3*x58 - s3*x50) + x4 - LWR_K(0.8)*x53;
@@ -495,6 +729,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x66 = c3*(c3*x50 + s3*x58) + s3*(c3*x58 + s3*x56) + x5 - LWR_K(0.8)*x53;
     const lwr_real x67 = s[18] - c3*x60 - s3*x57 - LWR_K(0.4)*x62;
     /* link 1: composite body */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x68 = c2*(c2*x59 + s2*x65) + s2*(c2*x65 + s2*x63) + x0;
     const lwr_real x69 = -c2*x67 - s2*x64;
     /* column 3: composite wrench */
@@ -631,222 +867,221 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
 /* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients). */
 void lwr_inverse_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *pi_full, lwr_real *tau)
 {
-    /* joint angles */
+    /* link 1: link wrench */
+    const lwr_real x0 = pi_full[0]*qdd[0];
+    /* link 2: velocities and accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
+    const lwr_real x1 = qd[0]*s2;
+    const lwr_real x2 = c2*qd[0];
+    const lwr_real x3 = qdd[0]*s2;
+    const lwr_real x4 = c2*qdd[0];
+    const lwr_real x5 = LWR_K(9.81)*s2;
+    const lwr_real x6 = LWR_K(9.81)*c2;
+    const lwr_real x7 = qd[1]*x2 + x3;
+    const lwr_real x8 = -qd[1]*x1 + x4;
+    const lwr_real x9 = x1*x1;
+    const lwr_real x10 = -qd[1]*x1;
+    const lwr_real x11 = x1*x2;
+    const lwr_real x12 = qd[1]*qd[1];
+    const lwr_real x13 = -qd[1]*x2;
+    const lwr_real x14 = x2*x2;
+    /* link 2: link wrench */
+    const lwr_real x15 = pi_full[4]*(-qdd[1] - x11) + (pi_full[5]*(x10 + x8) + (pi_full[3]*x7 - pi_full[6]*x13 + pi_full[7]*(x12 - x14)));
+    const lwr_real x16 = pi_full[4]*(x13 + x7) + (pi_full[7]*(-x10 + x8) + (-pi_full[1]*x6 + pi_full[2]*x5 + pi_full[3]*x11 + pi_full[5]*(-x9 + x14) - pi_full[6]*qdd[1]));
+    const lwr_real x17 = pi_full[5]*(-x13 + x7) + (pi_full[7]*(-qdd[1] + x11) + (pi_full[4]*(x9 - x12) + x10*(-pi_full[3] + pi_full[6])));
+    /* link 3: velocities and accelerations */
     lwr_real s3, c3;
     LWR_SINCOS(q[2], &s3, &c3);
+    const lwr_real x18 = c3*x1 - qd[1]*s3;
+    const lwr_real x19 = -c3*qd[1] - s3*x1;
+    const lwr_real x20 = c3*x7 - qdd[1]*s3;
+    const lwr_real x21 = -c3*qdd[1] - s3*x7;
+    const lwr_real x22 = c3*x5;
+    const lwr_real x23 = -s3*x5;
+    const lwr_real x24 = -qd[2] - x2;
+    const lwr_real x25 = qd[2]*x19 + x20;
+    const lwr_real x26 = -qdd[2] - x8;
+    const lwr_real x27 = -qd[2]*x18 + x21;
+    const lwr_real x28 = x18*x18;
+    const lwr_real x29 = x18*x24;
+    const lwr_real x30 = x18*x19;
+    const lwr_real x31 = x24*x24;
+    const lwr_real x32 = x19*x24;
+    const lwr_real x33 = x19*x19;
+    const lwr_real x34 = -x31 - x33;
+    const lwr_real x35 = -x28 - x33;
+    const lwr_real x36 = -x28 - x31;
+    const lwr_real x37 = -x27 + x29;
+    const lwr_real x38 = x26 + x30;
+    const lwr_real x39 = -x26 + x30;
+    const lwr_real x40 = x25 + x32;
+    const lwr_real x41 = x22 - LWR_K(0.4)*x37;
+    const lwr_real x42 = -LWR_K(0.4)*x35 - x6;
+    const lwr_real x43 = x23 - LWR_K(0.4)*x40;
+    /* link 3: link wrench */
+    const lwr_real x44 = pi_full[8]*x34 + pi_full[9]*x38;
+    const lwr_real x45 = pi_full[8]*x39 + pi_full[9]*x36;
+    const lwr_real x46 = pi_full[11]*(x26 - x30) + (pi_full[12]*(x27 + x29) + (pi_full[10]*x25 - pi_full[13]*x32 + pi_full[14]*(x31 - x33) - pi_full[9]*x42));
+    const lwr_real x47 = pi_full[11]*(x25 + x32) + (pi_full[14]*(x27 - x29) + (pi_full[10]*x30 + pi_full[12]*(-x28 + x33) + pi_full[13]*x26 - pi_full[8]*x43 + pi_full[9]*x41));
+    const lwr_real x48 = pi_full[12]*(x25 - x32) + (pi_full[14]*(x26 + x30) + (pi_full[11]*(x28 - x31) + pi_full[8]*x42 + x29*(-pi_full[10] + pi_full[13])));
+    /* link 4: velocities and accelerations */
     lwr_real s4, c4;
     LWR_SINCOS(q[3], &s4, &c4);
+    const lwr_real x49 = c4*x18 + s4*x24;
+    const lwr_real x50 = -c4*x24 + s4*x18;
+    const lwr_real x51 = c4*x25 + s4*x26;
+    const lwr_real x52 = -c4*x26 + s4*x25;
+    const lwr_real x53 = c4*x41 + s4*x42;
+    const lwr_real x54 = -c4*x42 + s4*x41;
+    const lwr_real x55 = qd[3] + x19;
+    const lwr_real x56 = -qd[3]*x50 + x51;
+    const lwr_real x57 = qdd[3] + x27;
+    const lwr_real x58 = qd[3]*x49 + x52;
+    const lwr_real x59 = x49*x49;
+    const lwr_real x60 = x49*x55;
+    const lwr_real x61 = x49*x50;
+    const lwr_real x62 = x55*x55;
+    const lwr_real x63 = x50*x55;
+    const lwr_real x64 = x50*x50;
+    const lwr_real x65 = -x62 - x64;
+    const lwr_real x66 = -x59 - x62;
+    const lwr_real x67 = x57 + x61;
+    const lwr_real x68 = x58 + x60;
+    const lwr_real x69 = -x56 + x63;
+    const lwr_real x70 = -x57 + x61;
+    /* link 4: link wrench */
+    const lwr_real x71 = pi_full[15]*x65 + pi_full[16]*x67;
+    const lwr_real x72 = pi_full[15]*x68 + pi_full[16]*x69;
+    const lwr_real x73 = pi_full[15]*x70 + pi_full[16]*x66;
+    const lwr_real x74 = pi_full[18]*(x57 - x61) + (pi_full[19]*(x58 + x60) + (-pi_full[16]*x43 + pi_full[17]*x56 - pi_full[20]*x63 + pi_full[21]*(x62 - x64)));
+    const lwr_real x75 = pi_full[18]*(x56 + x63) + (pi_full[21]*(x58 - x60) + (-pi_full[15]*x54 + pi_full[16]*x53 + pi_full[17]*x61 + pi_full[19]*(-x59 + x64) + pi_full[20]*x57));
+    const lwr_real x76 = pi_full[19]*(x56 - x63) + (pi_full[21]*(x57 + x61) + (pi_full[15]*x43 + pi_full[18]*(x59 - x62) + x60*(-pi_full[17] + pi_full[20])));
+    /* link 5: velocities and accelerations */
     lwr_real s5, c5;
     LWR_SINCOS(q[4], &s5, &c5);
+    const lwr_real x77 = c5*x49 + s5*x55;
+    const lwr_real x78 = -c5*x55 + s5*x49;
+    const lwr_real x79 = c5*x56 + s5*x57;
+    const lwr_real x80 = -c5*x57 + s5*x56;
+    const lwr_real x81 = c5*x53 + s5*x43;
+    const lwr_real x82 = -c5*x43 + s5*x53;
+    const lwr_real x83 = qd[4] + x50;
+    const lwr_real x84 = -qd[4]*x78 + x79;
+    const lwr_real x85 = qdd[4] + x58;
+    const lwr_real x86 = qd[4]*x77 + x80;
+    const lwr_real x87 = x77*x77;
+    const lwr_real x88 = x83*x77;
+    const lwr_real x89 = x77*x78;
+    const lwr_real x90 = x83*x83;
+    const lwr_real x91 = x83*x78;
+    const lwr_real x92 = x78*x78;
+    const lwr_real x93 = -x90 - x92;
+    const lwr_real x94 = -x87 - x92;
+    const lwr_real x95 = -x87 - x90;
+    const lwr_real x96 = -x86 + x88;
+    const lwr_real x97 = x85 + x89;
+    const lwr_real x98 = x86 + x88;
+    const lwr_real x99 = -x84 + x91;
+    const lwr_real x100 = -x85 + x89;
+    const lwr_real x101 = x84 + x91;
+    const lwr_real x102 = x81 + LWR_K(0.39)*x96;
+    const lwr_real x103 = LWR_K(0.39)*x94 + x54;
+    const lwr_real x104 = x82 + LWR_K(0.39)*x101;
+    /* link 5: link wrench */
+    const lwr_real x105 = pi_full[22]*x93 + pi_full[23]*x97;
+    const lwr_real x106 = pi_full[22]*x98 + pi_full[23]*x99;
+    const lwr_real x107 = pi_full[22]*x100 + pi_full[23]*x95;
+    const lwr_real x108 = pi_full[25]*(x85 - x89) + (pi_full[26]*(x86 + x88) + (-pi_full[23]*x103 + pi_full[24]*x84 - pi_full[27]*x91 + pi_full[28]*(x90 - x92)));
+    const lwr_real x109 = pi_full[25]*(x84 + x91) + (pi_full[28]*(x86 - x88) + (-pi_full[22]*x104 + pi_full[23]*x102 + pi_full[24]*x89 + pi_full[26]*(-x87 + x92) + pi_full[27]*x85));
+    const lwr_real x110 = pi_full[26]*(x84 - x91) + (pi_full[28]*(x85 + x89) + (pi_full[22]*x103 + pi_full[25]*(x87 - x90) + x88*(-pi_full[24] + pi_full[27])));
+    /* link 6: velocities and accelerations */
     lwr_real s6, c6;
     LWR_SINCOS(q[5], &s6, &c6);
+    const lwr_real x111 = c6*x77 + s6*x83;
+    const lwr_real x112 = c6*x83 - s6*x77;
+    const lwr_real x113 = c6*x84 + s6*x85;
+    const lwr_real x114 = c6*x85 - s6*x84;
+    const lwr_real x115 = c6*x102 + s6*x103;
+    const lwr_real x116 = c6*x103 - s6*x102;
+    const lwr_real x117 = -qd[5] - x78;
+    const lwr_real x118 = qd[5]*x112 + x113;
+    const lwr_real x119 = -qdd[5] - x86;
+    const lwr_real x120 = -qd[5]*x111 + x114;
+    const lwr_real x121 = x111*x111;
+    const lwr_real x122 = x111*x117;
+    const lwr_real x123 = x111*x112;
+    const lwr_real x124 = x117*x117;
+    const lwr_real x125 = x112*x117;
+    const lwr_real x126 = x112*x112;
+    const lwr_real x127 = -x124 - x126;
+    const lwr_real x128 = -x121 - x124;
+    const lwr_real x129 = x119 + x123;
+    const lwr_real x130 = x120 + x122;
+    const lwr_real x131 = -x118 + x125;
+    const lwr_real x132 = -x119 + x123;
+    /* link 6: link wrench */
+    const lwr_real x133 = pi_full[29]*x127 + pi_full[30]*x129;
+    const lwr_real x134 = pi_full[29]*x130 + pi_full[30]*x131;
+    const lwr_real x135 = pi_full[29]*x132 + pi_full[30]*x128;
+    const lwr_real x136 = pi_full[32]*(x119 - x123) + (pi_full[33]*(x120 + x122) + (pi_full[30]*x104 + pi_full[31]*x118 - pi_full[34]*x125 + pi_full[35]*(x124 - x126)));
+    const lwr_real x137 = pi_full[32]*(x118 + x125) + (pi_full[35]*(x120 - x122) + (-pi_full[29]*x116 + pi_full[30]*x115 + pi_full[31]*x123 + pi_full[33]*(-x121 + x126) + pi_full[34]*x119));
+    const lwr_real x138 = pi_full[33]*(x118 - x125) + (pi_full[35]*(x119 + x123) + (-pi_full[29]*x104 + pi_full[32]*(x121 - x124) + x122*(-pi_full[31] + pi_full[34])));
+    /* link 7: velocities and accelerations */
     lwr_real s7, c7;
     LWR_SINCOS(q[6], &s7, &c7);
-    /* link 2: velocities and accelerations */
-    const lwr_real x0 = qd[0]*s2;
-    const lwr_real x1 = c2*qd[0];
-    const lwr_real x2 = qdd[0]*s2;
-    const lwr_real x3 = c2*qdd[0];
-    const lwr_real x4 = LWR_K(9.81)*s2;
-    const lwr_real x5 = LWR_K(9.81)*c2;
-    const lwr_real x6 = qd[1]*x1 + x2;
-    const lwr_real x7 = -qd[1]*x0 + x3;
-    const lwr_real x8 = x0*x0;
-    const lwr_real x9 = -qd[1]*x0;
-    const lwr_real x10 = x0*x1;
-    const lwr_real x11 = qd[1]*qd[1];
-    const lwr_real x12 = -qd[1]*x1;
-    const lwr_real x13 = x1*x1;
-    /* link 3: velocities and accelerations */
-    const lwr_real x14 = c3*x0 - qd[1]*s3;
-    const lwr_real x15 = -c3*qd[1] - s3*x0;
-    const lwr_real x16 = c3*x6 - qdd[1]*s3;
-    const lwr_real x17 = -c3*qdd[1] - s3*x6;
-    const lwr_real x18 = c3*x4;
-    const lwr_real x19 = -s3*x4;
-    const lwr_real x20 = -qd[2] - x1;
-    const lwr_real x21 = qd[2]*x15 + x16;
-    const lwr_real x22 = -qdd[2] - x7;
-    const lwr_real x23 = -qd[2]*x14 + x17;
-    const lwr_real x24 = x14*x14;
-    const lwr_real x25 = x14*x20;
-    const lwr_real x26 = x14*x15;
-    const lwr_real x27 = x20*x20;
-    const lwr_real x28 = x15*x20;
-    const lwr_real x29 = x15*x15;
-    const lwr_real x30 = -x27 - x29;
-    const lwr_real x31 = -x24 - x29;
-    const lwr_real x32 = -x24 - x27;
-    const lwr_real x33 = -x23 + x25;
-    const lwr_real x34 = x22 + x26;
-    const lwr_real x35 = -x22 + x26;
-    const lwr_real x36 = x21 + x28;
-    const lwr_real x37 = x18 - LWR_K(0.4)*x33;
-    const lwr_real x38 = -LWR_K(0.4)*x31 - x5;
-    const lwr_real x39 = x19 - LWR_K(0.4)*x36;
-    /* link 4: velocities and accelerations */
-    const lwr_real x40 = c4*x14 + s4*x20;
-    const lwr_real x41 = -c4*x20 + s4*x14;
-    const lwr_real x42 = c4*x21 + s4*x22;
-    const lwr_real x43 = -c4*x22 + s4*x21;
-    const lwr_real x44 = c4*x37 + s4*x38;
-    const lwr_real x45 = -c4*x38 + s4*x37;
-    const lwr_real x46 = qd[3] + x15;
-    const lwr_real x47 = -qd[3]*x41 + x42;
-    const lwr_real x48 = qdd[3] + x23;
-    const lwr_real x49 = qd[3]*x40 + x43;
-    const lwr_real x50 = x40*x40;
-    const lwr_real x51 = x40*x46;
-    const lwr_real x52 = x40*x41;
-    const lwr_real x53 = x46*x46;
-    const lwr_real x54 = x41*x46;
-    const lwr_real x55 = x41*x41;
-    const lwr_real x56 = -x53 - x55;
-    const lwr_real x57 = -x50 - x53;
-    const lwr_real x58 = x48 + x52;
-    const lwr_real x59 = x49 + x51;
-    const lwr_real x60 = -x47 + x54;
-    const lwr_real x61 = -x48 + x52;
-    /* link 5: velocities and accelerations */
-    const lwr_real x62 = c5*x40 + s5*x46;
-    const lwr_real x63 = -c5*x46 + s5*x40;
-    const lwr_real x64 = c5*x47 + s5*x48;
-    const lwr_real x65 = -c5*x48 + s5*x47;
-    const lwr_real x66 = c5*x44 + s5*x39;
-    const lwr_real x67 = -c5*x39 + s5*x44;
-    const lwr_real x68 = qd[4] + x41;
-    const lwr_real x69 = -qd[4]*x63 + x64;
-    const lwr_real x70 = qdd[4] + x49;
-    const lwr_real x71 = qd[4]*x62 + x65;
-    const lwr_real x72 = x62*x62;
-    const lwr_real x73 = x62*x68;
-    const lwr_real x74 = x62*x63;
-    const lwr_real x75 = x68*x68;
-    const lwr_real x76 = x63*x68;
-    const lwr_real x77 = x63*x63;
-    const lwr_real x78 = -x75 - x77;
-    const lwr_real x79 = -x72 - x77;
-    const lwr_real x80 = -x72 - x75;
-    const lwr_real x81 = -x71 + x73;
-    const lwr_real x82 = x70 + x74;
-    const lwr_real x83 = x71 + x73;
-    const lwr_real x84 = -x69 + x76;
-    const lwr_real x85 = -x70 + x74;
-    const lwr_real x86 = x69 + x76;
-    const lwr_real x87 = x66 + LWR_K(0.39)*x81;
-    const lwr_real x88 = x45 + LWR_K(0.39)*x79;
-    const lwr_real x89 = LWR_K(0.39)*x86 + x67;
-    /* link 6: velocities and accelerations */
-    const lwr_real x90 = c6*x62 + s6*x68;
-    const lwr_real x91 = c6*x68 - s6*x62;
-    const lwr_real x92 = c6*x69 + s6*x70;
-    const lwr_real x93 = c6*x70 - s6*x69;
-    const lwr_real x94 = c6*x87 + s6*x88;
-    const lwr_real x95 = c6*x88 - s6*x87;
-    const lwr_real x96 = -qd[5] - x63;
-    const lwr_real x97 = qd[5]*x91 + x92;
-    const lwr_real x98 = -qdd[5] - x71;
-    const lwr_real x99 = -qd[5]*x90 + x93;
-    const lwr_real x100 = x90*x90;
-    const lwr_real x101 = x90*x96;
-    const lwr_real x102 = x90*x91;
-    const lwr_real x103 = x96*x96;
-    const lwr_real x104 = x91*x96;
-    const lwr_real x105 = x91*x91;
-    const lwr_real x106 = -x103 - x105;
-    const lwr_real x107 = -x100 - x103;
-    const lwr_real x108 = x98 + x102;
-    const lwr_real x109 = x99 + x101;
-    const lwr_real x110 = -x97 + x104;
-    const lwr_real x111 = -x98 + x102;
-    /* link 7: velocities and accelerations */
-    const lwr_real x112 = c7*x90 + s7*x96;
-    const lwr_real x113 = c7*x96 - s7*x90;
-    const lwr_real x114 = c7*x97 + s7*x98;
-    const lwr_real x115 = c7*x98 - s7*x97;
-    const lwr_real x116 = c7*x94 - s7*x89;
-    const lwr_real x117 = -c7*x89 - s7*x94;
-    const lwr_real x118 = qd[6] + x91;
-    const lwr_real x119 = qd[6]*x113 + x114;
-    const lwr_real x120 = -qd[6]*x112 + x115;
-    const lwr_real x121 = qdd[6] + x99;
-    const lwr_real x122 = x112*x112;
-    const lwr_real x123 = x112*x113;
-    const lwr_real x124 = x112*x118;
-    const lwr_real x125 = x113*x113;
-    const lwr_real x126 = x113*x118;
-    const lwr_real x127 = x118*x118;
-    const lwr_real x128 = -x125 - x127;
-    const lwr_real x129 = -x122 - x127;
-    const lwr_real x130 = -x121 + x123;
-    const lwr_real x131 = x121 + x123;
-    const lwr_real x132 = -x120 + x124;
-    const lwr_real x133 = x119 + x126;
-    /* link 1: link wrench */
-    const lwr_real x134 = pi_full[0]*qdd[0];
-    /* link 2: link wrench */
-    const lwr_real x135 = pi_full[4]*(-qdd[1] - x10) + (pi_full[5]*(x9 + x7) + (pi_full[3]*x6 - pi_full[6]*x12 + pi_full[7]*(x11 - x13)));
-    const lwr_real x136 = pi_full[4]*(x12 + x6) + (pi_full[7]*(-x9 + x7) + (-pi_full[1]*x5 + pi_full[2]*x4 + pi_full[3]*x10 + pi_full[5]*(x13 - x8) - pi_full[6]*qdd[1]));
-    const lwr_real x137 = pi_full[5]*(-x12 + x6) + (pi_full[7]*(-qdd[1] + x10) + (pi_full[4]*(-x11 + x8) + x9*(-pi_full[3] + pi_full[6])));
-    /* link 3: link wrench */
-    const lwr_real x138 = pi_full[8]*x30 + pi_full[9]*x34;
-    const lwr_real x139 = pi_full[8]*x35 + pi_full[9]*x32;
-    const lwr_real x140 = pi_full[11]*(x22 - x26) + (pi_full[12]*(x23 + x25) + (pi_full[10]*x21 - pi_full[13]*x28 + pi_full[14]*(x27 - x29) - pi_full[9]*x38));
-    const lwr_real x141 = pi_full[11]*(x21 + x28) + (pi_full[14]*(x23 - x25) + (pi_full[10]*x26 + pi_full[12]*(-x24 + x29) + pi_full[13]*x22 - pi_full[8]*x39 + pi_full[9]*x37));
-    const lwr_real x142 = pi_full[12]*(x21 - x28) + (pi_full[14]*(x22 + x26) + (pi_full[11]*(x24 - x27) + pi_full[8]*x38 + x25*(-pi_full[10] + pi_full[13])));
-    /* link 4: link wrench */
-    const lwr_real x143 = pi_full[15]*x56 + pi_full[16]*x58;
-    const lwr_real x144 = pi_full[15]*x59 + pi_full[16]*x60;
-    const lwr_real x145 = pi_full[15]*x61 + pi_full[16]*x57;
-    const lwr_real x146 = pi_full[18]*(x48 - x52) + (pi_full[19]*(x49 + x51) + (-pi_full[16]*x39 + pi_full[17]*x47 - pi_full[20]*x54 + pi_full[21]*(x53 - x55)));
-    const lwr_real x147 = pi_full[18]*(x47 + x54) + (pi_full[21]*(x49 - x51) + (-pi_full[15]*x45 + pi_full[16]*x44 + pi_full[17]*x52 + pi_full[19]*(-x50 + x55) + pi_full[20]*x48));
-    const lwr_real x148 = pi_full[19]*(x47 - x54) + (pi_full[21]*(x48 + x52) + (pi_full[15]*x39 + pi_full[18]*(x50 - x53) + x51*(-pi_full[17] + pi_full[20])));
-    /* link 5: link wrench */
-    const lwr_real x149 = pi_full[22]*x78 + pi_full[23]*x82;
-    const lwr_real x150 = pi_full[22]*x83 + pi_full[23]*x84;
-    const lwr_real x151 = pi_full[22]*x85 + pi_full[23]*x80;
-    const lwr_real x152 = pi_full[25]*(x70 - x74) + (pi_full[26]*(x71 + x73) + (-pi_full[23]*x88 + pi_full[24]*x69 - pi_full[27]*x76 + pi_full[28]*(x75 - x77)));
-    const lwr_real x153 = pi_full[25]*(x69 + x76) + (pi_full[28]*(x71 - x73) + (-pi_full[22]*x89 + pi_full[23]*x87 + pi_full[24]*x74 + pi_full[26]*(-x72 + x77) + pi_full[27]*x70));
-    const lwr_real x154 = pi_full[26]*(x69 - x76) + (pi_full[28]*(x70 + x74) + (pi_full[22]*x88 + pi_full[25]*(x72 - x75) + x73*(-pi_full[24] + pi_full[27])));
-    /* link 6: link wrench */
-    const lwr_real x155 = pi_full[29]*x106 + pi_full[30]*x108;
-    const lwr_real x156 = pi_full[29]*x109 + pi_full[30]*x110;
-    const lwr_real x157 = pi_full[29]*x111 + pi_full[30]*x107;
-    const lwr_real x158 = pi_full[32]*(x98 - x102) + (pi_full[33]*(x99 + x101) + (pi_full[30]*x89 + pi_full[31]*x97 - pi_full[34]*x104 + pi_full[35]*(x103 - x105)));
-    const lwr_real x159 = pi_full[32]*(x97 + x104) + (pi_full[35]*(x99 - x101) + (-pi_full[29]*x95 + pi_full[30]*x94 + pi_full[31]*x102 + pi_full[33]*(-x100 + x105) + pi_full[34]*x98));
-    const lwr_real x160 = pi_full[33]*(x97 - x104) + (pi_full[35]*(x98 + x102) + (-pi_full[29]*x89 + pi_full[32]*(x100 - x103) + x101*(-pi_full[31] + pi_full[34])));
+    const lwr_real x139 = c7*x111 + s7*x117;
+    const lwr_real x140 = c7*x117 - s7*x111;
+    const lwr_real x141 = c7*x118 + s7*x119;
+    const lwr_real x142 = c7*x119 - s7*x118;
+    const lwr_real x143 = c7*x115 - s7*x104;
+    const lwr_real x144 = -c7*x104 - s7*x115;
+    const lwr_real x145 = qd[6] + x112;
+    const lwr_real x146 = qd[6]*x140 + x141;
+    const lwr_real x147 = -qd[6]*x139 + x142;
+    const lwr_real x148 = qdd[6] + x120;
+    const lwr_real x149 = x139*x139;
+    const lwr_real x150 = x139*x140;
+    const lwr_real x151 = x139*x145;
+    const lwr_real x152 = x140*x140;
+    const lwr_real x153 = x140*x145;
+    const lwr_real x154 = x145*x145;
+    const lwr_real x155 = -x152 - x154;
+    const lwr_real x156 = -x149 - x154;
+    const lwr_real x157 = -x148 + x150;
+    const lwr_real x158 = x148 + x150;
+    const lwr_real x159 = -x147 + x151;
+    const lwr_real x160 = x146 + x153;
     /* link 7: link wrench */
-    const lwr_real x161 = pi_full[36]*x128 + pi_full[37]*x130;
-    const lwr_real x162 = pi_full[36]*x131 + pi_full[37]*x129;
-    const lwr_real x163 = pi_full[36]*x132 + pi_full[37]*x133;
-    const lwr_real x164 = pi_full[39]*(x120 - x124) + (pi_full[40]*(x121 + x123) + (pi_full[37]*x95 + pi_full[38]*x119 + pi_full[41]*(x125 - x127) + pi_full[42]*x126));
-    const lwr_real x165 = pi_full[39]*(x119 + x126) + (pi_full[41]*(x121 - x123) + (-pi_full[36]*x95 + pi_full[40]*(-x122 + x127) + x124*(pi_full[38] - pi_full[42])));
-    const lwr_real x166 = pi_full[40]*(x119 - x126) + (pi_full[41]*(x120 + x124) + (pi_full[36]*x117 - pi_full[37]*x116 - pi_full[38]*x123 + pi_full[39]*(x122 - x125) + pi_full[42]*x121));
+    const lwr_real x161 = pi_full[36]*x155 + pi_full[37]*x157;
+    const lwr_real x162 = pi_full[36]*x158 + pi_full[37]*x156;
+    const lwr_real x163 = pi_full[36]*x159 + pi_full[37]*x160;
+    const lwr_real x164 = pi_full[39]*(x147 - x151) + (pi_full[40]*(x148 + x150) + (pi_full[37]*x116 + pi_full[38]*x146 + pi_full[41]*(x152 - x154) + pi_full[42]*x153));
+    const lwr_real x165 = pi_full[39]*(x146 + x153) + (pi_full[41]*(x148 - x150) + (-pi_full[36]*x116 + pi_full[40]*(-x149 + x154) + x151*(pi_full[38] - pi_full[42])));
+    const lwr_real x166 = pi_full[40]*(x146 - x153) + (pi_full[41]*(x147 + x151) + (pi_full[36]*x144 - pi_full[37]*x143 - pi_full[38]*x150 + pi_full[39]*(x149 - x152) + pi_full[42]*x148));
     /* link 7: forces */
     const lwr_real x167 = c7*x161 - s7*x162;
     const lwr_real x168 = c7*x162 + s7*x161;
     const lwr_real x169 = c7*x164 - s7*x165;
     const lwr_real x170 = c7*x165 + s7*x164;
     /* link 6: forces */
-    const lwr_real x171 = x155 + x167;
-    const lwr_real x172 = x156 + x168;
-    const lwr_real x173 = x157 + x163;
-    const lwr_real x174 = x158 + x169;
-    const lwr_real x175 = x159 + x170;
-    const lwr_real x176 = x160 + x166;
+    const lwr_real x171 = x133 + x167;
+    const lwr_real x172 = x134 + x168;
+    const lwr_real x173 = x135 + x163;
+    const lwr_real x174 = x136 + x169;
+    const lwr_real x175 = x137 + x170;
+    const lwr_real x176 = x138 + x166;
     const lwr_real x177 = c6*x171 - s6*x173;
     const lwr_real x178 = c6*x173 + s6*x171;
     const lwr_real x179 = c6*x174 - s6*x176;
     const lwr_real x180 = c6*x176 + s6*x174;
     /* link 5: forces */
-    const lwr_real x181 = x149 + x177;
-    const lwr_real x182 = x150 + x178;
-    const lwr_real x183 = x151 - x172;
-    const lwr_real x184 = x152 + x179;
-    const lwr_real x185 = x153 + x180;
-    const lwr_real x186 = x154 - x175;
+    const lwr_real x181 = x105 + x177;
+    const lwr_real x182 = x106 + x178;
+    const lwr_real x183 = x107 - x172;
+    const lwr_real x184 = x108 + x179;
+    const lwr_real x185 = x109 + x180;
+    const lwr_real x186 = x110 - x175;
     const lwr_real x187 = LWR_K(0.39)*x183 + x184;
     const lwr_real x188 = -LWR_K(0.39)*x181 + x186;
     const lwr_real x189 = c5*x181 + s5*x183;
@@ -854,32 +1089,32 @@ void lwr_inverse_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x191 = c5*x187 + s5*x188;
     const lwr_real x192 = -c5*x188 + s5*x187;
     /* link 4: forces */
-    const lwr_real x193 = x143 + x189;
-    const lwr_real x194 = x144 + x190;
-    const lwr_real x195 = x145 + x182;
-    const lwr_real x196 = x146 + x191;
-    const lwr_real x197 = x147 + x192;
-    const lwr_real x198 = x148 + x185;
+    const lwr_real x193 = x189 + x71;
+    const lwr_real x194 = x190 + x72;
+    const lwr_real x195 = x182 + x73;
+    const lwr_real x196 = x191 + x74;
+    const lwr_real x197 = x192 + x75;
+    const lwr_real x198 = x185 + x76;
     const lwr_real x199 = c4*x193 + s4*x195;
     const lwr_real x200 = c4*x196 + s4*x198;
     const lwr_real x201 = -c4*x198 + s4*x196;
     /* link 3: forces */
-    const lwr_real x202 = x138 + x199;
-    const lwr_real x203 = x139 + x194;
-    const lwr_real x204 = x140 + x200;
-    const lwr_real x205 = x141 + x201;
-    const lwr_real x206 = x142 + x197;
+    const lwr_real x202 = x199 + x44;
+    const lwr_real x203 = x194 + x45;
+    const lwr_real x204 = x200 + x46;
+    const lwr_real x205 = x201 + x47;
+    const lwr_real x206 = x197 + x48;
     const lwr_real x207 = -LWR_K(0.4)*x203 + x204;
     const lwr_real x208 = LWR_K(0.4)*x202 + x206;
     const lwr_real x209 = c3*x207 - s3*x208;
     const lwr_real x210 = c3*x208 + s3*x207;
     /* link 2: forces */
-    const lwr_real x211 = x135 + x209;
-    const lwr_real x212 = x136 + x210;
-    const lwr_real x213 = x137 - x205;
+    const lwr_real x211 = x209 + x15;
+    const lwr_real x212 = x210 + x16;
+    const lwr_real x213 = -x205 + x17;
     const lwr_real x214 = c2*x213 + s2*x211;
     /* link 1: forces */
-    const lwr_real x215 = x134 + x214;
+    const lwr_real x215 = x0 + x214;
     /* tau */
     tau[0] = x215;
     tau[1] = -x212;

@@ -10,30 +10,25 @@
 /* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T. */
 void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd)
 {
-    /* joint angles */
+    /* link 3: velocities and accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
     lwr_real s3, c3;
     LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 3: velocities and accelerations */
     const lwr_real x0 = c3*s2;
     const lwr_real x1 = -s2*s3;
     const lwr_real x2 = LWR_K(0.4)*x1;
     const lwr_real x3 = -LWR_K(0.4)*x0;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x4 = -c2*s4 + c4*x0;
     const lwr_real x5 = c2*c4 + s4*x0;
     const lwr_real x6 = c4*x2;
     const lwr_real x7 = s4*x2;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x8 = c5*x4 + s5*x1;
     const lwr_real x9 = -c5*x1 + s5*x4;
     const lwr_real x10 = c5*x6 + s5*x3;
@@ -41,11 +36,15 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x12 = x10 - LWR_K(0.39)*x9;
     const lwr_real x13 = x11 + LWR_K(0.39)*x8;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x14 = c6*x8 + s6*x5;
     const lwr_real x15 = c6*x5 - s6*x8;
     const lwr_real x16 = c6*x12 + s6*x7;
     const lwr_real x17 = c6*x7 - s6*x12;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x18 = c7*x14 - s7*x9;
     const lwr_real x19 = -c7*x9 - s7*x14;
     const lwr_real x20 = c7*x16 - s7*x13;

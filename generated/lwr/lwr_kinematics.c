@@ -14,27 +14,18 @@
 /* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first. */
 void lwr_link_poses(const lwr_real *q, lwr_real *T)
 {
-    /* joint angles */
+    /* link 2: pose */
     lwr_real s1, c1;
     LWR_SINCOS(q[0], &s1, &c1);
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 2: pose */
     const lwr_real x0 = c1*c2;
     const lwr_real x1 = -c1*s2;
     const lwr_real x2 = c2*s1;
     const lwr_real x3 = -s1*s2;
     /* link 3: pose */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x4 = c3*x0 - s1*s3;
     const lwr_real x5 = -c3*s1 - s3*x0;
     const lwr_real x6 = c1*s3 + c3*x2;
@@ -45,6 +36,8 @@ void lwr_link_poses(const lwr_real *q, lwr_real *T)
     const lwr_real x11 = LWR_K(0.4)*x3;
     const lwr_real x12 = LWR_K(0.4)*c2;
     /* link 4: pose */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x13 = c4*x4 - s4*x1;
     const lwr_real x14 = -c4*x1 - s4*x4;
     const lwr_real x15 = c4*x6 - s4*x3;
@@ -52,6 +45,8 @@ void lwr_link_poses(const lwr_real *q, lwr_real *T)
     const lwr_real x17 = -c2*s4 + c4*x8;
     const lwr_real x18 = -c2*c4 - s4*x8;
     /* link 5: pose */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x19 = c5*x13 + s5*x5;
     const lwr_real x20 = c5*x5 - s5*x13;
     const lwr_real x21 = c5*x15 + s5*x7;
@@ -62,6 +57,8 @@ void lwr_link_poses(const lwr_real *q, lwr_real *T)
     const lwr_real x26 = x11 - LWR_K(0.39)*x16;
     const lwr_real x27 = x12 - LWR_K(0.39)*x18;
     /* link 6: pose */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x28 = c6*x19 - s6*x14;
     const lwr_real x29 = -c6*x14 - s6*x19;
     const lwr_real x30 = c6*x21 - s6*x16;
@@ -69,6 +66,8 @@ void lwr_link_poses(const lwr_real *q, lwr_real *T)
     const lwr_real x32 = c6*x23 - s6*x18;
     const lwr_real x33 = -c6*x18 - s6*x23;
     /* link 7: pose */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x34 = c7*x28 + s7*x20;
     const lwr_real x35 = c7*x20 - s7*x28;
     const lwr_real x36 = c7*x30 + s7*x22;
@@ -162,27 +161,18 @@ void lwr_link_poses(const lwr_real *q, lwr_real *T)
 /* Pose of the flange frame (last link frame times the description's tool offset) in the base frame. */
 void lwr_flange_pose(const lwr_real *q, lwr_real *T)
 {
-    /* joint angles */
+    /* link 2: pose */
     lwr_real s1, c1;
     LWR_SINCOS(q[0], &s1, &c1);
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 2: pose */
     const lwr_real x0 = c1*c2;
     const lwr_real x1 = -c1*s2;
     const lwr_real x2 = c2*s1;
     const lwr_real x3 = -s1*s2;
     /* link 3: pose */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x4 = c3*x0 - s1*s3;
     const lwr_real x5 = -c3*s1 - s3*x0;
     const lwr_real x6 = c1*s3 + c3*x2;
@@ -193,6 +183,8 @@ void lwr_flange_pose(const lwr_real *q, lwr_real *T)
     const lwr_real x11 = LWR_K(0.4)*x3;
     const lwr_real x12 = LWR_K(0.4)*c2;
     /* link 4: pose */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x13 = c4*x4 - s4*x1;
     const lwr_real x14 = -c4*x1 - s4*x4;
     const lwr_real x15 = c4*x6 - s4*x3;
@@ -200,6 +192,8 @@ void lwr_flange_pose(const lwr_real *q, lwr_real *T)
     const lwr_real x17 = -c2*s4 + c4*x8;
     const lwr_real x18 = -c2*c4 - s4*x8;
     /* link 5: pose */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x19 = c5*x13 + s5*x5;
     const lwr_real x20 = c5*x5 - s5*x13;
     const lwr_real x21 = c5*x15 + s5*x7;
@@ -210,6 +204,8 @@ void lwr_flange_pose(const lwr_real *q, lwr_real *T)
     const lwr_real x26 = x11 - LWR_K(0.39)*x16;
     const lwr_real x27 = x12 - LWR_K(0.39)*x18;
     /* link 6: pose */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x28 = c6*x19 - s6*x14;
     const lwr_real x29 = -c6*x14 - s6*x19;
     const lwr_real x30 = c6*x21 - s6*x16;
@@ -217,6 +213,8 @@ void lwr_flange_pose(const lwr_real *q, lwr_real *T)
     const lwr_real x32 = c6*x23 - s6*x18;
     const lwr_real x33 = -c6*x18 - s6*x23;
     /* link 7: pose */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x34 = c7*x28 + s7*x20;
     const lwr_real x35 = c7*x20 - s7*x28;
     const lwr_real x36 = c7*x30 + s7*x22;
@@ -245,25 +243,18 @@ void lwr_flange_pose(const lwr_real *q, lwr_real *T)
 /* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED). */
 void lwr_jacobian(const lwr_real *q, lwr_real *J)
 {
-    /* joint angles */
+    /* link 2: pose */
     lwr_real s1, c1;
     LWR_SINCOS(q[0], &s1, &c1);
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    /* link 2: pose */
     const lwr_real x0 = c1*c2;
     const lwr_real x1 = -c1*s2;
     const lwr_real x2 = c2*s1;
     const lwr_real x3 = -s1*s2;
     /* link 3: pose */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x4 = c3*x0 - s1*s3;
     const lwr_real x5 = -c3*s1 - s3*x0;
     const lwr_real x6 = c1*s3 + c3*x2;
@@ -274,6 +265,8 @@ void lwr_jacobian(const lwr_real *q, lwr_real *J)
     const lwr_real x11 = LWR_K(0.4)*x3;
     const lwr_real x12 = LWR_K(0.4)*c2;
     /* link 4: pose */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x13 = c4*x4 - s4*x1;
     const lwr_real x14 = -c4*x1 - s4*x4;
     const lwr_real x15 = c4*x6 - s4*x3;
@@ -281,6 +274,8 @@ void lwr_jacobian(const lwr_real *q, lwr_real *J)
     const lwr_real x17 = -c2*s4 + c4*x8;
     const lwr_real x18 = -c2*c4 - s4*x8;
     /* link 5: pose */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x19 = c5*x13 + s5*x5;
     const lwr_real x20 = c5*x5 - s5*x13;
     const lwr_real x21 = c5*x15 + s5*x7;
@@ -291,6 +286,8 @@ void lwr_jacobian(const lwr_real *q, lwr_real *J)
     const lwr_real x26 = x11 - LWR_K(0.39)*x16;
     const lwr_real x27 = x12 - LWR_K(0.39)*x18;
     /* link 6: pose */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x28 = -c6*x14 - s6*x19;
     const lwr_real x29 = -c6*x16 - s6*x21;
     const lwr_real x30 = -c6*x18 - s6*x23;
@@ -346,25 +343,18 @@ void lwr_jacobian(const lwr_real *q, lwr_real *J)
 /* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero). */
 void lwr_link_jacobians(const lwr_real *q, lwr_real *J)
 {
-    /* joint angles */
+    /* link 2: pose */
     lwr_real s1, c1;
     LWR_SINCOS(q[0], &s1, &c1);
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    /* link 2: pose */
     const lwr_real x0 = c1*c2;
     const lwr_real x1 = -c1*s2;
     const lwr_real x2 = c2*s1;
     const lwr_real x3 = -s1*s2;
     /* link 3: pose */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x4 = c3*x0 - s1*s3;
     const lwr_real x5 = -c3*s1 - s3*x0;
     const lwr_real x6 = c1*s3 + c3*x2;
@@ -375,6 +365,8 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J)
     const lwr_real x11 = LWR_K(0.4)*x3;
     const lwr_real x12 = LWR_K(0.4)*c2;
     /* link 4: pose */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x13 = c4*x4 - s4*x1;
     const lwr_real x14 = -c4*x1 - s4*x4;
     const lwr_real x15 = c4*x6 - s4*x3;
@@ -382,6 +374,8 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J)
     const lwr_real x17 = -c2*s4 + c4*x8;
     const lwr_real x18 = -c2*c4 - s4*x8;
     /* link 5: pose */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x19 = c5*x13 + s5*x5;
     const lwr_real x20 = c5*x5 - s5*x13;
     const lwr_real x21 = c5*x15 + s5*x7;
@@ -392,6 +386,8 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J)
     const lwr_real x26 = x11 - LWR_K(0.39)*x16;
     const lwr_real x27 = x12 - LWR_K(0.39)*x18;
     /* link 6: pose */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x28 = -c6*x14 - s6*x19;
     const lwr_real x29 = -c6*x16 - s6*x21;
     const lwr_real x30 = -c6*x18 - s6*x23;
@@ -544,25 +540,18 @@ void lwr_link_jacobians(const lwr_real *q, lwr_real *J)
 /* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control). */
 void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_qd)
 {
-    /* joint angles */
+    /* link 2: pose */
     lwr_real s1, c1;
     LWR_SINCOS(q[0], &s1, &c1);
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    /* link 2: pose */
     const lwr_real x0 = c1*c2;
     const lwr_real x1 = -c1*s2;
     const lwr_real x2 = c2*s1;
     const lwr_real x3 = -s1*s2;
     /* link 3: pose */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x4 = c3*x0 - s1*s3;
     const lwr_real x5 = -c3*s1 - s3*x0;
     const lwr_real x6 = c1*s3 + c3*x2;
@@ -573,6 +562,8 @@ void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_q
     const lwr_real x11 = LWR_K(0.4)*x3;
     const lwr_real x12 = LWR_K(0.4)*c2;
     /* link 4: pose */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x13 = c4*x4 - s4*x1;
     const lwr_real x14 = -c4*x1 - s4*x4;
     const lwr_real x15 = c4*x6 - s4*x3;
@@ -580,6 +571,8 @@ void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_q
     const lwr_real x17 = -c2*s4 + c4*x8;
     const lwr_real x18 = -c2*c4 - s4*x8;
     /* link 5: pose */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x19 = c5*x13 + s5*x5;
     const lwr_real x20 = c5*x5 - s5*x13;
     const lwr_real x21 = c5*x15 + s5*x7;
@@ -590,6 +583,8 @@ void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_q
     const lwr_real x26 = x11 - LWR_K(0.39)*x16;
     const lwr_real x27 = x12 - LWR_K(0.39)*x18;
     /* link 6: pose */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x28 = -c6*x14 - s6*x19;
     const lwr_real x29 = -c6*x16 - s6*x21;
     const lwr_real x30 = -c6*x18 - s6*x23;

@@ -13,35 +13,34 @@
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity. */
 void lwr_regressor_gravity(const lwr_real *q, lwr_real *Y)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 2: velocities and accelerations */
     const lwr_real x0 = LWR_K(9.81)*s2;
     const lwr_real x1 = LWR_K(9.81)*c2;
     /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x2 = c3*x0;
     const lwr_real x3 = -s3*x0;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x4 = c4*x2 - s4*x1;
     const lwr_real x5 = c4*x1 + s4*x2;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x6 = c5*x4 + s5*x3;
     const lwr_real x7 = -c5*x3 + s5*x4;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x8 = c6*x6 + s6*x5;
     const lwr_real x9 = c6*x5 - s6*x6;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x10 = c7*x8 - s7*x7;
     const lwr_real x11 = -c7*x7 - s7*x8;
     /* link 3: regressor */
@@ -168,20 +167,11 @@ void lwr_regressor_gravity(const lwr_real *q, lwr_real *Y)
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body). */
 void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
 {
-    /* joint angles */
+    /* link 3: unit accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
     lwr_real s3, c3;
     LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 3: unit accelerations */
     const lwr_real x0 = c3*s2;
     const lwr_real x1 = -s2*s3;
     const lwr_real x2 = LWR_K(0.4)*x1;
@@ -189,6 +179,8 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
     const lwr_real x4 = -LWR_K(0.4)*c3;
     const lwr_real x5 = LWR_K(0.4)*s3;
     /* link 4: unit accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x6 = -c2*s4 + c4*x0;
     const lwr_real x7 = c2*c4 + s4*x0;
     const lwr_real x8 = c4*x2;
@@ -198,6 +190,8 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
     const lwr_real x12 = c4*x4;
     const lwr_real x13 = s4*x4;
     /* link 5: unit accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x14 = c5*x6 + s5*x1;
     const lwr_real x15 = -c5*x1 + s5*x6;
     const lwr_real x16 = c5*x8 + s5*x3;
@@ -217,6 +211,8 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
     const lwr_real x30 = LWR_K(0.39)*c5;
     const lwr_real x31 = LWR_K(0.39)*s5;
     /* link 6: unit accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x32 = c6*x14 + s6*x7;
     const lwr_real x33 = c6*x7 - s6*x14;
     const lwr_real x34 = c6*x18 + s6*x9;
@@ -234,6 +230,8 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
     const lwr_real x46 = c6*x30;
     const lwr_real x47 = -s6*x30;
     /* link 7: unit accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x48 = c7*x32 - s7*x15;
     const lwr_real x49 = -c7*x15 - s7*x32;
     const lwr_real x50 = c7*x34 - s7*x19;
@@ -353,20 +351,9 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y)
 /* Base regressor of the inverse dynamics tau = Y(q, qd, qdd) pi_full. */
 void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *Y)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* link 2: velocities and accelerations */
     const lwr_real x0 = qd[0]*s2;
     const lwr_real x1 = c2*qd[0];
     const lwr_real x2 = qdd[0]*s2;
@@ -388,6 +375,8 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
     const lwr_real x18 = qdd[1] + x10;
     const lwr_real x19 = x12 + x6;
     /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x20 = c3*x0 - qd[1]*s3;
     const lwr_real x21 = -c3*qd[1] - s3*x0;
     const lwr_real x22 = c3*x6 - qdd[1]*s3;
@@ -417,6 +406,8 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
     const lwr_real x46 = -LWR_K(0.4)*x37 - x5;
     const lwr_real x47 = x25 - LWR_K(0.4)*x44;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x48 = c4*x20 + s4*x26;
     const lwr_real x49 = -c4*x26 + s4*x20;
     const lwr_real x50 = c4*x27 + s4*x28;
@@ -442,6 +433,8 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
     const lwr_real x70 = -x56 + x60;
     const lwr_real x71 = x55 + x62;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x72 = c5*x48 + s5*x54;
     const lwr_real x73 = -c5*x54 + s5*x48;
     const lwr_real x74 = c5*x55 + s5*x56;
@@ -471,6 +464,8 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
     const lwr_real x98 = x53 + LWR_K(0.39)*x89;
     const lwr_real x99 = LWR_K(0.39)*x96 + x77;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x100 = c6*x72 + s6*x78;
     const lwr_real x101 = c6*x78 - s6*x72;
     const lwr_real x102 = c6*x79 + s6*x80;
@@ -496,6 +491,8 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
     const lwr_real x122 = -x108 + x112;
     const lwr_real x123 = x107 + x114;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x124 = c7*x100 + s7*x106;
     const lwr_real x125 = c7*x106 - s7*x100;
     const lwr_real x126 = c7*x107 + s7*x108;
@@ -1048,19 +1045,6 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
 void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_real *qr_d, const lwr_real *qr_dd, lwr_real *Y)
 {
     /* joint angles */
-    lwr_real s2, c2;
-    LWR_SINCOS(q[1], &s2, &c2);
-    lwr_real s3, c3;
-    LWR_SINCOS(q[2], &s3, &c3);
-    lwr_real s4, c4;
-    LWR_SINCOS(q[3], &s4, &c4);
-    lwr_real s5, c5;
-    LWR_SINCOS(q[4], &s5, &c5);
-    lwr_real s6, c6;
-    LWR_SINCOS(q[5], &s6, &c6);
-    lwr_real s7, c7;
-    LWR_SINCOS(q[6], &s7, &c7);
-    /* joint angles */
     const lwr_real x0 = LWR_K(0.5)*qd[0];
     const lwr_real x1 = LWR_K(0.5)*qd[1];
     const lwr_real x2 = LWR_K(0.5)*qd[2];
@@ -1069,6 +1053,8 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
     const lwr_real x5 = LWR_K(0.5)*qd[5];
     const lwr_real x6 = LWR_K(0.5)*qd[6];
     /* link 2: velocities and accelerations */
+    lwr_real s2, c2;
+    LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x7 = s2*x0;
     const lwr_real x8 = c2*x0;
     const lwr_real x9 = qr_d[0]*s2;
@@ -1092,6 +1078,8 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
     const lwr_real x27 = qr_dd[1] + x19;
     const lwr_real x28 = x15 + x21;
     /* link 3: velocities and accelerations */
+    lwr_real s3, c3;
+    LWR_SINCOS(q[2], &s3, &c3);
     const lwr_real x29 = c3*x7 - s3*x1;
     const lwr_real x30 = -c3*x1 - s3*x7;
     const lwr_real x31 = c3*x9 - qr_d[1]*s3;
@@ -1124,6 +1112,8 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
     const lwr_real x58 = -x14 - LWR_K(0.4)*x49;
     const lwr_real x59 = x36 - LWR_K(0.4)*x56;
     /* link 4: velocities and accelerations */
+    lwr_real s4, c4;
+    LWR_SINCOS(q[3], &s4, &c4);
     const lwr_real x60 = c4*x29 + s4*x37;
     const lwr_real x61 = -c4*x37 + s4*x29;
     const lwr_real x62 = c4*x31 + s4*x38;
@@ -1152,6 +1142,8 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
     const lwr_real x85 = -x71 + x75;
     const lwr_real x86 = x70 + x77;
     /* link 5: velocities and accelerations */
+    lwr_real s5, c5;
+    LWR_SINCOS(q[4], &s5, &c5);
     const lwr_real x87 = c5*x60 + s5*x68;
     const lwr_real x88 = -c5*x68 + s5*x60;
     const lwr_real x89 = c5*x62 + s5*x69;
@@ -1184,6 +1176,8 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
     const lwr_real x116 = LWR_K(0.39)*x107 + x67;
     const lwr_real x117 = LWR_K(0.39)*x114 + x94;
     /* link 6: velocities and accelerations */
+    lwr_real s6, c6;
+    LWR_SINCOS(q[5], &s6, &c6);
     const lwr_real x118 = c6*x87 + s6*x95;
     const lwr_real x119 = c6*x95 - s6*x87;
     const lwr_real x120 = c6*x89 + s6*x96;
@@ -1212,6 +1206,8 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
     const lwr_real x143 = -x129 + x133;
     const lwr_real x144 = x128 + x135;
     /* link 7: velocities and accelerations */
+    lwr_real s7, c7;
+    LWR_SINCOS(q[6], &s7, &c7);
     const lwr_real x145 = c7*x118 + s7*x126;
     const lwr_real x146 = c7*x126 - s7*x118;
     const lwr_real x147 = c7*x120 + s7*x127;

@@ -1236,6 +1236,7 @@ static lwr_real regressor_gravity_out[84];
 static lwr_real regressor_inertia_out[1092];
 static lwr_real regressor_out[301];
 static lwr_real rnea_out[7];
+static lwr_real rnea_nominal_out[7];
 static lwr_real gravity_out[7];
 static lwr_real mass_matrix_out[49];
 static lwr_real inverse_dynamics_out[7];
@@ -1373,6 +1374,11 @@ int main(void)
 
         lwr_rnea(q, qd, qdd, standard_from_dynamic_out, rnea_out);
         failures += !compare("rnea", k, rnea_out, rnea_expected[k], 7,
+0.0);
+        ++checks;
+
+        lwr_rnea_nominal(q, qd, qdd, rnea_nominal_out);
+        failures += !compare("rnea_nominal", k, rnea_nominal_out, rnea_expected[k], 7,
 0.0);
         ++checks;
 

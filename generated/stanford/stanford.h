@@ -30,6 +30,7 @@
  *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 4 sin/cos
  *   stanford_regressor           402 mul, 259 add, 0 div, 4 sin/cos
  *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
+ *   stanford_rnea_nominal        134 mul, 102 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
  *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
  *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
@@ -207,6 +208,15 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
  * 237 mul, 270 add, 0 div, 4 sin/cos
  */
 void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *tau);
+
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p).
+ *   q        [6]  joint positions [rad or m]
+ *   qd       [6]  joint velocities
+ *   qdd      [6]  joint accelerations
+ *   tau      [6]  joint torques/forces (written)
+ * 134 mul, 102 add, 0 div, 4 sin/cos
+ */
+void stanford_rnea_nominal(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *tau);
 
 /* Gravity vector g(q).
  *   q        [6]  joint positions [rad or m]

@@ -11,15 +11,6 @@
 /* g(q), M(q) and c(q, qd) in one call (tau = M qdd + c + g): each sine and cosine once, shared subexpressions once. */
 void stanford_control(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c)
 {
-    /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
     /* base coefficients pi_gravity = K s */
     const stanford_real x0 = s[11] + s[22];
     const stanford_real x1 = -s[32] + s[13] + s[23];
@@ -28,55 +19,63 @@ void stanford_control(const stanford_real *q, const stanford_real *qd, const sta
     const stanford_real x4 = STANFORD_K(0.263)*s[50];
     const stanford_real x5 = s[43] + s[53] + x4;
     /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x6 = -STANFORD_K(9.81)*s2;
     const stanford_real x7 = STANFORD_K(9.81)*c2;
-    /* link 4: velocities and accelerations */
-    const stanford_real x8 = s4*x6;
-    const stanford_real x9 = c4*x6;
-    /* link 5: velocities and accelerations */
-    const stanford_real x10 = c5*x8 - s5*x7;
-    const stanford_real x11 = c5*x7 + s5*x8;
-    /* link 6: velocities and accelerations */
-    const stanford_real x12 = c6*x10 + s6*x9;
-    const stanford_real x13 = c6*x9 - s6*x10;
     /* link 2: link wrench */
-    const stanford_real x14 = -x0*x7 + x1*x6;
+    const stanford_real x8 = -x0*x7 + x1*x6;
     /* link 3: link wrench */
-    const stanford_real x15 = x2*x6;
-    const stanford_real x16 = x2*x7;
+    const stanford_real x9 = x2*x6;
+    const stanford_real x10 = x2*x7;
+    /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x11 = s4*x6;
+    const stanford_real x12 = c4*x6;
     /* link 4: link wrench */
-    const stanford_real x17 = x3*x7;
-    const stanford_real x18 = -s[31]*x9 + x3*x8;
-    const stanford_real x19 = -s[31]*x7;
+    const stanford_real x13 = x3*x7;
+    const stanford_real x14 = -s[31]*x12 + x11*x3;
+    const stanford_real x15 = -s[31]*x7;
+    /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x16 = c5*x11 - s5*x7;
+    const stanford_real x17 = c5*x7 + s5*x11;
     /* link 5: link wrench */
-    const stanford_real x20 = -x5*x9;
-    const stanford_real x21 = -s[41]*x11 + x10*x5;
-    const stanford_real x22 = s[41]*x9;
+    const stanford_real x18 = -x12*x5;
+    const stanford_real x19 = -s[41]*x17 + x16*x5;
+    const stanford_real x20 = s[41]*x12;
+    /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
+    const stanford_real x21 = c6*x16 + s6*x12;
+    const stanford_real x22 = c6*x12 - s6*x16;
     /* link 6: link wrench */
-    const stanford_real x23 = s[52]*x11;
-    const stanford_real x24 = -s[51]*x11;
-    const stanford_real x25 = s[51]*x13 - s[52]*x12;
+    const stanford_real x23 = s[52]*x17;
+    const stanford_real x24 = -s[51]*x17;
+    const stanford_real x25 = s[51]*x22 - s[52]*x21;
     /* link 6: forces */
     const stanford_real x26 = c6*x23 - s6*x24;
     const stanford_real x27 = c6*x24 + s6*x23;
     /* link 5: forces */
-    const stanford_real x28 = x20 + x26;
-    const stanford_real x29 = x21 + x27;
-    const stanford_real x30 = x22 + x25;
+    const stanford_real x28 = x18 + x26;
+    const stanford_real x29 = x19 + x27;
+    const stanford_real x30 = x20 + x25;
     const stanford_real x31 = c5*x28 + s5*x30;
     const stanford_real x32 = -c5*x30 + s5*x28;
     /* link 4: forces */
-    const stanford_real x33 = x17 + x31;
-    const stanford_real x34 = x18 + x32;
-    const stanford_real x35 = x19 + x29;
+    const stanford_real x33 = x13 + x31;
+    const stanford_real x34 = x14 + x32;
+    const stanford_real x35 = x15 + x29;
     const stanford_real x36 = c4*x33 - s4*x35;
     const stanford_real x37 = c4*x35 + s4*x33;
     /* link 3: forces */
-    const stanford_real x38 = -q[2]*x15 + x36;
+    const stanford_real x38 = -q[2]*x9 + x36;
     /* link 2: forces */
-    const stanford_real x39 = x14 - x38;
-    const stanford_real x40 = STANFORD_K(0.154)*x16 + x37;
-    const stanford_real x41 = -STANFORD_K(0.154)*x15 - x34;
+    const stanford_real x39 = -x38 + x8;
+    const stanford_real x40 = STANFORD_K(0.154)*x10 + x37;
+    const stanford_real x41 = -x34 - STANFORD_K(0.154)*x9;
     const stanford_real x42 = -c2*x41 + s2*x40;
     /* base coefficients pi_inertia = K s */
     const stanford_real x43 = STANFORD_K(0.023716)*s[10];
@@ -365,7 +364,7 @@ void stanford_control(const stanford_real *q, const stanford_real *qd, const sta
     /* g */
     g[0] = -x42;
     g[1] = x39;
-    g[2] = x16;
+    g[2] = x10;
     g[3] = -x34;
     g[4] = x29;
     g[5] = x25;
@@ -418,17 +417,6 @@ void stanford_control(const stanford_real *q, const stanford_real *qd, const sta
 /* control() and the flange's Jacobian J and Jdot qd (as jacobian and jacobian_dot_qd) in one call. */
 void stanford_control_with_jacobian(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c, stanford_real *J, stanford_real *jdot_qd)
 {
-    /* joint angles */
-    stanford_real s1, c1;
-    STANFORD_SINCOS(q[0], &s1, &c1);
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
     /* base coefficients pi_gravity = K s */
     const stanford_real x0 = s[11] + s[22];
     const stanford_real x1 = -s[32] + s[13] + s[23];
@@ -437,55 +425,63 @@ void stanford_control_with_jacobian(const stanford_real *q, const stanford_real 
     const stanford_real x4 = STANFORD_K(0.263)*s[50];
     const stanford_real x5 = s[43] + s[53] + x4;
     /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x6 = -STANFORD_K(9.81)*s2;
     const stanford_real x7 = STANFORD_K(9.81)*c2;
-    /* link 4: velocities and accelerations */
-    const stanford_real x8 = s4*x6;
-    const stanford_real x9 = c4*x6;
-    /* link 5: velocities and accelerations */
-    const stanford_real x10 = c5*x8 - s5*x7;
-    const stanford_real x11 = c5*x7 + s5*x8;
-    /* link 6: velocities and accelerations */
-    const stanford_real x12 = c6*x10 + s6*x9;
-    const stanford_real x13 = c6*x9 - s6*x10;
     /* link 2: link wrench */
-    const stanford_real x14 = -x0*x7 + x1*x6;
+    const stanford_real x8 = -x0*x7 + x1*x6;
     /* link 3: link wrench */
-    const stanford_real x15 = x2*x6;
-    const stanford_real x16 = x2*x7;
+    const stanford_real x9 = x2*x6;
+    const stanford_real x10 = x2*x7;
+    /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x11 = s4*x6;
+    const stanford_real x12 = c4*x6;
     /* link 4: link wrench */
-    const stanford_real x17 = x3*x7;
-    const stanford_real x18 = -s[31]*x9 + x3*x8;
-    const stanford_real x19 = -s[31]*x7;
+    const stanford_real x13 = x3*x7;
+    const stanford_real x14 = -s[31]*x12 + x11*x3;
+    const stanford_real x15 = -s[31]*x7;
+    /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x16 = c5*x11 - s5*x7;
+    const stanford_real x17 = c5*x7 + s5*x11;
     /* link 5: link wrench */
-    const stanford_real x20 = -x5*x9;
-    const stanford_real x21 = -s[41]*x11 + x10*x5;
-    const stanford_real x22 = s[41]*x9;
+    const stanford_real x18 = -x12*x5;
+    const stanford_real x19 = -s[41]*x17 + x16*x5;
+    const stanford_real x20 = s[41]*x12;
+    /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
+    const stanford_real x21 = c6*x16 + s6*x12;
+    const stanford_real x22 = c6*x12 - s6*x16;
     /* link 6: link wrench */
-    const stanford_real x23 = s[52]*x11;
-    const stanford_real x24 = -s[51]*x11;
-    const stanford_real x25 = s[51]*x13 - s[52]*x12;
+    const stanford_real x23 = s[52]*x17;
+    const stanford_real x24 = -s[51]*x17;
+    const stanford_real x25 = s[51]*x22 - s[52]*x21;
     /* link 6: forces */
     const stanford_real x26 = c6*x23 - s6*x24;
     const stanford_real x27 = c6*x24 + s6*x23;
     /* link 5: forces */
-    const stanford_real x28 = x20 + x26;
-    const stanford_real x29 = x21 + x27;
-    const stanford_real x30 = x22 + x25;
+    const stanford_real x28 = x18 + x26;
+    const stanford_real x29 = x19 + x27;
+    const stanford_real x30 = x20 + x25;
     const stanford_real x31 = c5*x28 + s5*x30;
     const stanford_real x32 = -c5*x30 + s5*x28;
     /* link 4: forces */
-    const stanford_real x33 = x17 + x31;
-    const stanford_real x34 = x18 + x32;
-    const stanford_real x35 = x19 + x29;
+    const stanford_real x33 = x13 + x31;
+    const stanford_real x34 = x14 + x32;
+    const stanford_real x35 = x15 + x29;
     const stanford_real x36 = c4*x33 - s4*x35;
     const stanford_real x37 = c4*x35 + s4*x33;
     /* link 3: forces */
-    const stanford_real x38 = -q[2]*x15 + x36;
+    const stanford_real x38 = -q[2]*x9 + x36;
     /* link 2: forces */
-    const stanford_real x39 = x14 - x38;
-    const stanford_real x40 = STANFORD_K(0.154)*x16 + x37;
-    const stanford_real x41 = -STANFORD_K(0.154)*x15 - x34;
+    const stanford_real x39 = -x38 + x8;
+    const stanford_real x40 = STANFORD_K(0.154)*x10 + x37;
+    const stanford_real x41 = -x34 - STANFORD_K(0.154)*x9;
     const stanford_real x42 = -c2*x41 + s2*x40;
     /* base coefficients pi_inertia = K s */
     const stanford_real x43 = STANFORD_K(0.023716)*s[10];
@@ -772,6 +768,8 @@ void stanford_control_with_jacobian(const stanford_real *q, const stanford_real 
     const stanford_real x289 = -STANFORD_K(0.154)*x283 + x287;
     const stanford_real x290 = -c2*x289 + s2*x288;
     /* link 2: pose */
+    stanford_real s1, c1;
+    STANFORD_SINCOS(q[0], &s1, &c1);
     const stanford_real x291 = c1*c2;
     const stanford_real x292 = -c1*s2;
     const stanford_real x293 = c2*s1;
@@ -867,7 +865,7 @@ void stanford_control_with_jacobian(const stanford_real *q, const stanford_real 
     /* g */
     g[0] = -x42;
     g[1] = x39;
-    g[2] = x16;
+    g[2] = x10;
     g[3] = -x34;
     g[4] = x29;
     g[5] = x25;

@@ -12,15 +12,6 @@
 void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *C)
 {
     /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* joint angles */
     const stanford_real x0 = STANFORD_K(0.5)*qd[0];
     const stanford_real x1 = STANFORD_K(0.5)*qd[1];
     const stanford_real x2 = STANFORD_K(0.5)*qd[2];
@@ -28,6 +19,8 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
     const stanford_real x4 = STANFORD_K(0.5)*qd[4];
     const stanford_real x5 = STANFORD_K(0.5)*qd[5];
     /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x6 = -s2*x0;
     const stanford_real x7 = c2*x0;
     const stanford_real x8 = -c2*x1;
@@ -44,6 +37,8 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
     const stanford_real x18 = q[2]*x11;
     const stanford_real x19 = -q[2]*x10;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x20 = -c4*x1 + s4*x6;
     const stanford_real x21 = c4*x6 + s4*x1;
     const stanford_real x22 = -s2*s4;
@@ -71,6 +66,8 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
     const stanford_real x44 = x9 + x33;
     const stanford_real x45 = x29 + x35;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x46 = c5*x20 + s5*x28;
     const stanford_real x47 = -c5*x28 + s5*x20;
     const stanford_real x48 = -c2*s5 + c5*x22;
@@ -98,6 +95,8 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
     const stanford_real x70 = -x30 + x59;
     const stanford_real x71 = x55 + x61;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x72 = c6*x46 + s6*x54;
     const stanford_real x73 = c6*x54 - s6*x46;
     const stanford_real x74 = c6*x48 + s6*x23;
@@ -684,15 +683,6 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
 void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot)
 {
     /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* joint angles */
     const stanford_real x0 = STANFORD_K(0.5)*qd[0];
     const stanford_real x1 = STANFORD_K(0.5)*qd[1];
     const stanford_real x2 = STANFORD_K(0.5)*qd[2];
@@ -700,6 +690,8 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
     const stanford_real x4 = STANFORD_K(0.5)*qd[4];
     const stanford_real x5 = STANFORD_K(0.5)*qd[5];
     /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x6 = -s2*x0;
     const stanford_real x7 = c2*x0;
     const stanford_real x8 = -c2*x1;
@@ -716,6 +708,8 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
     const stanford_real x18 = q[2]*x11;
     const stanford_real x19 = -q[2]*x10;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x20 = -c4*x1 + s4*x6;
     const stanford_real x21 = c4*x6 + s4*x1;
     const stanford_real x22 = -s2*s4;
@@ -743,6 +737,8 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
     const stanford_real x44 = x9 + x33;
     const stanford_real x45 = x29 + x35;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x46 = c5*x20 + s5*x28;
     const stanford_real x47 = -c5*x28 + s5*x20;
     const stanford_real x48 = -c2*s5 + c5*x22;
@@ -770,6 +766,8 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
     const stanford_real x70 = -x30 + x59;
     const stanford_real x71 = x55 + x61;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x72 = c6*x46 + s6*x54;
     const stanford_real x73 = c6*x54 - s6*x46;
     const stanford_real x74 = c6*x48 + s6*x23;

@@ -11,16 +11,9 @@
 /* Derivatives of inverse dynamics: D = [d tau / d q | d tau / d qd] (N x 2N) at (q, qd, qdd). */
 void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *D)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: velocities and accelerations */
     const stanford_real x0 = -qd[0]*s2;
     const stanford_real x1 = c2*qd[0];
     const stanford_real x2 = -qdd[0]*s2;
@@ -52,6 +45,8 @@ void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x27 = q[2]*x18 + 2*qd[1]*qd[2] + x23;
     const stanford_real x28 = q[2]*x16 + qdd[2] + x25;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x29 = -c4*qd[1] + s4*x0;
     const stanford_real x30 = c4*x0 + qd[1]*s4;
     const stanford_real x31 = -c4*qdd[1] + s4*x6;
@@ -78,6 +73,8 @@ void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x52 = -x37 + x41;
     const stanford_real x53 = x36 + x43;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x54 = c5*x29 + s5*x35;
     const stanford_real x55 = -c5*x35 + s5*x29;
     const stanford_real x56 = c5*x36 + s5*x37;
@@ -104,6 +101,8 @@ void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x77 = -x62 + x66;
     const stanford_real x78 = x61 + x68;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x79 = c6*x54 + s6*x60;
     const stanford_real x80 = c6*x60 - s6*x54;
     const stanford_real x81 = c6*x61 + s6*x62;
@@ -1255,31 +1254,30 @@ void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, 
 /* Derivatives of forward dynamics: D = [d qdd / d q | d qdd / d qd] = -M^-1 [d tau / d q | d tau / d qd] at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1). */
 void stanford_forward_dynamics_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *D)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: velocities and accelerations */
     const stanford_real x0 = -STANFORD_K(0.154)*c2;
     const stanford_real x1 = -STANFORD_K(0.154)*s2;
     /* link 3: velocities and accelerations */
     const stanford_real x2 = -q[2]*s2;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x3 = -s2*s4;
     const stanford_real x4 = -c4*s2;
     const stanford_real x5 = c4*x2 + s4*x0;
     const stanford_real x6 = c4*x0 - s4*x2;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x7 = -c2*s5 + c5*x3;
     const stanford_real x8 = c2*c5 + s5*x3;
     const stanford_real x9 = c5*x5 - s5*x1;
     const stanford_real x10 = c5*x1 + s5*x5;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x11 = c6*x7 + s6*x4;
     const stanford_real x12 = c6*x4 - s6*x7;
     const stanford_real x13 = c6*x9 + s6*x6;

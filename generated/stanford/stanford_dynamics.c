@@ -4,6 +4,7 @@
  * Conventions, shapes and parameter orders: stanford.h.
  *
  *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
+ *   stanford_rnea_nominal        134 mul, 102 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
  *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
  *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
@@ -13,15 +14,6 @@
 /* Inverse dynamics tau = M(q) qdd + c(q, qd) + g(q), recursive Newton-Euler. */
 void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *tau)
 {
-    /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
     /* base coefficients pi_full = K s */
     const stanford_real x0 = STANFORD_K(0.023716)*s[10];
     const stanford_real x1 = STANFORD_K(0.308)*s[12];
@@ -43,148 +35,156 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
     const stanford_real x17 = s[44] + s[57] - s[49] + x15 + x16;
     const stanford_real x18 = s[47] + s[57] + x15 + x16;
     const stanford_real x19 = s[54] - s[57];
-    /* link 2: velocities and accelerations */
-    const stanford_real x20 = -qd[0]*s2;
-    const stanford_real x21 = c2*qd[0];
-    const stanford_real x22 = -qdd[0]*s2;
-    const stanford_real x23 = c2*qdd[0];
-    const stanford_real x24 = -STANFORD_K(9.81)*s2;
-    const stanford_real x25 = STANFORD_K(9.81)*c2;
-    const stanford_real x26 = -qd[1]*x21 + x22;
-    const stanford_real x27 = qd[1]*x20 + x23;
-    const stanford_real x28 = x20*x20;
-    const stanford_real x29 = qd[1]*x20;
-    const stanford_real x30 = x20*x21;
-    const stanford_real x31 = qd[1]*qd[1];
-    const stanford_real x32 = qd[1]*x21;
-    const stanford_real x33 = x21*x21;
-    const stanford_real x34 = -x31 - x33;
-    const stanford_real x35 = -x28 - x33;
-    const stanford_real x36 = -x28 - x31;
-    const stanford_real x37 = -x27 + x29;
-    const stanford_real x38 = qdd[1] + x30;
-    const stanford_real x39 = x27 + x29;
-    const stanford_real x40 = -x26 + x32;
-    const stanford_real x41 = -qdd[1] + x30;
-    const stanford_real x42 = x26 + x32;
-    const stanford_real x43 = x24 + STANFORD_K(0.154)*x37;
-    const stanford_real x44 = STANFORD_K(0.154)*x35;
-    const stanford_real x45 = x25 + STANFORD_K(0.154)*x42;
-    /* link 3: velocities and accelerations */
-    const stanford_real x46 = -q[2]*x40 + 2*qd[2]*x20 - x44;
-    const stanford_real x47 = q[2]*x38 + 2*qd[1]*qd[2] + x43;
-    const stanford_real x48 = q[2]*x36 + qdd[2] + x45;
-    /* link 4: velocities and accelerations */
-    const stanford_real x49 = -c4*qd[1] + s4*x20;
-    const stanford_real x50 = c4*x20 + qd[1]*s4;
-    const stanford_real x51 = -c4*qdd[1] + s4*x26;
-    const stanford_real x52 = c4*x26 + qdd[1]*s4;
-    const stanford_real x53 = c4*x46 + s4*x47;
-    const stanford_real x54 = c4*x47 - s4*x46;
-    const stanford_real x55 = -qd[3] - x21;
-    const stanford_real x56 = qd[3]*x50 + x51;
-    const stanford_real x57 = -qdd[3] - x27;
-    const stanford_real x58 = -qd[3]*x49 + x52;
-    const stanford_real x59 = x49*x49;
-    const stanford_real x60 = x49*x55;
-    const stanford_real x61 = x49*x50;
-    const stanford_real x62 = x55*x55;
-    const stanford_real x63 = x50*x55;
-    const stanford_real x64 = x50*x50;
-    const stanford_real x65 = -x62 - x64;
-    const stanford_real x66 = -x59 - x62;
-    const stanford_real x67 = x57 + x61;
-    const stanford_real x68 = x58 + x60;
-    const stanford_real x69 = -x56 + x63;
-    const stanford_real x70 = -x57 + x61;
-    /* link 5: velocities and accelerations */
-    const stanford_real x71 = c5*x49 + s5*x55;
-    const stanford_real x72 = -c5*x55 + s5*x49;
-    const stanford_real x73 = c5*x56 + s5*x57;
-    const stanford_real x74 = -c5*x57 + s5*x56;
-    const stanford_real x75 = c5*x53 - s5*x48;
-    const stanford_real x76 = c5*x48 + s5*x53;
-    const stanford_real x77 = qd[4] + x50;
-    const stanford_real x78 = -qd[4]*x72 + x73;
-    const stanford_real x79 = qdd[4] + x58;
-    const stanford_real x80 = qd[4]*x71 + x74;
-    const stanford_real x81 = x71*x71;
-    const stanford_real x82 = x71*x77;
-    const stanford_real x83 = x71*x72;
-    const stanford_real x84 = x77*x77;
-    const stanford_real x85 = x72*x77;
-    const stanford_real x86 = x72*x72;
-    const stanford_real x87 = -x84 - x86;
-    const stanford_real x88 = -x81 - x84;
-    const stanford_real x89 = x79 + x83;
-    const stanford_real x90 = x80 + x82;
-    const stanford_real x91 = -x78 + x85;
-    const stanford_real x92 = -x79 + x83;
-    /* link 6: velocities and accelerations */
-    const stanford_real x93 = c6*x71 + s6*x77;
-    const stanford_real x94 = c6*x77 - s6*x71;
-    const stanford_real x95 = c6*x78 + s6*x79;
-    const stanford_real x96 = c6*x79 - s6*x78;
-    const stanford_real x97 = c6*x75 + s6*x54;
-    const stanford_real x98 = c6*x54 - s6*x75;
-    const stanford_real x99 = qd[5] + x72;
-    const stanford_real x100 = qd[5]*x94 + x95;
-    const stanford_real x101 = -qd[5]*x93 + x96;
-    const stanford_real x102 = qdd[5] + x80;
-    const stanford_real x103 = x93*x93;
-    const stanford_real x104 = x93*x94;
-    const stanford_real x105 = x93*x99;
-    const stanford_real x106 = x94*x94;
-    const stanford_real x107 = x94*x99;
-    const stanford_real x108 = x99*x99;
-    const stanford_real x109 = -x106 - x108;
-    const stanford_real x110 = -x103 - x108;
-    const stanford_real x111 = -x103 - x106;
-    const stanford_real x112 = -x102 + x104;
-    const stanford_real x113 = x101 + x105;
-    const stanford_real x114 = x102 + x104;
-    const stanford_real x115 = -x100 + x107;
-    const stanford_real x116 = -x101 + x105;
-    const stanford_real x117 = x100 + x107;
-    const stanford_real x118 = x97 + STANFORD_K(0.263)*x113;
-    const stanford_real x119 = x98 + STANFORD_K(0.263)*x115;
-    const stanford_real x120 = STANFORD_K(0.263)*x111 + x76;
     /* link 1: link wrench */
-    const stanford_real x121 = -qdd[0]*x2;
+    const stanford_real x20 = -qdd[0]*x2;
+    /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
+    const stanford_real x21 = -qd[0]*s2;
+    const stanford_real x22 = c2*qd[0];
+    const stanford_real x23 = -qdd[0]*s2;
+    const stanford_real x24 = c2*qdd[0];
+    const stanford_real x25 = -STANFORD_K(9.81)*s2;
+    const stanford_real x26 = STANFORD_K(9.81)*c2;
+    const stanford_real x27 = -qd[1]*x22 + x23;
+    const stanford_real x28 = qd[1]*x21 + x24;
+    const stanford_real x29 = x21*x21;
+    const stanford_real x30 = qd[1]*x21;
+    const stanford_real x31 = x21*x22;
+    const stanford_real x32 = qd[1]*qd[1];
+    const stanford_real x33 = qd[1]*x22;
+    const stanford_real x34 = x22*x22;
+    const stanford_real x35 = -x32 - x34;
+    const stanford_real x36 = -x29 - x34;
+    const stanford_real x37 = -x29 - x32;
+    const stanford_real x38 = -x28 + x30;
+    const stanford_real x39 = qdd[1] + x31;
+    const stanford_real x40 = x28 + x30;
+    const stanford_real x41 = -x27 + x33;
+    const stanford_real x42 = -qdd[1] + x31;
+    const stanford_real x43 = x27 + x33;
+    const stanford_real x44 = x25 + STANFORD_K(0.154)*x38;
+    const stanford_real x45 = STANFORD_K(0.154)*x36;
+    const stanford_real x46 = x26 + STANFORD_K(0.154)*x43;
     /* link 2: link wrench */
-    const stanford_real x122 = s[11]*x34 + s[13]*x38;
-    const stanford_real x123 = s[11]*x41 + s[13]*x36;
-    const stanford_real x124 = x4*(qdd[1] - x30) + (x5*(x27 + x29) + (-s[13]*x44 + x26*x3 - x32*x6 + x7*(x31 - x33)));
-    const stanford_real x125 = x4*(x26 + x32) + (x7*(x27 - x29) + (-s[11]*x45 + s[13]*x43 + qdd[1]*x6 + x3*x30 + x5*(-x28 + x33)));
-    const stanford_real x126 = x5*(x26 - x32) + (x7*(qdd[1] + x30) + (s[11]*x44 + x29*(-x3 + x6) + x4*(x28 - x31)));
+    const stanford_real x47 = s[11]*x35 + s[13]*x39;
+    const stanford_real x48 = s[11]*x42 + s[13]*x37;
+    const stanford_real x49 = x4*(qdd[1] - x31) + (x5*(x28 + x30) + (-s[13]*x45 + x27*x3 - x33*x6 + x7*(x32 - x34)));
+    const stanford_real x50 = x4*(x27 + x33) + (x7*(x28 - x30) + (-s[11]*x46 + s[13]*x44 + qdd[1]*x6 + x3*x31 + x5*(-x29 + x34)));
+    const stanford_real x51 = x5*(x27 - x33) + (x7*(qdd[1] + x31) + (s[11]*x45 + x30*(-x3 + x6) + x4*(x29 - x32)));
+    /* link 3: velocities and accelerations */
+    const stanford_real x52 = -q[2]*x41 + 2*qd[2]*x21 - x45;
+    const stanford_real x53 = q[2]*x39 + 2*qd[1]*qd[2] + x44;
+    const stanford_real x54 = q[2]*x37 + qdd[2] + x46;
     /* link 3: link wrench */
-    const stanford_real x127 = s[21]*x35 - s[22]*x39 - x40*x9 + x46*x8;
-    const stanford_real x128 = -s[21]*x37 + s[22]*x34 + x38*x9 + x47*x8;
-    const stanford_real x129 = -s[21]*x42 + s[22]*x41 + x36*x9 + x48*x8;
-    const stanford_real x130 = s[22]*x48 - x47*x9;
-    const stanford_real x131 = -s[21]*x48 + x46*x9;
-    const stanford_real x132 = s[21]*x47 - s[22]*x46;
+    const stanford_real x55 = s[21]*x36 - s[22]*x40 - x41*x9 + x52*x8;
+    const stanford_real x56 = -s[21]*x38 + s[22]*x35 + x39*x9 + x53*x8;
+    const stanford_real x57 = -s[21]*x43 + s[22]*x42 + x37*x9 + x54*x8;
+    const stanford_real x58 = s[22]*x54 - x53*x9;
+    const stanford_real x59 = -s[21]*x54 + x52*x9;
+    const stanford_real x60 = s[21]*x53 - s[22]*x52;
+    /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x61 = -c4*qd[1] + s4*x21;
+    const stanford_real x62 = c4*x21 + qd[1]*s4;
+    const stanford_real x63 = -c4*qdd[1] + s4*x27;
+    const stanford_real x64 = c4*x27 + qdd[1]*s4;
+    const stanford_real x65 = c4*x52 + s4*x53;
+    const stanford_real x66 = c4*x53 - s4*x52;
+    const stanford_real x67 = -qd[3] - x22;
+    const stanford_real x68 = qd[3]*x62 + x63;
+    const stanford_real x69 = -qdd[3] - x28;
+    const stanford_real x70 = -qd[3]*x61 + x64;
+    const stanford_real x71 = x61*x61;
+    const stanford_real x72 = x61*x67;
+    const stanford_real x73 = x61*x62;
+    const stanford_real x74 = x67*x67;
+    const stanford_real x75 = x62*x67;
+    const stanford_real x76 = x62*x62;
+    const stanford_real x77 = -x74 - x76;
+    const stanford_real x78 = -x71 - x74;
+    const stanford_real x79 = x69 + x73;
+    const stanford_real x80 = x70 + x72;
+    const stanford_real x81 = -x68 + x75;
+    const stanford_real x82 = -x69 + x73;
     /* link 4: link wrench */
-    const stanford_real x133 = s[31]*x65 + x10*x67;
-    const stanford_real x134 = s[31]*x68 + x10*x69;
-    const stanford_real x135 = s[31]*x70 + x10*x66;
-    const stanford_real x136 = s[35]*(x57 - x61) + (s[36]*(x58 + x60) + (s[38]*(x62 - x64) + x10*x48 + x11*x56 - x12*x63));
-    const stanford_real x137 = s[35]*(x56 + x63) + (s[38]*(x58 - x60) + (s[36]*(-x59 + x64) - s[31]*x54 + x10*x53 + x11*x61 + x12*x57));
-    const stanford_real x138 = s[36]*(x56 - x63) + (s[38]*(x57 + x61) + (s[35]*(x59 - x62) - s[31]*x48 + x60*(-x11 + x12)));
+    const stanford_real x83 = s[31]*x77 + x10*x79;
+    const stanford_real x84 = s[31]*x80 + x10*x81;
+    const stanford_real x85 = s[31]*x82 + x10*x78;
+    const stanford_real x86 = s[35]*(x69 - x73) + (s[36]*(x70 + x72) + (s[38]*(x74 - x76) + x10*x54 + x11*x68 - x12*x75));
+    const stanford_real x87 = s[35]*(x68 + x75) + (s[38]*(x70 - x72) + (s[36]*(-x71 + x76) - s[31]*x66 + x10*x65 + x11*x73 + x12*x69));
+    const stanford_real x88 = s[36]*(x68 - x75) + (s[38]*(x69 + x73) + (s[35]*(x71 - x74) - s[31]*x54 + x72*(-x11 + x12)));
+    /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x89 = c5*x61 + s5*x67;
+    const stanford_real x90 = -c5*x67 + s5*x61;
+    const stanford_real x91 = c5*x68 + s5*x69;
+    const stanford_real x92 = -c5*x69 + s5*x68;
+    const stanford_real x93 = c5*x65 - s5*x54;
+    const stanford_real x94 = c5*x54 + s5*x65;
+    const stanford_real x95 = qd[4] + x62;
+    const stanford_real x96 = -qd[4]*x90 + x91;
+    const stanford_real x97 = qdd[4] + x70;
+    const stanford_real x98 = qd[4]*x89 + x92;
+    const stanford_real x99 = x89*x89;
+    const stanford_real x100 = x95*x89;
+    const stanford_real x101 = x89*x90;
+    const stanford_real x102 = x95*x95;
+    const stanford_real x103 = x95*x90;
+    const stanford_real x104 = x90*x90;
+    const stanford_real x105 = -x102 - x104;
+    const stanford_real x106 = -x99 - x102;
+    const stanford_real x107 = x97 + x101;
+    const stanford_real x108 = x98 + x100;
+    const stanford_real x109 = -x96 + x103;
+    const stanford_real x110 = -x97 + x101;
     /* link 5: link wrench */
-    const stanford_real x139 = s[41]*x87 + x14*x89;
-    const stanford_real x140 = s[41]*x90 + x14*x91;
-    const stanford_real x141 = s[41]*x92 + x14*x88;
-    const stanford_real x142 = s[45]*(x79 - x83) + (s[46]*(x80 + x82) + (s[48]*(x84 - x86) - x14*x54 + x17*x78 - x18*x85));
-    const stanford_real x143 = s[45]*(x78 + x85) + (s[48]*(x80 - x82) + (s[46]*(-x81 + x86) - s[41]*x76 + x14*x75 + x17*x83 + x18*x79));
-    const stanford_real x144 = s[46]*(x78 - x85) + (s[48]*(x79 + x83) + (s[45]*(x81 - x84) + s[41]*x54 + x82*(-x17 + x18)));
+    const stanford_real x111 = s[41]*x105 + x107*x14;
+    const stanford_real x112 = s[41]*x108 + x109*x14;
+    const stanford_real x113 = s[41]*x110 + x106*x14;
+    const stanford_real x114 = s[45]*(x97 - x101) + (s[46]*(x98 + x100) + (s[48]*(x102 - x104) + x96*x17 - x103*x18 - x14*x66));
+    const stanford_real x115 = s[45]*(x96 + x103) + (s[48]*(x98 - x100) + (s[46]*(-x99 + x104) - s[41]*x94 + x97*x18 + x101*x17 + x14*x93));
+    const stanford_real x116 = s[46]*(x96 - x103) + (s[48]*(x97 + x101) + (s[45]*(x99 - x102) + s[41]*x66 + x100*(-x17 + x18)));
+    /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
+    const stanford_real x117 = c6*x89 + s6*x95;
+    const stanford_real x118 = c6*x95 - s6*x89;
+    const stanford_real x119 = c6*x96 + s6*x97;
+    const stanford_real x120 = c6*x97 - s6*x96;
+    const stanford_real x121 = c6*x93 + s6*x66;
+    const stanford_real x122 = c6*x66 - s6*x93;
+    const stanford_real x123 = qd[5] + x90;
+    const stanford_real x124 = qd[5]*x118 + x119;
+    const stanford_real x125 = -qd[5]*x117 + x120;
+    const stanford_real x126 = qdd[5] + x98;
+    const stanford_real x127 = x117*x117;
+    const stanford_real x128 = x117*x118;
+    const stanford_real x129 = x117*x123;
+    const stanford_real x130 = x118*x118;
+    const stanford_real x131 = x118*x123;
+    const stanford_real x132 = x123*x123;
+    const stanford_real x133 = -x130 - x132;
+    const stanford_real x134 = -x127 - x132;
+    const stanford_real x135 = -x127 - x130;
+    const stanford_real x136 = -x126 + x128;
+    const stanford_real x137 = x125 + x129;
+    const stanford_real x138 = x126 + x128;
+    const stanford_real x139 = -x124 + x131;
+    const stanford_real x140 = -x125 + x129;
+    const stanford_real x141 = x124 + x131;
+    const stanford_real x142 = x121 + STANFORD_K(0.263)*x137;
+    const stanford_real x143 = x122 + STANFORD_K(0.263)*x139;
+    const stanford_real x144 = STANFORD_K(0.263)*x135 + x94;
     /* link 6: link wrench */
-    const stanford_real x145 = s[51]*x109 + s[52]*x112;
-    const stanford_real x146 = s[51]*x114 + s[52]*x110;
-    const stanford_real x147 = s[51]*x116 + s[52]*x117;
-    const stanford_real x148 = s[55]*(x101 - x105) + (s[56]*(x102 + x104) + (s[58]*(x106 - x108) + s[59]*x107 + s[52]*x120 + x100*x19));
-    const stanford_real x149 = s[55]*(x100 + x107) + (s[58]*(x102 - x104) + (s[56]*(-x103 + x108) - s[51]*x120 + x105*(-s[59] + x19)));
-    const stanford_real x150 = s[56]*(x100 - x107) + (s[58]*(x101 + x105) + (s[55]*(x103 - x106) + s[59]*x102 + s[51]*x119 - s[52]*x118 - x104*x19));
+    const stanford_real x145 = s[51]*x133 + s[52]*x136;
+    const stanford_real x146 = s[51]*x138 + s[52]*x134;
+    const stanford_real x147 = s[51]*x140 + s[52]*x141;
+    const stanford_real x148 = s[55]*(x125 - x129) + (s[56]*(x126 + x128) + (s[58]*(x130 - x132) + s[59]*x131 + s[52]*x144 + x124*x19));
+    const stanford_real x149 = s[55]*(x124 + x131) + (s[58]*(x126 - x128) + (s[56]*(-x127 + x132) - s[51]*x144 + x129*(-s[59] + x19)));
+    const stanford_real x150 = s[56]*(x124 - x131) + (s[58]*(x125 + x129) + (s[55]*(x127 - x130) + s[59]*x126 + s[51]*x143 - s[52]*x142 - x128*x19));
     /* link 6: forces */
     const stanford_real x151 = -STANFORD_K(0.263)*x146 + x148;
     const stanford_real x152 = STANFORD_K(0.263)*x145 + x149;
@@ -193,47 +193,47 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
     const stanford_real x155 = c6*x151 - s6*x152;
     const stanford_real x156 = c6*x152 + s6*x151;
     /* link 5: forces */
-    const stanford_real x157 = x139 + x153;
-    const stanford_real x158 = x140 + x154;
-    const stanford_real x159 = x141 + x147;
-    const stanford_real x160 = x142 + x155;
-    const stanford_real x161 = x143 + x156;
-    const stanford_real x162 = x144 + x150;
+    const stanford_real x157 = x111 + x153;
+    const stanford_real x158 = x112 + x154;
+    const stanford_real x159 = x113 + x147;
+    const stanford_real x160 = x114 + x155;
+    const stanford_real x161 = x115 + x156;
+    const stanford_real x162 = x116 + x150;
     const stanford_real x163 = c5*x157 + s5*x159;
     const stanford_real x164 = -c5*x159 + s5*x157;
     const stanford_real x165 = c5*x160 + s5*x162;
     const stanford_real x166 = -c5*x162 + s5*x160;
     /* link 4: forces */
-    const stanford_real x167 = x133 + x163;
-    const stanford_real x168 = x134 + x164;
-    const stanford_real x169 = x135 + x158;
-    const stanford_real x170 = x136 + x165;
-    const stanford_real x171 = x137 + x166;
-    const stanford_real x172 = x138 + x161;
+    const stanford_real x167 = x163 + x83;
+    const stanford_real x168 = x164 + x84;
+    const stanford_real x169 = x158 + x85;
+    const stanford_real x170 = x165 + x86;
+    const stanford_real x171 = x166 + x87;
+    const stanford_real x172 = x161 + x88;
     const stanford_real x173 = c4*x167 - s4*x169;
     const stanford_real x174 = c4*x169 + s4*x167;
     const stanford_real x175 = c4*x170 - s4*x172;
     const stanford_real x176 = c4*x172 + s4*x170;
     /* link 3: forces */
-    const stanford_real x177 = x127 + x173;
-    const stanford_real x178 = x128 + x174;
-    const stanford_real x179 = x129 - x168;
-    const stanford_real x180 = x130 + x175;
-    const stanford_real x181 = x131 + x176;
-    const stanford_real x182 = x132 - x171;
+    const stanford_real x177 = x173 + x55;
+    const stanford_real x178 = x174 + x56;
+    const stanford_real x179 = -x168 + x57;
+    const stanford_real x180 = x175 + x58;
+    const stanford_real x181 = x176 + x59;
+    const stanford_real x182 = -x171 + x60;
     const stanford_real x183 = -q[2]*x178 + x180;
     const stanford_real x184 = q[2]*x177 + x181;
     /* link 2: forces */
-    const stanford_real x185 = x122 + x178;
-    const stanford_real x186 = x123 + x179;
-    const stanford_real x187 = x124 + x184;
-    const stanford_real x188 = x125 - x183;
-    const stanford_real x189 = x126 + x182;
+    const stanford_real x185 = x178 + x47;
+    const stanford_real x186 = x179 + x48;
+    const stanford_real x187 = x184 + x49;
+    const stanford_real x188 = -x183 + x50;
+    const stanford_real x189 = x182 + x51;
     const stanford_real x190 = STANFORD_K(0.154)*x186 + x187;
     const stanford_real x191 = -STANFORD_K(0.154)*x185 + x189;
     const stanford_real x192 = -c2*x191 + s2*x190;
     /* link 1: forces */
-    const stanford_real x193 = x121 + x192;
+    const stanford_real x193 = x192 + x20;
     /* tau */
     tau[0] = -x193;
     tau[1] = x188;
@@ -243,18 +243,172 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
     tau[5] = x150;
 }
 
+/* Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's fixed parameters when it has none; manifest.json selftest.p). */
+void stanford_rnea_nominal(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *tau)
+{
+    /* link 1: link wrench */
+    const stanford_real x0 = -STANFORD_K(4.5325332225)*qdd[0];
+    /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
+    const stanford_real x1 = -qd[0]*s2;
+    const stanford_real x2 = c2*qd[0];
+    const stanford_real x3 = -qdd[0]*s2;
+    const stanford_real x4 = c2*qdd[0];
+    const stanford_real x5 = -STANFORD_K(9.81)*s2;
+    const stanford_real x6 = STANFORD_K(9.81)*c2;
+    const stanford_real x7 = -qd[1]*x2 + x3;
+    const stanford_real x8 = qd[1]*x1 + x4;
+    const stanford_real x9 = x1*x1;
+    const stanford_real x10 = qd[1]*x1;
+    const stanford_real x11 = x1*x2;
+    const stanford_real x12 = qd[1]*qd[1];
+    const stanford_real x13 = qd[1]*x2;
+    const stanford_real x14 = x2*x2;
+    const stanford_real x15 = -x9 - x14;
+    const stanford_real x16 = -x9 - x12;
+    const stanford_real x17 = x10 - x8;
+    const stanford_real x18 = qdd[1] + x11;
+    const stanford_real x19 = x13 - x7;
+    const stanford_real x20 = x13 + x7;
+    const stanford_real x21 = STANFORD_K(0.154)*x17 + x5;
+    const stanford_real x22 = STANFORD_K(0.154)*x15;
+    const stanford_real x23 = STANFORD_K(0.154)*x20 + x6;
+    /* link 2: link wrench */
+    const stanford_real x24 = -STANFORD_K(179.18432937)*x13 + STANFORD_K(179.16832937)*x7;
+    const stanford_real x25 = STANFORD_K(179.18432937)*qdd[1] + STANFORD_K(179.16832937)*x11;
+    const stanford_real x26 = STANFORD_K(0.016)*x10;
+    /* link 3: velocities and accelerations */
+    const stanford_real x27 = -q[2]*x19 + 2*qd[2]*x1 - x22;
+    const stanford_real x28 = q[2]*x18 + 2*qd[1]*qd[2] + x21;
+    const stanford_real x29 = q[2]*x16 + qdd[2] + x23;
+    /* link 3: link wrench */
+    const stanford_real x30 = STANFORD_K(27.49911)*x19 + STANFORD_K(6.47)*x27;
+    const stanford_real x31 = -STANFORD_K(27.49911)*x18 + STANFORD_K(6.47)*x28;
+    const stanford_real x32 = -STANFORD_K(27.49911)*x16 + STANFORD_K(6.47)*x29;
+    const stanford_real x33 = STANFORD_K(27.49911)*x28;
+    const stanford_real x34 = -STANFORD_K(27.49911)*x27;
+    /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x35 = -c4*qd[1] + s4*x1;
+    const stanford_real x36 = c4*x1 + qd[1]*s4;
+    const stanford_real x37 = -c4*qdd[1] + s4*x7;
+    const stanford_real x38 = c4*x7 + qdd[1]*s4;
+    const stanford_real x39 = c4*x27 + s4*x28;
+    const stanford_real x40 = c4*x28 - s4*x27;
+    const stanford_real x41 = -qd[3] - x2;
+    const stanford_real x42 = qd[3]*x36 + x37;
+    const stanford_real x43 = -qdd[3] - x8;
+    const stanford_real x44 = -qd[3]*x35 + x38;
+    const stanford_real x45 = x35*x35;
+    const stanford_real x46 = x35*x41;
+    const stanford_real x47 = x35*x36;
+    const stanford_real x48 = x41*x41;
+    const stanford_real x49 = x36*x41;
+    const stanford_real x50 = x36*x36;
+    const stanford_real x51 = -x45 - x48;
+    const stanford_real x52 = x43 + x47;
+    const stanford_real x53 = -x42 + x49;
+    /* link 4: link wrench */
+    const stanford_real x54 = STANFORD_K(0.29826)*x52;
+    const stanford_real x55 = STANFORD_K(0.29826)*x53;
+    const stanford_real x56 = STANFORD_K(0.29826)*x51;
+    const stanford_real x57 = (STANFORD_K(0.29826)*x29 + STANFORD_K(0.20597356)*(x42 - x49)) + STANFORD_K(0.00536544)*(x48 - x50);
+    const stanford_real x58 = (STANFORD_K(0.29826)*x39 + STANFORD_K(0.20597356)*(x43 + x47)) + STANFORD_K(0.00536544)*(x44 - x46);
+    const stanford_real x59 = STANFORD_K(0.00536544)*(x43 + x47);
+    /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x60 = c5*x35 + s5*x41;
+    const stanford_real x61 = -c5*x41 + s5*x35;
+    const stanford_real x62 = c5*x42 + s5*x43;
+    const stanford_real x63 = -c5*x43 + s5*x42;
+    const stanford_real x64 = c5*x39 - s5*x29;
+    const stanford_real x65 = qd[4] + x36;
+    const stanford_real x66 = -qd[4]*x61 + x62;
+    const stanford_real x67 = qdd[4] + x44;
+    const stanford_real x68 = qd[4]*x60 + x63;
+    const stanford_real x69 = x60*x60;
+    const stanford_real x70 = x60*x65;
+    const stanford_real x71 = x60*x61;
+    const stanford_real x72 = x65*x65;
+    const stanford_real x73 = x61*x65;
+    const stanford_real x74 = x61*x61;
+    const stanford_real x75 = -x69 - x72;
+    const stanford_real x76 = x67 + x71;
+    const stanford_real x77 = -x66 + x73;
+    /* link 5: link wrench */
+    const stanford_real x78 = STANFORD_K(0.92856)*x76;
+    const stanford_real x79 = STANFORD_K(0.92856)*x77;
+    const stanford_real x80 = STANFORD_K(0.92856)*x75;
+    const stanford_real x81 = STANFORD_K(0.00106974)*(-x72 + x74) + (-STANFORD_K(0.92856)*x40 + STANFORD_K(1.69976506)*x66 - STANFORD_K(1.69716506)*x73);
+    const stanford_real x82 = STANFORD_K(0.00106974)*(-x68 + x70) + (STANFORD_K(0.92856)*x64 + STANFORD_K(1.69716506)*x67 + STANFORD_K(1.69976506)*x71);
+    const stanford_real x83 = -STANFORD_K(0.0026)*x70 + STANFORD_K(0.00106974)*(-x67 - x71);
+    /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
+    const stanford_real x84 = c6*x60 + s6*x65;
+    const stanford_real x85 = c6*x65 - s6*x60;
+    const stanford_real x86 = qd[5] + x61;
+    const stanford_real x87 = qdd[5] + x68;
+    const stanford_real x88 = x84*x86;
+    const stanford_real x89 = x85*x86;
+    /* link 6: link wrench */
+    const stanford_real x90 = STANFORD_K(0.0003)*x89;
+    const stanford_real x91 = -STANFORD_K(0.0003)*x88;
+    const stanford_real x92 = STANFORD_K(0.0003)*x87;
+    /* link 6: forces */
+    const stanford_real x93 = c6*x90 - s6*x91;
+    const stanford_real x94 = c6*x91 + s6*x90;
+    /* link 5: forces */
+    const stanford_real x95 = x93 + x81;
+    const stanford_real x96 = x94 + x82;
+    const stanford_real x97 = x83 + x92;
+    const stanford_real x98 = c5*x78 + s5*x80;
+    const stanford_real x99 = -c5*x80 + s5*x78;
+    const stanford_real x100 = c5*x95 + s5*x97;
+    const stanford_real x101 = -c5*x97 + s5*x95;
+    /* link 4: forces */
+    const stanford_real x102 = x98 + x54;
+    const stanford_real x103 = x99 + x55;
+    const stanford_real x104 = x56 + x79;
+    const stanford_real x105 = x100 + x57;
+    const stanford_real x106 = x101 + x58;
+    const stanford_real x107 = x96 + x59;
+    const stanford_real x108 = c4*x102 - s4*x104;
+    const stanford_real x109 = c4*x104 + s4*x102;
+    const stanford_real x110 = c4*x105 - s4*x107;
+    const stanford_real x111 = c4*x107 + s4*x105;
+    /* link 3: forces */
+    const stanford_real x112 = x108 + x30;
+    const stanford_real x113 = x109 + x31;
+    const stanford_real x114 = -x103 + x32;
+    const stanford_real x115 = x110 + x33;
+    const stanford_real x116 = x111 + x34;
+    const stanford_real x117 = -q[2]*x113 + x115;
+    const stanford_real x118 = q[2]*x112 + x116;
+    /* link 2: forces */
+    const stanford_real x119 = x118 + x24;
+    const stanford_real x120 = -x117 + x25;
+    const stanford_real x121 = -x106 + x26;
+    const stanford_real x122 = STANFORD_K(0.154)*x114 + x119;
+    const stanford_real x123 = -STANFORD_K(0.154)*x113 + x121;
+    const stanford_real x124 = -c2*x123 + s2*x122;
+    /* link 1: forces */
+    const stanford_real x125 = x0 + x124;
+    /* tau */
+    tau[0] = -x125;
+    tau[1] = x120;
+    tau[2] = x114;
+    tau[3] = -x106;
+    tau[4] = x96;
+    tau[5] = x92;
+}
+
 /* Gravity vector g(q). */
 void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_real *g)
 {
-    /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
     /* base coefficients pi_gravity = K s */
     const stanford_real x0 = s[11] + s[22];
     const stanford_real x1 = -s[32] + s[13] + s[23];
@@ -263,60 +417,68 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
     const stanford_real x4 = STANFORD_K(0.263)*s[50];
     const stanford_real x5 = s[43] + s[53] + x4;
     /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x6 = -STANFORD_K(9.81)*s2;
     const stanford_real x7 = STANFORD_K(9.81)*c2;
-    /* link 4: velocities and accelerations */
-    const stanford_real x8 = s4*x6;
-    const stanford_real x9 = c4*x6;
-    /* link 5: velocities and accelerations */
-    const stanford_real x10 = c5*x8 - s5*x7;
-    const stanford_real x11 = c5*x7 + s5*x8;
-    /* link 6: velocities and accelerations */
-    const stanford_real x12 = c6*x10 + s6*x9;
-    const stanford_real x13 = c6*x9 - s6*x10;
     /* link 2: link wrench */
-    const stanford_real x14 = -x0*x7 + x1*x6;
+    const stanford_real x8 = -x0*x7 + x1*x6;
     /* link 3: link wrench */
-    const stanford_real x15 = x2*x6;
-    const stanford_real x16 = x2*x7;
+    const stanford_real x9 = x2*x6;
+    const stanford_real x10 = x2*x7;
+    /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x11 = s4*x6;
+    const stanford_real x12 = c4*x6;
     /* link 4: link wrench */
-    const stanford_real x17 = x3*x7;
-    const stanford_real x18 = -s[31]*x9 + x3*x8;
-    const stanford_real x19 = -s[31]*x7;
+    const stanford_real x13 = x3*x7;
+    const stanford_real x14 = -s[31]*x12 + x11*x3;
+    const stanford_real x15 = -s[31]*x7;
+    /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x16 = c5*x11 - s5*x7;
+    const stanford_real x17 = c5*x7 + s5*x11;
     /* link 5: link wrench */
-    const stanford_real x20 = -x5*x9;
-    const stanford_real x21 = -s[41]*x11 + x10*x5;
-    const stanford_real x22 = s[41]*x9;
+    const stanford_real x18 = -x12*x5;
+    const stanford_real x19 = -s[41]*x17 + x16*x5;
+    const stanford_real x20 = s[41]*x12;
+    /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
+    const stanford_real x21 = c6*x16 + s6*x12;
+    const stanford_real x22 = c6*x12 - s6*x16;
     /* link 6: link wrench */
-    const stanford_real x23 = s[52]*x11;
-    const stanford_real x24 = -s[51]*x11;
-    const stanford_real x25 = s[51]*x13 - s[52]*x12;
+    const stanford_real x23 = s[52]*x17;
+    const stanford_real x24 = -s[51]*x17;
+    const stanford_real x25 = s[51]*x22 - s[52]*x21;
     /* link 6: forces */
     const stanford_real x26 = c6*x23 - s6*x24;
     const stanford_real x27 = c6*x24 + s6*x23;
     /* link 5: forces */
-    const stanford_real x28 = x20 + x26;
-    const stanford_real x29 = x21 + x27;
-    const stanford_real x30 = x22 + x25;
+    const stanford_real x28 = x18 + x26;
+    const stanford_real x29 = x19 + x27;
+    const stanford_real x30 = x20 + x25;
     const stanford_real x31 = c5*x28 + s5*x30;
     const stanford_real x32 = -c5*x30 + s5*x28;
     /* link 4: forces */
-    const stanford_real x33 = x17 + x31;
-    const stanford_real x34 = x18 + x32;
-    const stanford_real x35 = x19 + x29;
+    const stanford_real x33 = x13 + x31;
+    const stanford_real x34 = x14 + x32;
+    const stanford_real x35 = x15 + x29;
     const stanford_real x36 = c4*x33 - s4*x35;
     const stanford_real x37 = c4*x35 + s4*x33;
     /* link 3: forces */
-    const stanford_real x38 = -q[2]*x15 + x36;
+    const stanford_real x38 = -q[2]*x9 + x36;
     /* link 2: forces */
-    const stanford_real x39 = x14 - x38;
-    const stanford_real x40 = STANFORD_K(0.154)*x16 + x37;
-    const stanford_real x41 = -STANFORD_K(0.154)*x15 - x34;
+    const stanford_real x39 = -x38 + x8;
+    const stanford_real x40 = STANFORD_K(0.154)*x10 + x37;
+    const stanford_real x41 = -x34 - STANFORD_K(0.154)*x9;
     const stanford_real x42 = -c2*x41 + s2*x40;
     /* g */
     g[0] = -x42;
     g[1] = x39;
-    g[2] = x16;
+    g[2] = x10;
     g[3] = -x34;
     g[4] = x29;
     g[5] = x25;
@@ -325,15 +487,6 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
 /* Inertia matrix M(q). */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M)
 {
-    /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
     /* base coefficients pi_inertia = K s */
     const stanford_real x0 = STANFORD_K(0.023716)*s[10];
     const stanford_real x1 = STANFORD_K(0.308)*s[12];
@@ -360,6 +513,8 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x22 = s[47] + s[57] + x19 + x20;
     const stanford_real x23 = s[54] - s[57];
     /* link 5: composite body */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x24 = c6*s[51] - s[52]*s6;
     const stanford_real x25 = c6*s[52] + s[51]*s6;
     const stanford_real x26 = s[41] + x24;
@@ -369,6 +524,8 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x30 = s6*(2*s[55]*c6 + s6*x23) + x22;
     const stanford_real x31 = s[56]*s6 + s[48] + s[58]*c6 - STANFORD_K(0.263)*x25;
     /* link 4: composite body */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x32 = c5*x26 + s5*x18;
     const stanford_real x33 = -c5*x18 + s5*x26;
     const stanford_real x34 = s[31] + x32;
@@ -379,6 +536,8 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x39 = -c5*(-s[59]*c5 + s5*x29) + s5*(-c5*x29 + s5*x27) + x16;
     const stanford_real x40 = s[38] - c5*x31 + s5*x28;
     /* link 3: composite body */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x41 = c4*x34 - s4*x35;
     const stanford_real x42 = c4*x35 + s4*x34;
     const stanford_real x43 = s[21] + x41;
@@ -398,6 +557,8 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x56 = q[2]*x43 - x48;
     /* link 1: composite body */
     const stanford_real x57 = STANFORD_K(0.154)*x12 - x43;
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x58 = -c2*(-c2*x39 + s2*x54) + s2*(-c2*x54 + s2*x53) + STANFORD_K(0.023716)*x12 + x2 - STANFORD_K(0.308)*x43;
     /* column 2: composite wrench */
     const stanford_real x59 = -x47 - STANFORD_K(0.154)*x51;
@@ -492,157 +653,156 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
 /* Inverse dynamics tau = Y(q, qd, qdd) pi_full from the base coefficients, a Newton-Euler recursion in the grouped parameters (for controllers that hold identified coefficients). */
 void stanford_inverse_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *pi_full, stanford_real *tau)
 {
-    /* joint angles */
+    /* link 1: link wrench */
+    const stanford_real x0 = -pi_full[0]*qdd[0];
+    /* link 2: velocities and accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
+    const stanford_real x1 = -qd[0]*s2;
+    const stanford_real x2 = c2*qd[0];
+    const stanford_real x3 = -qdd[0]*s2;
+    const stanford_real x4 = c2*qdd[0];
+    const stanford_real x5 = -STANFORD_K(9.81)*s2;
+    const stanford_real x6 = STANFORD_K(9.81)*c2;
+    const stanford_real x7 = -qd[1]*x2 + x3;
+    const stanford_real x8 = qd[1]*x1 + x4;
+    const stanford_real x9 = x1*x1;
+    const stanford_real x10 = qd[1]*x1;
+    const stanford_real x11 = x1*x2;
+    const stanford_real x12 = qd[1]*qd[1];
+    const stanford_real x13 = qd[1]*x2;
+    const stanford_real x14 = x2*x2;
+    const stanford_real x15 = -x12 - x14;
+    const stanford_real x16 = -x9 - x14;
+    const stanford_real x17 = -x9 - x12;
+    const stanford_real x18 = x10 - x8;
+    const stanford_real x19 = qdd[1] + x11;
+    const stanford_real x20 = x10 + x8;
+    const stanford_real x21 = x13 - x7;
+    const stanford_real x22 = -qdd[1] + x11;
+    const stanford_real x23 = x13 + x7;
+    const stanford_real x24 = STANFORD_K(0.154)*x18 + x5;
+    const stanford_real x25 = STANFORD_K(0.154)*x16;
+    const stanford_real x26 = STANFORD_K(0.154)*x23 + x6;
+    /* link 2: link wrench */
+    const stanford_real x27 = pi_full[1]*x15 + pi_full[2]*x19;
+    const stanford_real x28 = pi_full[1]*x22 + pi_full[2]*x17;
+    const stanford_real x29 = pi_full[4]*(qdd[1] - x11) + (pi_full[5]*(x10 + x8) + (-pi_full[2]*x25 + pi_full[3]*x7 - pi_full[6]*x13 + pi_full[7]*(x12 - x14)));
+    const stanford_real x30 = pi_full[4]*(x13 + x7) + (pi_full[7]*(-x10 + x8) + (-pi_full[1]*x26 + pi_full[2]*x24 + pi_full[3]*x11 + pi_full[5]*(-x9 + x14) + pi_full[6]*qdd[1]));
+    const stanford_real x31 = pi_full[5]*(-x13 + x7) + (pi_full[7]*(qdd[1] + x11) + (pi_full[1]*x25 + pi_full[4]*(x9 - x12) + x10*(-pi_full[3] + pi_full[6])));
+    /* link 3: velocities and accelerations */
+    const stanford_real x32 = -q[2]*x21 + 2*qd[2]*x1 - x25;
+    const stanford_real x33 = q[2]*x19 + 2*qd[1]*qd[2] + x24;
+    const stanford_real x34 = q[2]*x17 + qdd[2] + x26;
+    /* link 3: link wrench */
+    const stanford_real x35 = -pi_full[10]*x20 - pi_full[11]*x21 + pi_full[8]*x32 + pi_full[9]*x16;
+    const stanford_real x36 = pi_full[10]*x15 + pi_full[11]*x19 + pi_full[8]*x33 - pi_full[9]*x18;
+    const stanford_real x37 = pi_full[10]*x22 + pi_full[11]*x17 + pi_full[8]*x34 - pi_full[9]*x23;
+    const stanford_real x38 = pi_full[10]*x34 - pi_full[11]*x33;
+    const stanford_real x39 = pi_full[11]*x32 - pi_full[9]*x34;
+    const stanford_real x40 = -pi_full[10]*x32 + pi_full[9]*x33;
+    /* link 4: velocities and accelerations */
     stanford_real s4, c4;
     STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x41 = -c4*qd[1] + s4*x1;
+    const stanford_real x42 = c4*x1 + qd[1]*s4;
+    const stanford_real x43 = -c4*qdd[1] + s4*x7;
+    const stanford_real x44 = c4*x7 + qdd[1]*s4;
+    const stanford_real x45 = c4*x32 + s4*x33;
+    const stanford_real x46 = c4*x33 - s4*x32;
+    const stanford_real x47 = -qd[3] - x2;
+    const stanford_real x48 = qd[3]*x42 + x43;
+    const stanford_real x49 = -qdd[3] - x8;
+    const stanford_real x50 = -qd[3]*x41 + x44;
+    const stanford_real x51 = x41*x41;
+    const stanford_real x52 = x41*x47;
+    const stanford_real x53 = x41*x42;
+    const stanford_real x54 = x47*x47;
+    const stanford_real x55 = x42*x47;
+    const stanford_real x56 = x42*x42;
+    const stanford_real x57 = -x54 - x56;
+    const stanford_real x58 = -x51 - x54;
+    const stanford_real x59 = x49 + x53;
+    const stanford_real x60 = x50 + x52;
+    const stanford_real x61 = -x48 + x55;
+    const stanford_real x62 = -x49 + x53;
+    /* link 4: link wrench */
+    const stanford_real x63 = pi_full[12]*x57 + pi_full[13]*x59;
+    const stanford_real x64 = pi_full[12]*x60 + pi_full[13]*x61;
+    const stanford_real x65 = pi_full[12]*x62 + pi_full[13]*x58;
+    const stanford_real x66 = pi_full[15]*(x49 - x53) + (pi_full[16]*(x50 + x52) + (pi_full[13]*x34 + pi_full[14]*x48 - pi_full[17]*x55 + pi_full[18]*(x54 - x56)));
+    const stanford_real x67 = pi_full[15]*(x48 + x55) + (pi_full[18]*(x50 - x52) + (-pi_full[12]*x46 + pi_full[13]*x45 + pi_full[14]*x53 + pi_full[16]*(-x51 + x56) + pi_full[17]*x49));
+    const stanford_real x68 = pi_full[16]*(x48 - x55) + (pi_full[18]*(x49 + x53) + (-pi_full[12]*x34 + pi_full[15]*(x51 - x54) + x52*(-pi_full[14] + pi_full[17])));
+    /* link 5: velocities and accelerations */
     stanford_real s5, c5;
     STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x69 = c5*x41 + s5*x47;
+    const stanford_real x70 = -c5*x47 + s5*x41;
+    const stanford_real x71 = c5*x48 + s5*x49;
+    const stanford_real x72 = -c5*x49 + s5*x48;
+    const stanford_real x73 = c5*x45 - s5*x34;
+    const stanford_real x74 = c5*x34 + s5*x45;
+    const stanford_real x75 = qd[4] + x42;
+    const stanford_real x76 = -qd[4]*x70 + x71;
+    const stanford_real x77 = qdd[4] + x50;
+    const stanford_real x78 = qd[4]*x69 + x72;
+    const stanford_real x79 = x69*x69;
+    const stanford_real x80 = x69*x75;
+    const stanford_real x81 = x69*x70;
+    const stanford_real x82 = x75*x75;
+    const stanford_real x83 = x70*x75;
+    const stanford_real x84 = x70*x70;
+    const stanford_real x85 = -x82 - x84;
+    const stanford_real x86 = -x79 - x82;
+    const stanford_real x87 = x77 + x81;
+    const stanford_real x88 = x78 + x80;
+    const stanford_real x89 = -x76 + x83;
+    const stanford_real x90 = -x77 + x81;
+    /* link 5: link wrench */
+    const stanford_real x91 = pi_full[19]*x85 + pi_full[20]*x87;
+    const stanford_real x92 = pi_full[19]*x88 + pi_full[20]*x89;
+    const stanford_real x93 = pi_full[19]*x90 + pi_full[20]*x86;
+    const stanford_real x94 = pi_full[22]*(x77 - x81) + (pi_full[23]*(x78 + x80) + (-pi_full[20]*x46 + pi_full[21]*x76 - pi_full[24]*x83 + pi_full[25]*(x82 - x84)));
+    const stanford_real x95 = pi_full[22]*(x76 + x83) + (pi_full[25]*(x78 - x80) + (-pi_full[19]*x74 + pi_full[20]*x73 + pi_full[21]*x81 + pi_full[23]*(-x79 + x84) + pi_full[24]*x77));
+    const stanford_real x96 = pi_full[23]*(x76 - x83) + (pi_full[25]*(x77 + x81) + (pi_full[19]*x46 + pi_full[22]*(x79 - x82) + x80*(-pi_full[21] + pi_full[24])));
+    /* link 6: velocities and accelerations */
     stanford_real s6, c6;
     STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: velocities and accelerations */
-    const stanford_real x0 = -qd[0]*s2;
-    const stanford_real x1 = c2*qd[0];
-    const stanford_real x2 = -qdd[0]*s2;
-    const stanford_real x3 = c2*qdd[0];
-    const stanford_real x4 = -STANFORD_K(9.81)*s2;
-    const stanford_real x5 = STANFORD_K(9.81)*c2;
-    const stanford_real x6 = -qd[1]*x1 + x2;
-    const stanford_real x7 = qd[1]*x0 + x3;
-    const stanford_real x8 = x0*x0;
-    const stanford_real x9 = qd[1]*x0;
-    const stanford_real x10 = x0*x1;
-    const stanford_real x11 = qd[1]*qd[1];
-    const stanford_real x12 = qd[1]*x1;
-    const stanford_real x13 = x1*x1;
-    const stanford_real x14 = -x11 - x13;
-    const stanford_real x15 = -x13 - x8;
-    const stanford_real x16 = -x11 - x8;
-    const stanford_real x17 = x9 - x7;
-    const stanford_real x18 = qdd[1] + x10;
-    const stanford_real x19 = x9 + x7;
-    const stanford_real x20 = x12 - x6;
-    const stanford_real x21 = -qdd[1] + x10;
-    const stanford_real x22 = x12 + x6;
-    const stanford_real x23 = STANFORD_K(0.154)*x17 + x4;
-    const stanford_real x24 = STANFORD_K(0.154)*x15;
-    const stanford_real x25 = STANFORD_K(0.154)*x22 + x5;
-    /* link 3: velocities and accelerations */
-    const stanford_real x26 = -q[2]*x20 + 2*qd[2]*x0 - x24;
-    const stanford_real x27 = q[2]*x18 + 2*qd[1]*qd[2] + x23;
-    const stanford_real x28 = q[2]*x16 + qdd[2] + x25;
-    /* link 4: velocities and accelerations */
-    const stanford_real x29 = -c4*qd[1] + s4*x0;
-    const stanford_real x30 = c4*x0 + qd[1]*s4;
-    const stanford_real x31 = -c4*qdd[1] + s4*x6;
-    const stanford_real x32 = c4*x6 + qdd[1]*s4;
-    const stanford_real x33 = c4*x26 + s4*x27;
-    const stanford_real x34 = c4*x27 - s4*x26;
-    const stanford_real x35 = -qd[3] - x1;
-    const stanford_real x36 = qd[3]*x30 + x31;
-    const stanford_real x37 = -qdd[3] - x7;
-    const stanford_real x38 = -qd[3]*x29 + x32;
-    const stanford_real x39 = x29*x29;
-    const stanford_real x40 = x29*x35;
-    const stanford_real x41 = x29*x30;
-    const stanford_real x42 = x35*x35;
-    const stanford_real x43 = x30*x35;
-    const stanford_real x44 = x30*x30;
-    const stanford_real x45 = -x42 - x44;
-    const stanford_real x46 = -x39 - x42;
-    const stanford_real x47 = x37 + x41;
-    const stanford_real x48 = x38 + x40;
-    const stanford_real x49 = -x36 + x43;
-    const stanford_real x50 = -x37 + x41;
-    /* link 5: velocities and accelerations */
-    const stanford_real x51 = c5*x29 + s5*x35;
-    const stanford_real x52 = -c5*x35 + s5*x29;
-    const stanford_real x53 = c5*x36 + s5*x37;
-    const stanford_real x54 = -c5*x37 + s5*x36;
-    const stanford_real x55 = c5*x33 - s5*x28;
-    const stanford_real x56 = c5*x28 + s5*x33;
-    const stanford_real x57 = qd[4] + x30;
-    const stanford_real x58 = -qd[4]*x52 + x53;
-    const stanford_real x59 = qdd[4] + x38;
-    const stanford_real x60 = qd[4]*x51 + x54;
-    const stanford_real x61 = x51*x51;
-    const stanford_real x62 = x51*x57;
-    const stanford_real x63 = x51*x52;
-    const stanford_real x64 = x57*x57;
-    const stanford_real x65 = x52*x57;
-    const stanford_real x66 = x52*x52;
-    const stanford_real x67 = -x64 - x66;
-    const stanford_real x68 = -x61 - x64;
-    const stanford_real x69 = x59 + x63;
-    const stanford_real x70 = x60 + x62;
-    const stanford_real x71 = -x58 + x65;
-    const stanford_real x72 = -x59 + x63;
-    /* link 6: velocities and accelerations */
-    const stanford_real x73 = c6*x51 + s6*x57;
-    const stanford_real x74 = c6*x57 - s6*x51;
-    const stanford_real x75 = c6*x58 + s6*x59;
-    const stanford_real x76 = c6*x59 - s6*x58;
-    const stanford_real x77 = c6*x55 + s6*x34;
-    const stanford_real x78 = c6*x34 - s6*x55;
-    const stanford_real x79 = qd[5] + x52;
-    const stanford_real x80 = qd[5]*x74 + x75;
-    const stanford_real x81 = -qd[5]*x73 + x76;
-    const stanford_real x82 = qdd[5] + x60;
-    const stanford_real x83 = x73*x73;
-    const stanford_real x84 = x73*x74;
-    const stanford_real x85 = x73*x79;
-    const stanford_real x86 = x74*x74;
-    const stanford_real x87 = x74*x79;
-    const stanford_real x88 = x79*x79;
-    const stanford_real x89 = -x86 - x88;
-    const stanford_real x90 = -x83 - x88;
-    const stanford_real x91 = -x83 - x86;
-    const stanford_real x92 = -x82 + x84;
-    const stanford_real x93 = x81 + x85;
-    const stanford_real x94 = x82 + x84;
-    const stanford_real x95 = -x80 + x87;
-    const stanford_real x96 = -x81 + x85;
-    const stanford_real x97 = x80 + x87;
-    const stanford_real x98 = STANFORD_K(0.263)*x93 + x77;
-    const stanford_real x99 = STANFORD_K(0.263)*x95 + x78;
-    const stanford_real x100 = x56 + STANFORD_K(0.263)*x91;
-    /* link 1: link wrench */
-    const stanford_real x101 = -pi_full[0]*qdd[0];
-    /* link 2: link wrench */
-    const stanford_real x102 = pi_full[1]*x14 + pi_full[2]*x18;
-    const stanford_real x103 = pi_full[1]*x21 + pi_full[2]*x16;
-    const stanford_real x104 = pi_full[4]*(qdd[1] - x10) + (pi_full[5]*(x9 + x7) + (-pi_full[2]*x24 + pi_full[3]*x6 - pi_full[6]*x12 + pi_full[7]*(x11 - x13)));
-    const stanford_real x105 = pi_full[4]*(x12 + x6) + (pi_full[7]*(-x9 + x7) + (-pi_full[1]*x25 + pi_full[2]*x23 + pi_full[3]*x10 + pi_full[5]*(x13 - x8) + pi_full[6]*qdd[1]));
-    const stanford_real x106 = pi_full[5]*(-x12 + x6) + (pi_full[7]*(qdd[1] + x10) + (pi_full[1]*x24 + pi_full[4]*(-x11 + x8) + x9*(-pi_full[3] + pi_full[6])));
-    /* link 3: link wrench */
-    const stanford_real x107 = -pi_full[10]*x19 - pi_full[11]*x20 + pi_full[8]*x26 + pi_full[9]*x15;
-    const stanford_real x108 = pi_full[10]*x14 + pi_full[11]*x18 + pi_full[8]*x27 - pi_full[9]*x17;
-    const stanford_real x109 = pi_full[10]*x21 + pi_full[11]*x16 + pi_full[8]*x28 - pi_full[9]*x22;
-    const stanford_real x110 = pi_full[10]*x28 - pi_full[11]*x27;
-    const stanford_real x111 = pi_full[11]*x26 - pi_full[9]*x28;
-    const stanford_real x112 = -pi_full[10]*x26 + pi_full[9]*x27;
-    /* link 4: link wrench */
-    const stanford_real x113 = pi_full[12]*x45 + pi_full[13]*x47;
-    const stanford_real x114 = pi_full[12]*x48 + pi_full[13]*x49;
-    const stanford_real x115 = pi_full[12]*x50 + pi_full[13]*x46;
-    const stanford_real x116 = pi_full[15]*(x37 - x41) + (pi_full[16]*(x38 + x40) + (pi_full[13]*x28 + pi_full[14]*x36 - pi_full[17]*x43 + pi_full[18]*(x42 - x44)));
-    const stanford_real x117 = pi_full[15]*(x36 + x43) + (pi_full[18]*(x38 - x40) + (-pi_full[12]*x34 + pi_full[13]*x33 + pi_full[14]*x41 + pi_full[16]*(-x39 + x44) + pi_full[17]*x37));
-    const stanford_real x118 = pi_full[16]*(x36 - x43) + (pi_full[18]*(x37 + x41) + (-pi_full[12]*x28 + pi_full[15]*(x39 - x42) + x40*(-pi_full[14] + pi_full[17])));
-    /* link 5: link wrench */
-    const stanford_real x119 = pi_full[19]*x67 + pi_full[20]*x69;
-    const stanford_real x120 = pi_full[19]*x70 + pi_full[20]*x71;
-    const stanford_real x121 = pi_full[19]*x72 + pi_full[20]*x68;
-    const stanford_real x122 = pi_full[22]*(x59 - x63) + (pi_full[23]*(x60 + x62) + (-pi_full[20]*x34 + pi_full[21]*x58 - pi_full[24]*x65 + pi_full[25]*(x64 - x66)));
-    const stanford_real x123 = pi_full[22]*(x58 + x65) + (pi_full[25]*(x60 - x62) + (-pi_full[19]*x56 + pi_full[20]*x55 + pi_full[21]*x63 + pi_full[23]*(-x61 + x66) + pi_full[24]*x59));
-    const stanford_real x124 = pi_full[23]*(x58 - x65) + (pi_full[25]*(x59 + x63) + (pi_full[19]*x34 + pi_full[22]*(x61 - x64) + x62*(-pi_full[21] + pi_full[24])));
+    const stanford_real x97 = c6*x69 + s6*x75;
+    const stanford_real x98 = c6*x75 - s6*x69;
+    const stanford_real x99 = c6*x76 + s6*x77;
+    const stanford_real x100 = c6*x77 - s6*x76;
+    const stanford_real x101 = c6*x73 + s6*x46;
+    const stanford_real x102 = c6*x46 - s6*x73;
+    const stanford_real x103 = qd[5] + x70;
+    const stanford_real x104 = qd[5]*x98 + x99;
+    const stanford_real x105 = -qd[5]*x97 + x100;
+    const stanford_real x106 = qdd[5] + x78;
+    const stanford_real x107 = x97*x97;
+    const stanford_real x108 = x97*x98;
+    const stanford_real x109 = x97*x103;
+    const stanford_real x110 = x98*x98;
+    const stanford_real x111 = x98*x103;
+    const stanford_real x112 = x103*x103;
+    const stanford_real x113 = -x110 - x112;
+    const stanford_real x114 = -x107 - x112;
+    const stanford_real x115 = -x107 - x110;
+    const stanford_real x116 = -x106 + x108;
+    const stanford_real x117 = x105 + x109;
+    const stanford_real x118 = x106 + x108;
+    const stanford_real x119 = -x104 + x111;
+    const stanford_real x120 = -x105 + x109;
+    const stanford_real x121 = x104 + x111;
+    const stanford_real x122 = x101 + STANFORD_K(0.263)*x117;
+    const stanford_real x123 = x102 + STANFORD_K(0.263)*x119;
+    const stanford_real x124 = STANFORD_K(0.263)*x115 + x74;
     /* link 6: link wrench */
-    const stanford_real x125 = pi_full[26]*x89 + pi_full[27]*x92;
-    const stanford_real x126 = pi_full[26]*x94 + pi_full[27]*x90;
-    const stanford_real x127 = pi_full[26]*x96 + pi_full[27]*x97;
-    const stanford_real x128 = pi_full[29]*(x81 - x85) + (pi_full[30]*(x82 + x84) + (pi_full[27]*x100 + pi_full[28]*x80 + pi_full[31]*(x86 - x88) + pi_full[32]*x87));
-    const stanford_real x129 = pi_full[29]*(x80 + x87) + (pi_full[31]*(x82 - x84) + (-pi_full[26]*x100 + pi_full[30]*(-x83 + x88) + x85*(pi_full[28] - pi_full[32])));
-    const stanford_real x130 = pi_full[30]*(x80 - x87) + (pi_full[31]*(x81 + x85) + (pi_full[26]*x99 - pi_full[27]*x98 - pi_full[28]*x84 + pi_full[29]*(x83 - x86) + pi_full[32]*x82));
+    const stanford_real x125 = pi_full[26]*x113 + pi_full[27]*x116;
+    const stanford_real x126 = pi_full[26]*x118 + pi_full[27]*x114;
+    const stanford_real x127 = pi_full[26]*x120 + pi_full[27]*x121;
+    const stanford_real x128 = pi_full[29]*(x105 - x109) + (pi_full[30]*(x106 + x108) + (pi_full[27]*x124 + pi_full[28]*x104 + pi_full[31]*(x110 - x112) + pi_full[32]*x111));
+    const stanford_real x129 = pi_full[29]*(x104 + x111) + (pi_full[31]*(x106 - x108) + (-pi_full[26]*x124 + pi_full[30]*(-x107 + x112) + x109*(pi_full[28] - pi_full[32])));
+    const stanford_real x130 = pi_full[30]*(x104 - x111) + (pi_full[31]*(x105 + x109) + (pi_full[26]*x123 - pi_full[27]*x122 - pi_full[28]*x108 + pi_full[29]*(x107 - x110) + pi_full[32]*x106));
     /* link 6: forces */
     const stanford_real x131 = -STANFORD_K(0.263)*x126 + x128;
     const stanford_real x132 = STANFORD_K(0.263)*x125 + x129;
@@ -651,47 +811,47 @@ void stanford_inverse_dynamics(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x135 = c6*x131 - s6*x132;
     const stanford_real x136 = c6*x132 + s6*x131;
     /* link 5: forces */
-    const stanford_real x137 = x119 + x133;
-    const stanford_real x138 = x120 + x134;
-    const stanford_real x139 = x121 + x127;
-    const stanford_real x140 = x122 + x135;
-    const stanford_real x141 = x123 + x136;
-    const stanford_real x142 = x124 + x130;
+    const stanford_real x137 = x133 + x91;
+    const stanford_real x138 = x92 + x134;
+    const stanford_real x139 = x93 + x127;
+    const stanford_real x140 = x94 + x135;
+    const stanford_real x141 = x95 + x136;
+    const stanford_real x142 = x96 + x130;
     const stanford_real x143 = c5*x137 + s5*x139;
     const stanford_real x144 = -c5*x139 + s5*x137;
     const stanford_real x145 = c5*x140 + s5*x142;
     const stanford_real x146 = -c5*x142 + s5*x140;
     /* link 4: forces */
-    const stanford_real x147 = x113 + x143;
-    const stanford_real x148 = x114 + x144;
-    const stanford_real x149 = x115 + x138;
-    const stanford_real x150 = x116 + x145;
-    const stanford_real x151 = x117 + x146;
-    const stanford_real x152 = x118 + x141;
+    const stanford_real x147 = x143 + x63;
+    const stanford_real x148 = x144 + x64;
+    const stanford_real x149 = x138 + x65;
+    const stanford_real x150 = x145 + x66;
+    const stanford_real x151 = x146 + x67;
+    const stanford_real x152 = x141 + x68;
     const stanford_real x153 = c4*x147 - s4*x149;
     const stanford_real x154 = c4*x149 + s4*x147;
     const stanford_real x155 = c4*x150 - s4*x152;
     const stanford_real x156 = c4*x152 + s4*x150;
     /* link 3: forces */
-    const stanford_real x157 = x107 + x153;
-    const stanford_real x158 = x108 + x154;
-    const stanford_real x159 = x109 - x148;
-    const stanford_real x160 = x110 + x155;
-    const stanford_real x161 = x111 + x156;
-    const stanford_real x162 = x112 - x151;
+    const stanford_real x157 = x153 + x35;
+    const stanford_real x158 = x154 + x36;
+    const stanford_real x159 = -x148 + x37;
+    const stanford_real x160 = x155 + x38;
+    const stanford_real x161 = x156 + x39;
+    const stanford_real x162 = -x151 + x40;
     const stanford_real x163 = -q[2]*x158 + x160;
     const stanford_real x164 = q[2]*x157 + x161;
     /* link 2: forces */
-    const stanford_real x165 = x102 + x158;
-    const stanford_real x166 = x103 + x159;
-    const stanford_real x167 = x104 + x164;
-    const stanford_real x168 = x105 - x163;
-    const stanford_real x169 = x106 + x162;
+    const stanford_real x165 = x158 + x27;
+    const stanford_real x166 = x159 + x28;
+    const stanford_real x167 = x164 + x29;
+    const stanford_real x168 = -x163 + x30;
+    const stanford_real x169 = x162 + x31;
     const stanford_real x170 = STANFORD_K(0.154)*x166 + x167;
     const stanford_real x171 = -STANFORD_K(0.154)*x165 + x169;
     const stanford_real x172 = -c2*x171 + s2*x170;
     /* link 1: forces */
-    const stanford_real x173 = x101 + x172;
+    const stanford_real x173 = x0 + x172;
     /* tau */
     tau[0] = -x173;
     tau[1] = x168;

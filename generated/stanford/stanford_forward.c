@@ -10,31 +10,30 @@
 /* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T. */
 void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: velocities and accelerations */
     const stanford_real x0 = -STANFORD_K(0.154)*c2;
     const stanford_real x1 = -STANFORD_K(0.154)*s2;
     /* link 3: velocities and accelerations */
     const stanford_real x2 = -q[2]*s2;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x3 = -s2*s4;
     const stanford_real x4 = -c4*s2;
     const stanford_real x5 = c4*x2 + s4*x0;
     const stanford_real x6 = c4*x0 - s4*x2;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x7 = -c2*s5 + c5*x3;
     const stanford_real x8 = c2*c5 + s5*x3;
     const stanford_real x9 = c5*x5 - s5*x1;
     const stanford_real x10 = c5*x1 + s5*x5;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x11 = c6*x7 + s6*x4;
     const stanford_real x12 = c6*x4 - s6*x7;
     const stanford_real x13 = c6*x9 + s6*x6;

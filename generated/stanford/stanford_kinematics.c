@@ -14,18 +14,11 @@
 /* Pose of every link frame in the base frame: 4x4 homogeneous matrices [R p; 0 0 0 1], link 1 first. */
 void stanford_link_poses(const stanford_real *q, stanford_real *T)
 {
-    /* joint angles */
+    /* link 2: pose */
     stanford_real s1, c1;
     STANFORD_SINCOS(q[0], &s1, &c1);
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: pose */
     const stanford_real x0 = c1*c2;
     const stanford_real x1 = -c1*s2;
     const stanford_real x2 = c2*s1;
@@ -37,6 +30,8 @@ void stanford_link_poses(const stanford_real *q, stanford_real *T)
     const stanford_real x7 = -q[2]*x3 + x5;
     const stanford_real x8 = c2*q[2] + STANFORD_K(0.412);
     /* link 4: pose */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x9 = c4*s1 + s4*x0;
     const stanford_real x10 = c4*x0 - s1*s4;
     const stanford_real x11 = -c1*c4 + s4*x2;
@@ -44,6 +39,8 @@ void stanford_link_poses(const stanford_real *q, stanford_real *T)
     const stanford_real x13 = -s2*s4;
     const stanford_real x14 = -c4*s2;
     /* link 5: pose */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x15 = c5*x9 + s5*x1;
     const stanford_real x16 = c5*x1 - s5*x9;
     const stanford_real x17 = c5*x11 + s5*x3;
@@ -51,6 +48,8 @@ void stanford_link_poses(const stanford_real *q, stanford_real *T)
     const stanford_real x19 = -c2*s5 + c5*x13;
     const stanford_real x20 = -c2*c5 - s5*x13;
     /* link 6: pose */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x21 = c6*x15 + s6*x10;
     const stanford_real x22 = c6*x10 - s6*x15;
     const stanford_real x23 = c6*x17 + s6*x12;
@@ -137,18 +136,11 @@ void stanford_link_poses(const stanford_real *q, stanford_real *T)
 /* Pose of the flange frame (last link frame times the description's tool offset) in the base frame. */
 void stanford_flange_pose(const stanford_real *q, stanford_real *T)
 {
-    /* joint angles */
+    /* link 2: pose */
     stanford_real s1, c1;
     STANFORD_SINCOS(q[0], &s1, &c1);
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: pose */
     const stanford_real x0 = c1*c2;
     const stanford_real x1 = -c1*s2;
     const stanford_real x2 = c2*s1;
@@ -160,6 +152,8 @@ void stanford_flange_pose(const stanford_real *q, stanford_real *T)
     const stanford_real x7 = -q[2]*x3 + x5;
     const stanford_real x8 = c2*q[2] + STANFORD_K(0.412);
     /* link 4: pose */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x9 = c4*s1 + s4*x0;
     const stanford_real x10 = c4*x0 - s1*s4;
     const stanford_real x11 = -c1*c4 + s4*x2;
@@ -167,6 +161,8 @@ void stanford_flange_pose(const stanford_real *q, stanford_real *T)
     const stanford_real x13 = -s2*s4;
     const stanford_real x14 = -c4*s2;
     /* link 5: pose */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x15 = c5*x9 + s5*x1;
     const stanford_real x16 = c5*x1 - s5*x9;
     const stanford_real x17 = c5*x11 + s5*x3;
@@ -174,6 +170,8 @@ void stanford_flange_pose(const stanford_real *q, stanford_real *T)
     const stanford_real x19 = -c2*s5 + c5*x13;
     const stanford_real x20 = -c2*c5 - s5*x13;
     /* link 6: pose */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x21 = c6*x15 + s6*x10;
     const stanford_real x22 = c6*x10 - s6*x15;
     const stanford_real x23 = c6*x17 + s6*x12;
@@ -205,16 +203,11 @@ void stanford_flange_pose(const stanford_real *q, stanford_real *T)
 /* Geometric Jacobian of the flange in the base frame: [v; w] = J qd, v the velocity of the flange origin, w the angular velocity (Pinocchio's LOCAL_WORLD_ALIGNED). */
 void stanford_jacobian(const stanford_real *q, stanford_real *J)
 {
-    /* joint angles */
+    /* link 2: pose */
     stanford_real s1, c1;
     STANFORD_SINCOS(q[0], &s1, &c1);
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    /* link 2: pose */
     const stanford_real x0 = c1*c2;
     const stanford_real x1 = -c1*s2;
     const stanford_real x2 = c2*s1;
@@ -226,6 +219,8 @@ void stanford_jacobian(const stanford_real *q, stanford_real *J)
     const stanford_real x7 = -q[2]*x3 + x5;
     const stanford_real x8 = c2*q[2] + STANFORD_K(0.412);
     /* link 4: pose */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x9 = c4*s1 + s4*x0;
     const stanford_real x10 = c4*x0 - s1*s4;
     const stanford_real x11 = -c1*c4 + s4*x2;
@@ -233,6 +228,8 @@ void stanford_jacobian(const stanford_real *q, stanford_real *J)
     const stanford_real x13 = -s2*s4;
     const stanford_real x14 = -c4*s2;
     /* link 5: pose */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x15 = c5*x1 - s5*x9;
     const stanford_real x16 = c5*x3 - s5*x11;
     const stanford_real x17 = -c2*c5 - s5*x13;
@@ -295,16 +292,11 @@ void stanford_jacobian(const stanford_real *q, stanford_real *J)
 /* Geometric Jacobian of every link frame's origin in the base frame, rows [v; w] per link, link 1 first (columns of the joints after link i are zero). */
 void stanford_link_jacobians(const stanford_real *q, stanford_real *J)
 {
-    /* joint angles */
+    /* link 2: pose */
     stanford_real s1, c1;
     STANFORD_SINCOS(q[0], &s1, &c1);
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    /* link 2: pose */
     const stanford_real x0 = c1*c2;
     const stanford_real x1 = -c1*s2;
     const stanford_real x2 = c2*s1;
@@ -316,6 +308,8 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J)
     const stanford_real x7 = -q[2]*x3 + x5;
     const stanford_real x8 = c2*q[2] + STANFORD_K(0.412);
     /* link 4: pose */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x9 = c4*s1 + s4*x0;
     const stanford_real x10 = c4*x0 - s1*s4;
     const stanford_real x11 = -c1*c4 + s4*x2;
@@ -323,6 +317,8 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J)
     const stanford_real x13 = -s2*s4;
     const stanford_real x14 = -c4*s2;
     /* link 5: pose */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x15 = c5*x1 - s5*x9;
     const stanford_real x16 = c5*x3 - s5*x11;
     const stanford_real x17 = -c2*c5 - s5*x13;
@@ -434,16 +430,11 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J)
 /* Jdot qd of the flange in the base frame: the classical acceleration of the flange origin and the angular acceleration at qdd = 0, so that [a; wd] = J qdd + Jdot qd (operational-space control). */
 void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *jdot_qd)
 {
-    /* joint angles */
+    /* link 2: pose */
     stanford_real s1, c1;
     STANFORD_SINCOS(q[0], &s1, &c1);
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    /* link 2: pose */
     const stanford_real x0 = c1*c2;
     const stanford_real x1 = -c1*s2;
     const stanford_real x2 = c2*s1;
@@ -455,6 +446,8 @@ void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, s
     const stanford_real x7 = -q[2]*x3 + x5;
     const stanford_real x8 = c2*q[2] + STANFORD_K(0.412);
     /* link 4: pose */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x9 = c4*s1 + s4*x0;
     const stanford_real x10 = c4*x0 - s1*s4;
     const stanford_real x11 = -c1*c4 + s4*x2;
@@ -462,6 +455,8 @@ void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, s
     const stanford_real x13 = -s2*s4;
     const stanford_real x14 = -c4*s2;
     /* link 5: pose */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x15 = c5*x1 - s5*x9;
     const stanford_real x16 = c5*x3 - s5*x11;
     const stanford_real x17 = -c2*c5 - s5*x13;

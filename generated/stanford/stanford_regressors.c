@@ -13,25 +13,24 @@
 /* Base regressor of the gravity vector g(q) = Y_g(q) pi_gravity. */
 void stanford_regressor_gravity(const stanford_real *q, stanford_real *Y)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: velocities and accelerations */
     const stanford_real x0 = -STANFORD_K(9.81)*s2;
     const stanford_real x1 = STANFORD_K(9.81)*c2;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x2 = s4*x0;
     const stanford_real x3 = c4*x0;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x4 = c5*x2 - s5*x1;
     const stanford_real x5 = c5*x1 + s5*x2;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x6 = c6*x4 + s6*x3;
     const stanford_real x7 = c6*x3 - s6*x4;
     /* link 2: regressor */
@@ -103,21 +102,16 @@ void stanford_regressor_gravity(const stanford_real *q, stanford_real *Y)
 /* Base regressor of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia. Factored: link motions, then a loop (operation count: trips x loop body). */
 void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y)
 {
-    /* joint angles */
+    /* link 2: unit accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: unit accelerations */
     const stanford_real x0 = -STANFORD_K(0.154)*c2;
     const stanford_real x1 = -STANFORD_K(0.154)*s2;
     /* link 3: unit accelerations */
     const stanford_real x2 = -q[2]*s2;
     /* link 4: unit accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x3 = -s2*s4;
     const stanford_real x4 = -c4*s2;
     const stanford_real x5 = c4*x2 + s4*x0;
@@ -125,6 +119,8 @@ void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y)
     const stanford_real x7 = q[2]*s4;
     const stanford_real x8 = c4*q[2];
     /* link 5: unit accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x9 = -c2*s5 + c5*x3;
     const stanford_real x10 = c2*c5 + s5*x3;
     const stanford_real x11 = c5*x5 - s5*x1;
@@ -134,6 +130,8 @@ void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y)
     const stanford_real x15 = c5*x7;
     const stanford_real x16 = s5*x7;
     /* link 6: unit accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x17 = c6*x9 + s6*x4;
     const stanford_real x18 = c6*x4 - s6*x9;
     const stanford_real x19 = c6*x11 + s6*x6;
@@ -250,16 +248,9 @@ void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y)
 /* Base regressor of the inverse dynamics tau = Y(q, qd, qdd) pi_full. */
 void stanford_regressor(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *Y)
 {
-    /* joint angles */
+    /* link 2: velocities and accelerations */
     stanford_real s2, c2;
     STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* link 2: velocities and accelerations */
     const stanford_real x0 = -qd[0]*s2;
     const stanford_real x1 = c2*qd[0];
     const stanford_real x2 = -qdd[0]*s2;
@@ -291,6 +282,8 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
     const stanford_real x27 = q[2]*x18 + 2*qd[1]*qd[2] + x23;
     const stanford_real x28 = q[2]*x16 + qdd[2] + x25;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x29 = -c4*qd[1] + s4*x0;
     const stanford_real x30 = c4*x0 + qd[1]*s4;
     const stanford_real x31 = -c4*qdd[1] + s4*x6;
@@ -316,6 +309,8 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
     const stanford_real x51 = -x37 + x41;
     const stanford_real x52 = x36 + x43;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x53 = c5*x29 + s5*x35;
     const stanford_real x54 = -c5*x35 + s5*x29;
     const stanford_real x55 = c5*x36 + s5*x37;
@@ -341,6 +336,8 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
     const stanford_real x75 = -x61 + x65;
     const stanford_real x76 = x60 + x67;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x77 = c6*x53 + s6*x59;
     const stanford_real x78 = c6*x59 - s6*x53;
     const stanford_real x79 = c6*x60 + s6*x61;
@@ -694,15 +691,6 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
 void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *qd, const stanford_real *qr_d, const stanford_real *qr_dd, stanford_real *Y)
 {
     /* joint angles */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    stanford_real s6, c6;
-    STANFORD_SINCOS(q[5], &s6, &c6);
-    /* joint angles */
     const stanford_real x0 = STANFORD_K(0.5)*qd[0];
     const stanford_real x1 = STANFORD_K(0.5)*qd[1];
     const stanford_real x2 = STANFORD_K(0.5)*qd[2];
@@ -710,6 +698,8 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
     const stanford_real x4 = STANFORD_K(0.5)*qd[4];
     const stanford_real x5 = STANFORD_K(0.5)*qd[5];
     /* link 2: velocities and accelerations */
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
     const stanford_real x6 = -s2*x0;
     const stanford_real x7 = c2*x0;
     const stanford_real x8 = -qr_d[0]*s2;
@@ -743,6 +733,8 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
     const stanford_real x35 = (q[2]*x26 + x31) + 2*(qr_d[1]*x2 + qr_d[2]*x1);
     const stanford_real x36 = q[2]*x24 + qr_dd[2] + x33;
     /* link 4: velocities and accelerations */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
     const stanford_real x37 = -c4*x1 + s4*x6;
     const stanford_real x38 = c4*x6 + s4*x1;
     const stanford_real x39 = -c4*qr_d[1] + s4*x8;
@@ -771,6 +763,8 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
     const stanford_real x62 = -x48 + x52;
     const stanford_real x63 = x47 + x54;
     /* link 5: velocities and accelerations */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
     const stanford_real x64 = c5*x37 + s5*x45;
     const stanford_real x65 = -c5*x45 + s5*x37;
     const stanford_real x66 = c5*x39 + s5*x46;
@@ -799,6 +793,8 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
     const stanford_real x89 = -x75 + x79;
     const stanford_real x90 = x74 + x81;
     /* link 6: velocities and accelerations */
+    stanford_real s6, c6;
+    STANFORD_SINCOS(q[5], &s6, &c6);
     const stanford_real x91 = c6*x64 + s6*x72;
     const stanford_real x92 = c6*x72 - s6*x64;
     const stanford_real x93 = c6*x66 + s6*x73;

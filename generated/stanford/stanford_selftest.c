@@ -966,6 +966,7 @@ static stanford_real regressor_gravity_out[54];
 static stanford_real regressor_inertia_out[651];
 static stanford_real regressor_out[198];
 static stanford_real rnea_out[6];
+static stanford_real rnea_nominal_out[6];
 static stanford_real gravity_out[6];
 static stanford_real mass_matrix_out[36];
 static stanford_real inverse_dynamics_out[6];
@@ -1103,6 +1104,11 @@ int main(void)
 
         stanford_rnea(q, qd, qdd, standard_from_dynamic_out, rnea_out);
         failures += !compare("rnea", k, rnea_out, rnea_expected[k], 6,
+0.0);
+        ++checks;
+
+        stanford_rnea_nominal(q, qd, qdd, rnea_nominal_out);
+        failures += !compare("rnea_nominal", k, rnea_nominal_out, rnea_expected[k], 6,
 0.0);
         ++checks;
 

@@ -129,6 +129,11 @@ RNEA = Function(
     "rnea", "dynamics", "rnea", ("q", "qd", "qdd", "s", "gravity"),
     Output("tau", ("dof",), "joint torques/forces", "Joints"),
     "Inverse dynamics tau = M(q) qdd + c(q, qd) + g(q), recursive Newton-Euler.", Check())
+RNEA_NOMINAL = Function(
+    "rnea_nominal", "dynamics", "rnea_nominal", ("q", "qd", "qdd", "gravity"),
+    Output("tau", ("dof",), "joint torques/forces", "Joints"),
+    "Inverse dynamics as rnea at the description's nominal parameters, folded in as numbers (the self-test's "
+    "fixed parameters when it has none; manifest.json selftest.p).", Check("rnea"))
 GRAVITY = Function(
     "gravity", "dynamics", "gravity", ("q", "s", "gravity"),
     Output("g", ("dof",), "gravity torques", "Joints"), "Gravity vector g(q).", Check())
@@ -214,7 +219,7 @@ FORWARD_DYNAMICS_DERIVATIVES = Function(
     "at qdd = FD(q, qd, tau) (d qdd / d tau = M^-1).", Check())
 
 FUNCTIONS = (STANDARD_FROM_DYNAMIC, PI_GRAVITY, PI_GRAVITY_JACOBIAN, PI_INERTIA, PI_INERTIA_JACOBIAN, PI_FULL,
-             PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, GRAVITY, MASS_MATRIX,
+             PI_FULL_JACOBIAN, REGRESSOR_GRAVITY, REGRESSOR_INERTIA, REGRESSOR, RNEA, RNEA_NOMINAL, GRAVITY, MASS_MATRIX,
              INVERSE_DYNAMICS, FRICTION, LINK_POSES, FLANGE_POSE, JACOBIAN, LINK_JACOBIANS, JACOBIAN_DOT_QD,
              CONTROL, CONTROL_WITH_JACOBIAN, CORIOLIS_MATRIX, MASS_MATRIX_DERIVATIVE,
              REGRESSOR_SLOTINE_LI, FORWARD_DYNAMICS, RNEA_DERIVATIVES, FORWARD_DYNAMICS_DERIVATIVES)

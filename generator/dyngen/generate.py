@@ -15,6 +15,7 @@ from .derivation.controller import controller_models
 from .derivation.models import Derivation
 from .description import Robot, load_robot
 from .emission.render import Emitted, emit
+from .emission.selftest import fixed_parameters
 from .progress import Progress
 from .errors import InputError
 from .reduction.base import BaseSet, reduce_model
@@ -68,7 +69,9 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
                              "gravity coefficient: tilt the base slightly or give gravity a symbol")
     with progress.step("derive the dynamics over the base coefficients"):
         # each function over its own kind's coefficients (Derivation.rnea says why that is exact)
-        models = {"rnea": derivation.rnea(bases["full"]), "gravity": derivation.gravity(bases["gravity"]),
+        models = {"rnea": derivation.rnea(bases["full"]),
+                  "rnea_nominal": derivation.rnea_nominal(bases["full"], fixed_parameters(robot)),
+                  "gravity": derivation.gravity(bases["gravity"]),
                   "mass_matrix": derivation.mass_matrix(bases["inertia"]),
                   "inverse_dynamics": derivation.inverse_dynamics(bases["full"]),
                   "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),

@@ -80,18 +80,31 @@ class Derivation:
     def rnea(self, base=None) -> Model:
         program, sym, chain = self._start()
         params = self._grouped(program, base)
-        motions = chain.forward(sym.qd, sym.qdd, self.robot.gravity)
-        tau = self._tau(program, chain, motions, params)
+        tau = self._interleaved(program, chain, sym.qd, sym.qdd, params)
         return Model("rnea", self._joint_inputs(sym, "q", "qd", "qdd") + [self._params_input()] + self._gravity_inputs(),
                      tau, (self.n,), "inverse dynamics tau = M(q) qdd + c(q, qd) + g(q) (Newton-Euler)",
                      program, sym.trig)
+
+    def rnea_nominal(self, base, p_values) -> Model:
+        """rnea with fixed dynamic parameters p_values folded in as exact numbers (what a
+        controller with fixed parameters, or CasADi with baked parameters, runs): the YAML's
+        decimals as written, s(p) and pi = K s computed here in rationals, so every product with
+        a zero coefficient drops out and differences like ZZ - YY are one constant."""
+        program, sym, chain = self._start()
+        exact = [sp.Rational(repr(float(v))) for v in p_values]
+        s = [x for i in range(self.n) for x in standard_from_dynamic_link(exact[PER_LINK * i: PER_LINK * (i + 1)])]
+        params = s  # where K has a large entry, the grouped form cancels in float (_grouped)
+        if not any(abs(k) > GROUPING_LIMIT for row in base.K for k in row):
+            params = self._placed(base, [sp.Add(*(k * v for k, v in zip(row, s) if k != 0)) for row in base.K])
+        tau = self._interleaved(program, chain, sym.qd, sym.qdd, params)
+        return Model("rnea_nominal", self._joint_inputs(sym, "q", "qd", "qdd") + self._gravity_inputs(),
+                     tau, (self.n,), "inverse dynamics at fixed parameters (Newton-Euler)", program, sym.trig)
 
     def inverse_dynamics(self, base) -> Model:
         """tau = Y_b(q, qd, qdd) pi_full from the base coefficients themselves (full kind)."""
         program, sym, chain = self._start()
         pi = [sp.Symbol(f"pi{k}", real=True) for k in range(base.rank)]
-        motions = chain.forward(sym.qd, sym.qdd, self.robot.gravity)
-        tau = self._tau(program, chain, motions, self._placed(base, pi))
+        tau = self._interleaved(program, chain, sym.qd, sym.qdd, self._placed(base, pi))
         return Model("inverse_dynamics", self._joint_inputs(sym, "q", "qd", "qdd")
                      + [Input("pi_full", pi, ARGUMENTS["pi_full"].meaning)] + self._gravity_inputs(),
                      tau, (self.n,), "inverse dynamics over the base coefficients (Newton-Euler)", program, sym.trig)
@@ -100,7 +113,7 @@ class Derivation:
         program, sym, chain = self._start()
         params = self._grouped(program, base)
         zero = [0] * self.n
-        g = self._tau(program, chain, chain.forward(zero, zero, self.robot.gravity), params)
+        g = self._interleaved(program, chain, zero, zero, params)
         return Model("gravity", self._joint_inputs(sym, "q") + [self._params_input()] + self._gravity_inputs(),
                      g, (self.n,), "gravity vector g(q)", program, sym.trig)
 
@@ -127,6 +140,17 @@ class Derivation:
         for value, column in zip(pi, base.pivots):
             params[column] = value
         return params
+
+    def _interleaved(self, program, chain, qd, qdd, params):
+        """Joint torques, each link's wrench right after its motion (Chain.forward says why)."""
+        wrenches = []
+
+        def wrench(i, motion):
+            program.section = f"link {i + 1}: link wrench"
+            wrenches.append(link_wrench(program, motion, params[PER_LINK * i: PER_LINK * (i + 1)]))
+
+        chain.forward(qd, qdd, self.robot.gravity, then=wrench)
+        return chain.backward(wrenches)
 
     def _tau(self, program, chain, motions, params):
         wrenches = []

@@ -72,12 +72,17 @@ class Chain:
 
     # ---- forward ---------------------------------------------------------------------
 
-    def forward(self, qd, qdd, gravity) -> list[Motion]:
+    def forward(self, qd, qdd, gravity, then=None) -> list[Motion]:
+        """The links' motions, base to tip; then(i, motion), if given, right after each link's
+        motion: the emitted code uses a link's motion before the next link's (fewer values live
+        at once, so fewer spills to the stack)."""
         base = Motion(ZERO, ZERO, self.program.let_vector([-g for g in gravity]), sp.zeros(3, 3), {})
         motions = []
         for i in range(len(self.geometry)):
             self.program.section = f"link {i + 1}: velocities and accelerations"
             motions.append(self.step(i, motions[-1] if motions else base, qd[i], qdd[i]))
+            if then is not None:
+                then(i, motions[-1])
         return motions
 
     def unit_accelerations(self) -> list[list[Motion]]:
@@ -96,7 +101,7 @@ class Chain:
         """Link i's motion from its parent's (link i-1's, or the base's) and joint i's rate and acceleration."""
         let, lets = self.program.let, self.program.let_vector
         geo = self.geometry[i]
-        a = add(parent.a, mat_vec(parent.U, geo.before))  # at X, fixed in link i-1
+        a = lets(add(parent.a, mat_vec(parent.U, geo.before)))  # at X, fixed in link i-1
         w_in, wd_in, a_in = lets(mat_t_vec(geo.R, parent.w)), lets(mat_t_vec(geo.R, parent.wd)), lets(mat_t_vec(geo.R, a))
         spin = scale(qd_i, geo.spin)
         w = lets(add(w_in, spin))

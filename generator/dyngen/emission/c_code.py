@@ -41,7 +41,10 @@ class Printer(C99CodePrinter):
         return self.names.get(expr, expr.name)
 
     def _print_Rational(self, expr):
-        return f"{self.macro}_K({decimal_text(expr)})"
+        text = decimal_text(expr)
+        if len(text) > 24:  # a folded-in parameter product (rnea_nominal): the nearest double
+            text = repr(float(expr))
+        return f"{self.macro}_K({text})"
 
     def _print_Integer(self, expr):
         return str(int(expr))
@@ -130,36 +133,50 @@ def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     trig_used = sorted({s for a in pruned for s in a.expr.free_symbols if s in model.trig} |
                        {s for o in outputs for s in sp.sympify(o).free_symbols if s in model.trig},
                        key=lambda s: (model.trig[s][0], model.trig[s][1]))
-    if trig_used:
-        body.append("/* joint angles */")
     per_joint = {}
     for s in trig_used:
         joint, fn = model.trig[s]
         per_joint.setdefault(joint, {})[fn] = s
-    for joint, fns in per_joint.items():
-        angle = f"q[{joint}]"
-        offset = joint_models[joint].offset
-        if offset != 0:
-            angle = f"q[{joint}] + {macro}_K({float(offset)!r})"
-        if len(fns) == 2:  # one call for both (sincos where the C library has it)
-            body.append(f"{real} {fns['sin'].name}, {fns['cos'].name};")
-            body.append(f"{macro}_SINCOS({angle}, &{fns['sin'].name}, &{fns['cos'].name});")
-        else:
-            for fn, s in fns.items():
-                body.append(f"const {real} {s.name} = {macro}_{fn.upper()}({angle});")
+    angles = {joint: _angle_lines(prefix, joint_models, joint, fns) for joint, fns in per_joint.items()}
+    # each angle's sine and cosine just before their first use: fewer values live at once (the
+    # C compiler keeps the order; twelve sines and cosines held from the top spill to the stack)
+    first_use = {}
+    for k, a in enumerate(pruned):
+        for s in a.expr.free_symbols & set(trig_used):
+            first_use.setdefault(model.trig[s][0], k)
     section = None
     written = [factored(a.expr) for a in pruned]
-    for a, expr in zip(pruned, written):
+    for k, (a, expr) in enumerate(zip(pruned, written)):
         if a.section != section:
             section = a.section
             body.append(f"/* {section} */")
+        for joint in sorted(j for j, first in first_use.items() if first == k):
+            body += angles[joint]
         body.append(f"const {real} {names[a.symbol]} = {printer.doprint(expr)};")
+    late = [j for j in angles if j not in first_use]  # read only by the outputs
+    if late:
+        body.append("/* joint angles */")
+        for joint in sorted(late):
+            body += angles[joint]
     ops = count_all(written) + OpCount(trig=len(per_joint))  # a sin/cos pair counts once
     free = set().union(*(a.expr.free_symbols for a in pruned), *(sp.sympify(o).free_symbols for o in outputs))
     used = {inp.name for inp in model.inputs if free & set(inp.symbols)}
     if trig_used:
         used.add("q")
     return StraightLine(body, printer, ops, used)
+
+
+def _angle_lines(prefix: str, joint_models, joint: int, fns: dict) -> list[str]:
+    """The C that defines one joint angle's sine and/or cosine (one sincos for both)."""
+    real, macro = f"{prefix}_real", prefix.upper()
+    angle = f"q[{joint}]"
+    offset = joint_models[joint].offset
+    if offset != 0:
+        angle = f"q[{joint}] + {macro}_K({float(offset)!r})"
+    if len(fns) == 2:
+        return [f"{real} {fns['sin'].name}, {fns['cos'].name};",
+                f"{macro}_SINCOS({angle}, &{fns['sin'].name}, &{fns['cos'].name});"]
+    return [f"const {real} {s.name} = {macro}_{fn.upper()}({angle});" for fn, s in fns.items()]
 
 
 def render_function(prefix: str, joint_models, name: str, model, outputs, output, doc: str) -> CFunction:
