@@ -90,7 +90,7 @@ double casadi_call(Setup &S, int k) {
   const double *p = S.pin_params;
   if constexpr (F == CORIOLIS) Baked ? casb_coriolis(S.Q(k), S.QD(k), o) : cas_coriolis(S.Q(k), S.QD(k), p, o);
   if constexpr (F == MDOT) Baked ? casb_mass_matrix_dot(S.Q(k), S.QD(k), o) : cas_mass_matrix_dot(S.Q(k), S.QD(k), p, o);
-  if constexpr (F == SLOTINE_LI) cas_slotine_li(S.Q(k), S.QD(k), S.QD((k + 1) % S.count), S.QDD(k), o);
+  if constexpr (F == SLOTINE_LI) cas_slotine_li(S.Q(k), S.QD(k), S.QD((k + 1) % S.count), S.QDD(k), S.pin_params, o);
   if constexpr (F == FD) Baked ? casb_fd(S.Q(k), S.QD(k), S.TAU(k), o) : cas_fd(S.Q(k), S.QD(k), S.TAU(k), p, o);
   if constexpr (F == RNEA_DERIVATIVES)
     Baked ? casb_rnea_derivatives(S.Q(k), S.QD(k), S.QDD(k), o) : cas_rnea_derivatives(S.Q(k), S.QD(k), S.QDD(k), p, o);
@@ -149,7 +149,7 @@ void output(Setup &S, int k, int side, std::vector<double> &o) {
     const int cols = side == 0 ? N_PI_FULL : 10 * N;
     const double *p = side == 0 ? S.pi : S.pin_params;
     if (side == 0) ARM(regressor_slotine_li)(S.Q(k), S.QD(k), S.QD(k), S.QDD(k), Y.data());
-    else cas_slotine_li(S.Q(k), S.QD(k), S.QD(k), S.QDD(k), Y.data());
+    else cas_slotine_li(S.Q(k), S.QD(k), S.QD(k), S.QDD(k), S.pin_params, Y.data());
     for (int i = 0; i < N; ++i) {
       double t = 0.0;
       for (int c = 0; c < cols; ++c) t += Y[i * cols + c] * p[c];
