@@ -208,3 +208,65 @@ def generate_controller(model, name: str, folder: Path) -> dict:
     cg.generate(str(folder) + "/")
     return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
             for f in fns}
+
+
+# --- the kinematics functions (bench_kinematics.py) ---------------------------------------------
+# Forward kinematics over casadi.SX from the same Pinocchio model, the link frames at the given
+# placements after each joint (`posts`, Pinocchio frames) and the flange at the last link frame
+# times the tool; as a careful user writes them: the flange Jacobian's linear rows by
+# casadi.jacobian of its origin, its angular rows the joint axes in the base frame (zero for a
+# slide); Jdot qd = casadi.jtimes(J qd, q, qd) (qdd = 0). Outputs row-major as dyngen's.
+KINEMATICS_FUNCTIONS = {"link_poses": ["q"], "flange_pose": ["q"], "jacobian": ["q"], "link_jacobians": ["q"],
+                        "jacobian_dot_qd": ["q", "qd"]}
+
+
+def _homogeneous(R, p):
+    return ca.vertcat(ca.horzcat(R, p), ca.DM([[0, 0, 0, 1]]))
+
+
+def _exact(T) -> ca.DM:
+    return ca.DM([[_clean(v) for v in row] for row in np.asarray(T)])
+
+
+def kinematics_functions(model, name: str, posts, tool) -> list:
+    """posts[i]: link frame i in joint i's frame (4x4); tool: the flange in the last link frame."""
+    n = model.nv
+    q, qd = ca.SX.sym("q", n), ca.SX.sym("qd", n)
+    T = ca.SX.eye(4)
+    links, axes, origins = [], [], []
+    for i, (revolute, R0, t) in enumerate(_joints(model)):
+        T = ca.mtimes(T, _homogeneous(R0, t))
+        if revolute:
+            c, s = ca.cos(q[i]), ca.sin(q[i])
+            T = ca.mtimes(T, _homogeneous(ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1)),
+                                          ca.DM.zeros(3)))
+        else:
+            T = ca.mtimes(T, _homogeneous(ca.DM.eye(3), ca.vertcat(0, 0, q[i])))
+        axes.append(T[:3, 2] if revolute else ca.DM.zeros(3))
+        links.append(ca.mtimes(T, _exact(posts[i])))
+    flange = ca.mtimes(links[-1], _exact(tool))
+
+    def jacobian_of(origin, upto):
+        angular = ca.horzcat(*(axes[j] if j <= upto else ca.DM.zeros(3) for j in range(n)))
+        return ca.vertcat(ca.jacobian(origin, q), angular)
+
+    J = jacobian_of(flange[:3, 3], n - 1)
+    outputs = {"link_poses": ca.vertcat(*(_row_major(L) for L in links)), "flange_pose": _row_major(flange),
+               "jacobian": _row_major(J),
+               "link_jacobians": ca.vertcat(*(_row_major(jacobian_of(L[:3, 3], i)) for i, L in enumerate(links))),
+               "jacobian_dot_qd": ca.densify(ca.jtimes(ca.mtimes(J, qd), q, qd))}
+    syms = {"q": q, "qd": qd}
+    return [ca.Function(f"{name}_casb_{fn}", [syms[x] for x in KINEMATICS_FUNCTIONS[fn]], [value], {"cse": True})
+            for fn, value in outputs.items()]
+
+
+def generate_kinematics(model, name: str, posts, tool, folder: Path) -> dict:
+    """Writes <name>_casadi_kinematics.c and .h into folder; returns {function name: {iw, w, n_instructions}}."""
+    fns = kinematics_functions(model, name, posts, tool)
+    cg = ca.CodeGenerator(f"{name}_casadi_kinematics.c", {"with_header": True, "casadi_real": "double"})
+    for f in fns:
+        cg.add(f)
+    folder.mkdir(parents=True, exist_ok=True)
+    cg.generate(str(folder) + "/")
+    return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
+            for f in fns}
