@@ -16,6 +16,10 @@ and flags), check agreement on every state (1e-9), then time and count instructi
 
     python bench/bench_kinematics.py [--arms lwr ...] [--callgrind] [--output bench/results/kinematics.md]
 
+The five kinematics functions have a third side in the same binary: CasADi's C of SX forward
+kinematics of the same Pinocchio model (bench/casadi_side.py, kinematics_functions; the
+Jacobian's linear rows by casadi.jacobian, Jdot qd by casadi.jtimes), cse=True, same flags.
+
 Pinocchio is header-only, compiled once into bench/.build/ (the model is read at run time).
 """
 from __future__ import annotations
@@ -51,6 +55,8 @@ PAIRS = {
     "control_with_jacobian": "control's three + computeFrameJacobian + classical acceleration",
 }
 DEFAULT_FLAGS = "-O2 -DNDEBUG"
+SIDES = ("dyngen", "pinocchio", "casadi")
+CASADI_PAIRS = ("link_poses", "flange_pose", "jacobian", "link_jacobians", "jacobian_dot_qd")
 
 
 def pinocchio_object(cxx: str, flags: list, tool: dict) -> Path:
@@ -95,18 +101,31 @@ def prepare(name: str, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path
     lo, hi = joint_ranges(yaml_path)
     build = work / robot
     build.mkdir()
+    import casadi_side
+
+    cas_info = casadi_side.generate_kinematics(model, robot, posts, tool, build / "casadi")
+    wrappers = []
+    for fn, ins in casadi_side.KINEMATICS_FUNCTIONS.items():
+        info = cas_info[f"{robot}_casb_{fn}"]
+        wrappers += [f"static void casb_{fn}({', '.join(f'const double *{x}' for x in ins)}, double *out) {{",
+                     f"  const double *arg[{len(ins)}] = {{{', '.join(ins)}}};", "  double *res[1] = {out};",
+                     f"  static casadi_int iw[{max(1, info['iw'])}];", f"  static double w[{max(1, info['w'])}];",
+                     f"  {robot}_casb_{fn}(arg, res, iw, w, 0);", "}"]
     (build / "arm.inc").write_text("\n".join([
         f'#include "{robot}.h"', f"#define ARM(fn) {robot}_##fn", f"#define ARM_N {n}",
         f"static const double ARM_P[{10 * n}] = {{{', '.join(map(repr, map(float, p)))}}};",
         f"static const double ARM_QLO[{n}] = {{{', '.join(map(repr, map(float, lo)))}}};",
-        f"static const double ARM_QHI[{n}] = {{{', '.join(map(repr, map(float, hi)))}}};", ""]))
+        f"static const double ARM_QHI[{n}] = {{{', '.join(map(repr, map(float, hi)))}}};",
+        f'#include "{robot}_casadi_kinematics.h"', *wrappers, ""]))
     objects = []
     for src in manifest["files"]["library"]:
         obj = build / (Path(src).stem + ".o")
         run([cc, "-std=c99", *flags, "-c", str(folder / src), "-o", str(obj)])
         objects.append(obj)
+    objects.append(build / "casadi_kinematics.o")
+    run([cc, "-std=c99", *flags, "-c", str(build / "casadi" / f"{robot}_casadi_kinematics.c"), "-o", str(objects[-1])])
     harness = build / "harness.o"
-    run([cxx, "-std=c++17", *flags, f"-I{build}", f"-I{BENCH}", f"-I{folder}", "-c",
+    run([cxx, "-std=c++17", *flags, f"-I{build}", f"-I{BENCH}", f"-I{folder}", f"-I{build / 'casadi'}", "-c",
          str(BENCH / "kinematics_harness.cpp"), "-o", str(harness)])
     exe = build / "kinematics_harness"
     run([cxx, *flags, str(harness), str(pin_obj), *map(str, objects), "-o", str(exe), "-lm"])
@@ -131,16 +150,20 @@ def measure(arm: dict, args, work: Path) -> dict:
         tok = line.split()
         if tok[0] == "VERIFY":
             rows.setdefault(tok[1], {})["error"] = float(tok[2])
+            if len(tok) > 3:
+                rows[tok[1]]["casadi_error"] = float(tok[3])
         elif tok[0] == "TIME":
             rows[tok[1]].update(dyngen_ns=float(tok[2]), pinocchio_ns=float(tok[3]))
+            if len(tok) > 4:
+                rows[tok[1]]["casadi_ns"] = float(tok[4])
     if args.callgrind:
-        jobs = [("link_poses", "dyngen", 0)] + [(f, side, args.calls) for f in PAIRS for side in ("dyngen", "pinocchio")]
+        jobs = [("link_poses", "dyngen", 0)] + [(f, side, args.calls) for f in PAIRS for side in SIDES
+                                                if side != "casadi" or f in CASADI_PAIRS]
         with ThreadPoolExecutor(max_workers=2) as pool:
             irs = dict(zip(jobs, pool.map(lambda j: callgrind(arm, args.states, *j, work), jobs)))
         base = irs[("link_poses", "dyngen", 0)]
-        for f in PAIRS:
-            for side in ("dyngen", "pinocchio"):
-                rows[f][f"{side}_ir"] = (irs[(f, side, args.calls)] - base) / args.calls
+        for (f, side, calls) in jobs[1:]:
+            rows[f][f"{side}_ir"] = (irs[(f, side, calls)] - base) / calls
     return rows
 
 
@@ -148,8 +171,8 @@ def markdown(arms: list, results: dict, callgrind: bool) -> str:
     head = "| arm | dyngen | Pinocchio | dyngen ns | Pinocchio ns | ratio | mul | add | sin/cos |"
     rule = "|---|---|---|---:|---:|---:|---:|---:|---:|"
     if callgrind:
-        head += " dyngen Ir | Pinocchio Ir | Ir ratio |"
-        rule += "---:|---:|---:|"
+        head += " dyngen Ir | Pinocchio Ir | Ir ratio | CasADi ns | CasADi Ir | CasADi Ir / dyngen Ir |"
+        rule += "---:|---:|---:|---:|---:|---:|"
     lines = [head, rule]
     for a in arms:
         for f, theirs in PAIRS.items():
@@ -158,6 +181,8 @@ def markdown(arms: list, results: dict, callgrind: bool) -> str:
                     f"{r['pinocchio_ns'] / r['dyngen_ns']:.2f}x | {ops['mul']} | {ops['add']} | {ops['sin_cos']} |")
             if callgrind:
                 line += f" {r['dyngen_ir']:.0f} | {r['pinocchio_ir']:.0f} | {r['pinocchio_ir'] / r['dyngen_ir']:.2f}x |"
+                line += (f" {r['casadi_ns']:.1f} | {r['casadi_ir']:.0f} | {r['casadi_ir'] / r['dyngen_ir']:.2f}x |"
+                         if "casadi_ir" in r else " - | - | - |")
             lines.append(line)
     return "\n".join(lines)
 
@@ -186,9 +211,10 @@ def main(argv=None) -> int:
             log(f"{name}: verifying, timing{' and counting instructions' if args.callgrind else ''} ...")
             results[arm["name"]] = measure(arm, args, Path(tmp))
             arms.append(arm)
-    bad = {(a, f): r["error"] for a, rs in results.items() for f, r in rs.items() if not r["error"] < 1e-9}
+    bad = {(a, f): r["error"] for a, rs in results.items() for f, r in rs.items()
+           if not (r["error"] < 1e-9 and r.get("casadi_error", 0.0) < 1e-9)}
     if bad:
-        raise SystemExit(f"dyngen and Pinocchio disagree: {bad}")
+        raise SystemExit(f"dyngen or CasADi and Pinocchio disagree: {bad}")
     info = [f"- machine: {machine()}",
             f"- `{cc}` ({compiler_version(cc)}) `-std=c99 {args.flags}` for the generated C; `{cxx}` "
             f"({compiler_version(cxx)}) `-std=c++17 {args.flags}` for the harness and Pinocchio {tool['version']} "
@@ -198,6 +224,9 @@ def main(argv=None) -> int:
             + "; ".join(f"{a['name']} {a['p_source']}" for a in arms),
             "- agreement before timing, every state, max |dyngen - Pinocchio| / max(1, |Pinocchio|): "
             + "; ".join(f"{a} " + ", ".join(f"{f} {r['error']:.1e}" for f, r in rs.items()) for a, rs in results.items()),
+            "- CasADi (the five kinematics functions) against Pinocchio, same measure: "
+            + "; ".join(f"{a} " + ", ".join(f"{f} {r['casadi_error']:.1e}" for f, r in rs.items() if "casadi_error" in r)
+                        for a, rs in results.items()),
             "- Pinocchio's control: crba fills the upper triangle of M; c = nonLinearEffects - g"]
     if args.callgrind:
         info.append(f"- Ir: callgrind instructions per call ({args.calls} calls minus a 0-call run, same set-up)")
@@ -206,7 +235,7 @@ def main(argv=None) -> int:
     if args.output:
         out = Path(args.output)
         out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text("# Kinematics and control(): generated C vs Pinocchio\n\nWritten by `python "
+        out.write_text("# Kinematics and control(): generated C vs Pinocchio and CasADi\n\nWritten by `python "
                        f"bench/bench_kinematics.py{' --callgrind' if args.callgrind else ''}`.\n\n" + text)
         out.with_suffix(".json").write_text(json.dumps(
             {a: {f: {k: v for k, v in r.items()} for f, r in rs.items()} for a, rs in results.items()}, indent=1) + "\n")

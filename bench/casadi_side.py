@@ -133,3 +133,140 @@ def generate(model, name: str, folder: Path) -> dict:
     del cwd
     return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
             for f in fns}
+
+
+# --- the controller functions (bench_controller.py) ---------------------------------------------
+# Written the way a careful CasADi user would, from the same plain rnea above:
+#   coriolis         C_ij = sum_k 1/2 (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) qd_k (Christoffel, from
+#                    casadi.jacobian of M)
+#   mass_matrix_dot  casadi.jtimes(M, q, qd) (forward mode along qd)
+#   slotine_li       casadi.jacobian(M qr_dd + C qr_d + g, params) (parameters as input only: Y holds none)
+#   fd               casadi.solve(M, tau - rnea(q, qd, 0)) (CasADi's symbolic QR)
+#   rnea_derivatives casadi.jacobian(rnea, [q; qd])
+#   fd_derivatives   casadi.jacobian(fd, [q; qd])
+# Every matrix output is row-major, as dyngen's.
+CONTROLLER_FUNCTIONS = {  # name -> (inputs, output)
+    "coriolis": (["q", "qd"], "C"),
+    "mass_matrix_dot": (["q", "qd"], "Md"),
+    "slotine_li": (["q", "qd", "qrd", "qrdd"], "Y"),
+    "fd": (["q", "qd", "tau"], "qdd"),
+    "rnea_derivatives": (["q", "qd", "qdd"], "D"),
+    "fd_derivatives": (["q", "qd", "tau"], "D"),
+}
+
+
+def _row_major(X):
+    return ca.densify(ca.reshape(X.T, X.numel(), 1))
+
+
+def _christoffel(M, q, qd, n: int):
+    dM = ca.jacobian(ca.reshape(M, n * n, 1), q)  # row j + n i of column k: dM_ji / dq_k
+    C = ca.SX.zeros(n, n)
+    for i in range(n):
+        for j in range(n):
+            C[i, j] = sum(0.5 * (dM[i + n * j, k] + dM[i + n * k, j] - dM[j + n * k, i]) * qd[k] for k in range(n))
+    return C
+
+
+def controller_functions(model, name: str) -> list:
+    """The controller casadi.Function objects of one arm: both variants of every function but
+    slotine_li, which has only the parameters-as-input one (<name>_cas_slotine_li)."""
+    n = model.nv
+    sym = {x: ca.SX.sym(x, n) for x in ("q", "qd", "qdd", "tau", "qrd", "qrdd")}
+    q, qd = sym["q"], sym["qd"]
+    params = ca.SX.sym("params", 10 * n)
+    gravity = np.asarray(model.gravity.linear, dtype=float)
+    zero = ca.SX.zeros(n)
+    opts = {"cse": True}
+    out = []
+    for variant, P in (("cas", params), ("casb", ca.SX(ca.DM(body_parameters(model))))):
+        extra = [params] if variant == "cas" else []
+        M = ca.jacobian(rnea(model, q, zero, sym["qdd"], P, [0.0, 0.0, 0.0]), sym["qdd"])
+        C = _christoffel(M, q, qd, n)
+        bias = rnea(model, q, qd, zero, P, gravity)
+        qdd = ca.solve(M, sym["tau"] - bias)
+        x = ca.vertcat(q, qd)
+        outputs = {"coriolis": _row_major(C), "mass_matrix_dot": _row_major(ca.jtimes(M, q, qd)),
+                   "fd": qdd, "rnea_derivatives": _row_major(ca.jacobian(rnea(model, q, qd, sym["qdd"], P, gravity), x)),
+                   "fd_derivatives": _row_major(ca.jacobian(qdd, x))}
+        if variant == "cas":
+            g = rnea(model, q, zero, zero, P, gravity)
+            outputs["slotine_li"] = _row_major(ca.jacobian(ca.mtimes(M, sym["qrdd"]) + ca.mtimes(C, sym["qrd"]) + g, params))
+        for fn, value in outputs.items():
+            ins = [sym[i] for i in CONTROLLER_FUNCTIONS[fn][0]]
+            out.append(ca.Function(f"{name}_{variant}_{fn}", ins + extra, [value], opts))
+    return out
+
+
+def generate_controller(model, name: str, folder: Path) -> dict:
+    """Writes <name>_casadi_controller.c and .h into folder; returns {function name: {iw, w, n_instructions}}."""
+    fns = controller_functions(model, name)
+    cg = ca.CodeGenerator(f"{name}_casadi_controller.c", {"with_header": True, "casadi_real": "double"})
+    for f in fns:
+        cg.add(f)
+    folder.mkdir(parents=True, exist_ok=True)
+    cg.generate(str(folder) + "/")
+    return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
+            for f in fns}
+
+
+# --- the kinematics functions (bench_kinematics.py) ---------------------------------------------
+# Forward kinematics over casadi.SX from the same Pinocchio model, the link frames at the given
+# placements after each joint (`posts`, Pinocchio frames) and the flange at the last link frame
+# times the tool; as a careful user writes them: the flange Jacobian's linear rows by
+# casadi.jacobian of its origin, its angular rows the joint axes in the base frame (zero for a
+# slide); Jdot qd = casadi.jtimes(J qd, q, qd) (qdd = 0). Outputs row-major as dyngen's.
+KINEMATICS_FUNCTIONS = {"link_poses": ["q"], "flange_pose": ["q"], "jacobian": ["q"], "link_jacobians": ["q"],
+                        "jacobian_dot_qd": ["q", "qd"]}
+
+
+def _homogeneous(R, p):
+    return ca.vertcat(ca.horzcat(R, p), ca.DM([[0, 0, 0, 1]]))
+
+
+def _exact(T) -> ca.DM:
+    return ca.DM([[_clean(v) for v in row] for row in np.asarray(T)])
+
+
+def kinematics_functions(model, name: str, posts, tool) -> list:
+    """posts[i]: link frame i in joint i's frame (4x4); tool: the flange in the last link frame."""
+    n = model.nv
+    q, qd = ca.SX.sym("q", n), ca.SX.sym("qd", n)
+    T = ca.SX.eye(4)
+    links, axes, origins = [], [], []
+    for i, (revolute, R0, t) in enumerate(_joints(model)):
+        T = ca.mtimes(T, _homogeneous(R0, t))
+        if revolute:
+            c, s = ca.cos(q[i]), ca.sin(q[i])
+            T = ca.mtimes(T, _homogeneous(ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1)),
+                                          ca.DM.zeros(3)))
+        else:
+            T = ca.mtimes(T, _homogeneous(ca.DM.eye(3), ca.vertcat(0, 0, q[i])))
+        axes.append(T[:3, 2] if revolute else ca.DM.zeros(3))
+        links.append(ca.mtimes(T, _exact(posts[i])))
+    flange = ca.mtimes(links[-1], _exact(tool))
+
+    def jacobian_of(origin, upto):
+        angular = ca.horzcat(*(axes[j] if j <= upto else ca.DM.zeros(3) for j in range(n)))
+        return ca.vertcat(ca.jacobian(origin, q), angular)
+
+    J = jacobian_of(flange[:3, 3], n - 1)
+    outputs = {"link_poses": ca.vertcat(*(_row_major(L) for L in links)), "flange_pose": _row_major(flange),
+               "jacobian": _row_major(J),
+               "link_jacobians": ca.vertcat(*(_row_major(jacobian_of(L[:3, 3], i)) for i, L in enumerate(links))),
+               "jacobian_dot_qd": ca.densify(ca.jtimes(ca.mtimes(J, qd), q, qd))}
+    syms = {"q": q, "qd": qd}
+    return [ca.Function(f"{name}_casb_{fn}", [syms[x] for x in KINEMATICS_FUNCTIONS[fn]], [value], {"cse": True})
+            for fn, value in outputs.items()]
+
+
+def generate_kinematics(model, name: str, posts, tool, folder: Path) -> dict:
+    """Writes <name>_casadi_kinematics.c and .h into folder; returns {function name: {iw, w, n_instructions}}."""
+    fns = kinematics_functions(model, name, posts, tool)
+    cg = ca.CodeGenerator(f"{name}_casadi_kinematics.c", {"with_header": True, "casadi_real": "double"})
+    for f in fns:
+        cg.add(f)
+    folder.mkdir(parents=True, exist_ok=True)
+    cg.generate(str(folder) + "/")
+    return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
+            for f in fns}

@@ -1,10 +1,14 @@
-// Harness of bench_controller.py: one arm's generated controller functions against Pinocchio's,
-// in one binary, the same compiler and flags. "arm.inc" (written by bench_controller.py) includes
-// the arm's header and defines ARM(fn) (its C names), N, P (nominal dynamic parameters), QLO, QHI.
+// Harness of bench_controller.py: one arm's generated controller functions against Pinocchio's
+// and CasADi's (bench/casadi_side.py, parameters as input and baked), in one binary, the same
+// compiler and flags. "arm.inc" (written by bench_controller.py) includes the arm's headers and
+// defines ARM(fn) (its C names), N, P (nominal dynamic parameters), QLO, QHI and the CasADi
+// wrappers cas_<fn>(inputs..., params, out) and casb_<fn>(inputs..., out).
 //
-//   harness verify    MODEL STATES                     VERIFY <function> <max relative error>
-//   harness time      MODEL STATES BATCHES              TIME <function> <dyngen ns> <pinocchio ns>
-//   harness callgrind MODEL STATES FUNCTION SIDE CALLS  (CALLS = 0: the baseline run)
+//   harness verify    MODEL STATES                     VERIFY <function> <dyngen> <casadi> <casadi baked>
+//                                                      (max relative error of each against Pinocchio)
+//   harness time      MODEL STATES BATCHES              TIME <function> <dyngen> <pinocchio> <casadi> <casadi baked> (ns)
+//   harness callgrind MODEL STATES FUNCTION SIDE CALLS  SIDE: dyngen pinocchio casadi casadi_baked
+//                                                      (CALLS = 0: the baseline run)
 //
 // FUNCTION (dyngen vs Pinocchio):
 //   coriolis        ARM(coriolis_matrix)               vs computeCoriolisMatrix
@@ -36,9 +40,9 @@ const char *const kNames[N_FN] = {"coriolis", "mass_matrix_dot", "slotine_li", "
 
 struct Setup {
   PinArm *pin = nullptr;
-  double s[10 * N], pi[N_PI_FULL];
+  double s[10 * N], pi[N_PI_FULL], pin_params[10 * N];
   std::vector<double> q, qd, qdd, tau;
-  std::vector<double> out = std::vector<double>(N * std::max(2 * N, N_PI_FULL));
+  std::vector<double> out = std::vector<double>(N * std::max(2 * N, 10 * N));
   int count = 0;
   const double *Q(int k) const { return &q[(size_t)k * N]; }
   const double *QD(int k) const { return &qd[(size_t)k * N]; }
@@ -52,6 +56,7 @@ bool setup(const char *model, int states, Setup &S) {
   if (!S.pin || nv != N) return false;
   ARM(standard_from_dynamic)(P, S.s);
   ARM(pi_full)(P, S.pi);
+  pin_parameters(S.pin, S.pin_params);
   std::mt19937_64 rng(20240611u);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   S.count = states;
@@ -78,6 +83,22 @@ double dyngen_call(Setup &S, int k) {
   return o[0] + o[N - 1];
 }
 
+// CasADi: D and Y row-major as dyngen's; casb_slotine_li is cas_slotine_li (Y holds no parameters).
+template <int F, bool Baked>
+double casadi_call(Setup &S, int k) {
+  double *o = S.out.data();
+  const double *p = S.pin_params;
+  if constexpr (F == CORIOLIS) Baked ? casb_coriolis(S.Q(k), S.QD(k), o) : cas_coriolis(S.Q(k), S.QD(k), p, o);
+  if constexpr (F == MDOT) Baked ? casb_mass_matrix_dot(S.Q(k), S.QD(k), o) : cas_mass_matrix_dot(S.Q(k), S.QD(k), p, o);
+  if constexpr (F == SLOTINE_LI) cas_slotine_li(S.Q(k), S.QD(k), S.QD((k + 1) % S.count), S.QDD(k), S.pin_params, o);
+  if constexpr (F == FD) Baked ? casb_fd(S.Q(k), S.QD(k), S.TAU(k), o) : cas_fd(S.Q(k), S.QD(k), S.TAU(k), p, o);
+  if constexpr (F == RNEA_DERIVATIVES)
+    Baked ? casb_rnea_derivatives(S.Q(k), S.QD(k), S.QDD(k), o) : cas_rnea_derivatives(S.Q(k), S.QD(k), S.QDD(k), p, o);
+  if constexpr (F == FD_DERIVATIVES)
+    Baked ? casb_fd_derivatives(S.Q(k), S.QD(k), S.TAU(k), o) : cas_fd_derivatives(S.Q(k), S.QD(k), S.TAU(k), p, o);
+  return o[0] + o[N - 1];
+}
+
 template <int F>
 double pinocchio_call(Setup &S, int k) {
   const double *a = nullptr, *b = nullptr;
@@ -98,50 +119,73 @@ double pinocchio_call(Setup &S, int k) {
 
 double rel(double a, double b) { return std::fabs(a - b) / std::max(1.0, std::fabs(b)); }
 
-// Every function against Pinocchio on every state: matrices entry by entry (data.C column-major,
-// the derivative blocks RowMatrixXs),
-// the Slotine-Li regressor as Y(q, qd, qd, qdd) pi_full against pinocchio::rnea.
-bool verify(Setup &S) {
-  double err[N_FN] = {0.0};
-  std::vector<double> o(N * std::max(2 * N, N_PI_FULL));
-  for (int k = 0; k < S.count; ++k) {
-    const double *C = pin_coriolis(S.pin, S.Q(k), S.QD(k));
-    ARM(coriolis_matrix)(S.Q(k), S.QD(k), S.s, o.data());
+// Pinocchio's value in dyngen's layout (row-major matrices, [dq | dv] blocks side by side);
+// for the Slotine-Li regressor: tau = rnea(q, qd, qdd), against which Y(q, qd, qd, qdd) p is checked.
+template <int F>
+void reference(Setup &S, int k, std::vector<double> &r) {
+  const double *a = nullptr, *b = nullptr;
+  if constexpr (F == CORIOLIS || F == MDOT) {
+    a = pin_coriolis(S.pin, S.Q(k), S.QD(k));
     for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) err[CORIOLIS] = std::max(err[CORIOLIS], rel(o[i * N + j], C[i + j * N]));
-    ARM(mass_matrix_derivative)(S.Q(k), S.QD(k), S.s, o.data());
+      for (int j = 0; j < N; ++j) r[i * N + j] = F == CORIOLIS ? a[i + j * N] : a[i + j * N] + a[j + i * N];
+  }
+  if constexpr (F == SLOTINE_LI) std::copy_n(pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k)), N, r.begin());
+  if constexpr (F == FD) std::copy_n(pin_aba(S.pin, S.Q(k), S.QD(k), S.TAU(k)), N, r.begin());
+  if constexpr (F == RNEA_DERIVATIVES || F == FD_DERIVATIVES) {
+    if constexpr (F == RNEA_DERIVATIVES) pin_rnea_derivatives(S.pin, S.Q(k), S.QD(k), S.QDD(k), &a, &b);
+    else pin_aba_derivatives(S.pin, S.Q(k), S.QD(k), S.TAU(k), &a, &b);
     for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) err[MDOT] = std::max(err[MDOT], rel(o[i * N + j], C[i + j * N] + C[j + i * N]));
-    const double *tau = pin_rnea(S.pin, S.Q(k), S.QD(k), S.QDD(k));
-    ARM(regressor_slotine_li)(S.Q(k), S.QD(k), S.QD(k), S.QDD(k), o.data());
+      for (int j = 0; j < N; ++j) r[i * 2 * N + j] = a[i * N + j], r[i * 2 * N + N + j] = b[i * N + j];
+  }
+}
+
+constexpr int out_size(int f) { return f == CORIOLIS || f == MDOT ? N * N : f == FD || f == SLOTINE_LI ? N : 2 * N * N; }
+
+// side 0 dyngen, 1 CasADi, 2 CasADi baked: its output for state k in dyngen's layout (Slotine-Li: Y(q, qd, qd, qdd) p).
+template <int F>
+void output(Setup &S, int k, int side, std::vector<double> &o) {
+  if constexpr (F == SLOTINE_LI) {
+    std::vector<double> Y(N * std::max(N_PI_FULL, 10 * N));
+    const int cols = side == 0 ? N_PI_FULL : 10 * N;
+    const double *p = side == 0 ? S.pi : S.pin_params;
+    if (side == 0) ARM(regressor_slotine_li)(S.Q(k), S.QD(k), S.QD(k), S.QDD(k), Y.data());
+    else cas_slotine_li(S.Q(k), S.QD(k), S.QD(k), S.QDD(k), S.pin_params, Y.data());
     for (int i = 0; i < N; ++i) {
       double t = 0.0;
-      for (int c = 0; c < N_PI_FULL; ++c) t += o[i * N_PI_FULL + c] * S.pi[c];
-      err[SLOTINE_LI] = std::max(err[SLOTINE_LI], rel(t, tau[i]));
+      for (int c = 0; c < cols; ++c) t += Y[i * cols + c] * p[c];
+      o[i] = t;
     }
-    const double *a = pin_aba(S.pin, S.Q(k), S.QD(k), S.TAU(k));
-    ARM(forward_dynamics)(S.Q(k), S.QD(k), S.TAU(k), S.s, o.data());
-    for (int i = 0; i < N; ++i) err[FD] = std::max(err[FD], rel(o[i], a[i]));
-    const double *dq, *dv;
-    pin_rnea_derivatives(S.pin, S.Q(k), S.QD(k), S.QDD(k), &dq, &dv);
-    ARM(rnea_derivatives)(S.Q(k), S.QD(k), S.QDD(k), S.s, o.data());
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j)
-        err[RNEA_DERIVATIVES] = std::max({err[RNEA_DERIVATIVES], rel(o[i * 2 * N + j], dq[i * N + j]),
-                                          rel(o[i * 2 * N + N + j], dv[i * N + j])});
-    pin_aba_derivatives(S.pin, S.Q(k), S.QD(k), S.TAU(k), &dq, &dv);
-    ARM(forward_dynamics_derivatives)(S.Q(k), S.QD(k), S.TAU(k), S.s, o.data());
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j)
-        err[FD_DERIVATIVES] = std::max({err[FD_DERIVATIVES], rel(o[i * 2 * N + j], dq[i * N + j]),
-                                        rel(o[i * 2 * N + N + j], dv[i * N + j])});
+  } else {
+    if (side == 0) dyngen_call<F>(S, k);
+    if (side == 1) casadi_call<F, false>(S, k);
+    if (side == 2) casadi_call<F, true>(S, k);
+    std::copy_n(S.out.begin(), out_size(F), o.begin());
   }
-  bool ok = true;
-  for (int f = 0; f < N_FN; ++f) {
-    std::printf("VERIFY %s %.3e\n", kNames[f], err[f]);
-    ok = ok && err[f] <= 1e-9;
+}
+
+template <int F>
+bool verify_one(Setup &S) {
+  double err[3] = {0.0, 0.0, 0.0};
+  std::vector<double> r(2 * N * N), o(2 * N * N);
+  for (int k = 0; k < S.count; ++k) {
+    reference<F>(S, k, r);
+    for (int side = 0; side < 3; ++side) {
+      output<F>(S, k, side, o);
+      for (int i = 0; i < out_size(F); ++i) err[side] = std::max(err[side], rel(o[i], r[i]));
+    }
   }
-  return ok;
+  std::printf("VERIFY %s %.3e %.3e %.3e\n", kNames[F], err[0], err[1], err[2]);
+  return err[0] <= 1e-9 && err[1] <= 1e-9 && err[2] <= 1e-9;
+}
+
+// Every function of every side against Pinocchio on every state.
+bool verify(Setup &S) {
+  bool ok = verify_one<CORIOLIS>(S);
+  ok = verify_one<MDOT>(S) && ok;
+  ok = verify_one<SLOTINE_LI>(S) && ok;
+  ok = verify_one<FD>(S) && ok;
+  ok = verify_one<RNEA_DERIVATIVES>(S) && ok;
+  return verify_one<FD_DERIVATIVES>(S) && ok;
 }
 
 using Clock = std::chrono::steady_clock;
@@ -156,21 +200,32 @@ double batch_ns(F f, int count) {
 }
 
 template <int F>
-void time_pair(Setup &S, int batches) {
-  std::vector<double> td, tp;
-  for (int b = 0; b < batches; ++b) {
-    td.push_back(batch_ns([&](int k) { return dyngen_call<F>(S, k); }, S.count));
-    tp.push_back(batch_ns([&](int k) { return pinocchio_call<F>(S, k); }, S.count));
+double side_call(Setup &S, int side, int k) {
+  switch (side) {
+    case 0: return dyngen_call<F>(S, k);
+    case 1: return pinocchio_call<F>(S, k);
+    case 2: return casadi_call<F, false>(S, k);
+    default: return casadi_call<F, true>(S, k);
   }
-  std::sort(td.begin(), td.end());
-  std::sort(tp.begin(), tp.end());
-  std::printf("TIME %s %.1f %.1f\n", kNames[F], td[td.size() / 2], tp[tp.size() / 2]);
 }
 
 template <int F>
-double calls(Setup &S, bool dyngen, long n) {
+void time_pair(Setup &S, int batches) {
+  std::vector<double> t[4];
+  for (int b = 0; b < batches; ++b)  // interleaved batches
+    for (int side = 0; side < 4; ++side) t[side].push_back(batch_ns([&](int k) { return side_call<F>(S, side, k); }, S.count));
+  std::printf("TIME %s", kNames[F]);
+  for (auto &v : t) {
+    std::sort(v.begin(), v.end());
+    std::printf(" %.1f", v[v.size() / 2]);
+  }
+  std::printf("\n");
+}
+
+template <int F>
+double calls(Setup &S, int side, long n) {
   double acc = 0.0;
-  for (long c = 0; c < n; ++c) acc += dyngen ? dyngen_call<F>(S, (int)(c % S.count)) : pinocchio_call<F>(S, (int)(c % S.count));
+  for (long c = 0; c < n; ++c) acc += side_call<F>(S, side, (int)(c % S.count));
   return acc;
 }
 
@@ -194,7 +249,11 @@ int main(int argc, char **argv) {
   }
   if (mode == "callgrind" && argc == 7) {
     const std::string fn = argv[4];
-    const bool dyn = std::strcmp(argv[5], "dyngen") == 0;
+    const char *const sides[4] = {"dyngen", "pinocchio", "casadi", "casadi_baked"};
+    int dyn = -1;
+    for (int i = 0; i < 4; ++i)
+      if (std::strcmp(argv[5], sides[i]) == 0) dyn = i;
+    if (dyn < 0) return 1;
     const long n = std::atol(argv[6]);
     int f = -1;
     for (int i = 0; i < N_FN; ++i)

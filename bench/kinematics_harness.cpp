@@ -3,9 +3,12 @@
 // "arm.inc" (written by bench_kinematics.py) includes the arm's header and defines ARM(fn),
 // ARM_N, ARM_P (nominal dynamic parameters) and ARM_QLO / ARM_QHI (joint ranges).
 //
-//   kinematics_harness verify MODEL STATES                 VERIFY <function> <max relative error>
-//   kinematics_harness time MODEL STATES BATCHES WARMUP    TIME <function> <dyngen ns> <pinocchio ns>
-//   kinematics_harness count MODEL STATES FUNCTION SIDE CALLS   (for callgrind; CALLS = 0: baseline)
+// It also defines casb_<fn> for the five kinematics functions: CasADi's C of the same arm
+// (bench/casadi_side.py, kinematics_functions), the third side.
+//
+//   kinematics_harness verify MODEL STATES                 VERIFY <function> <dyngen error> [<CasADi error>]
+//   kinematics_harness time MODEL STATES BATCHES WARMUP    TIME <function> <dyngen ns> <pinocchio ns> [<CasADi ns>]
+//   kinematics_harness count MODEL STATES FUNCTION SIDE CALLS   (SIDE dyngen | pinocchio | casadi; CALLS = 0: baseline)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -69,6 +72,19 @@ double dyngen(int fn, const double *q, const double *qd, double *out) {
   return 0.0;
 }
 
+const int N_CASADI = CONTROL;  // the kinematics functions have a CasADi side
+
+double casadi(int fn, const double *q, const double *qd, double *out) {
+  switch (fn) {
+    case LINK_POSES: casb_link_poses(q, out); return out[16 * n - 13];
+    case FLANGE_POSE: casb_flange_pose(q, out); return out[3];
+    case JACOBIAN: casb_jacobian(q, out); return out[0];
+    case LINK_JACOBIANS: casb_link_jacobians(q, out); return out[6 * n * n - 1];
+    case JDOT_QD: casb_jacobian_dot_qd(q, qd, out); return out[0];
+  }
+  return 0.0;
+}
+
 double pinocchio(PkArm *a, int fn, const double *q, const double *qd, double *out) {
   switch (fn) {
     case LINK_POSES: return pk_link_poses(a, q, out);
@@ -82,24 +98,33 @@ double pinocchio(PkArm *a, int fn, const double *q, const double *qd, double *ou
   return 0.0;
 }
 
-// Agreement on every state: max |dyngen - pinocchio| / max(1, max |pinocchio|) per function.
+double relative(const std::vector<double> &mine, const std::vector<double> &theirs, int length) {
+  double diff = 0.0, scale = 1.0;
+  for (int i = 0; i < length; ++i) {
+    diff = std::max(diff, std::fabs(mine[i] - theirs[i]));
+    scale = std::max(scale, std::fabs(theirs[i]));
+  }
+  return diff / scale;
+}
+
+// Agreement on every state: max |dyngen - pinocchio| / max(1, max |pinocchio|) per function (CasADi's too).
 bool verify(PkArm *a, const States &S) {
-  std::vector<double> mine(kLongest), theirs(kLongest);
+  std::vector<double> mine(kLongest), theirs(kLongest), cas(kLongest);
   bool ok = true;
   for (int fn = 0; fn < N_FN; ++fn) {
-    double worst = 0.0;
+    double worst = 0.0, worst_cas = 0.0;
     for (int k = 0; k < S.count; ++k) {
       dyngen(fn, S.Q(k), S.QD(k), mine.data());
       pinocchio(a, fn, S.Q(k), S.QD(k), theirs.data());
-      double diff = 0.0, scale = 1.0;
-      for (int i = 0; i < kLength[fn]; ++i) {
-        diff = std::max(diff, std::fabs(mine[i] - theirs[i]));
-        scale = std::max(scale, std::fabs(theirs[i]));
+      worst = std::max(worst, relative(mine, theirs, kLength[fn]));
+      if (fn < N_CASADI) {
+        casadi(fn, S.Q(k), S.QD(k), cas.data());
+        worst_cas = std::max(worst_cas, relative(cas, theirs, kLength[fn]));
       }
-      worst = std::max(worst, diff / scale);
     }
-    std::printf("VERIFY %s %.3g\n", kNames[fn], worst);
-    ok = ok && worst < 1e-9;
+    if (fn < N_CASADI) std::printf("VERIFY %s %.3g %.3g\n", kNames[fn], worst, worst_cas);
+    else std::printf("VERIFY %s %.3g\n", kNames[fn], worst);
+    ok = ok && worst < 1e-9 && worst_cas < 1e-9;
   }
   return ok;
 }
@@ -147,25 +172,29 @@ int main(int argc, char **argv) {
     if (!verify(arm, S)) return 1;
     const int batches = std::atoi(argv[4]), warmup = std::atoi(argv[5]);
     for (int fn = 0; fn < N_FN; ++fn) {
-      std::vector<double> mine, theirs;
-      for (int b = 0; b < warmup + batches; ++b) {  // interleaved: both sides see the same machine state
+      std::vector<double> mine, theirs, cas;
+      for (int b = 0; b < warmup + batches; ++b) {  // interleaved: every side sees the same machine state
         const double d = batch_ns(S, [&](int k) { return dyngen(fn, S.Q(k), S.QD(k), out.data()); });
         const double p = batch_ns(S, [&](int k) { return pinocchio(arm, fn, S.Q(k), S.QD(k), nullptr); });
-        if (b >= warmup) mine.push_back(d), theirs.push_back(p);
+        const double c = fn < N_CASADI ? batch_ns(S, [&](int k) { return casadi(fn, S.Q(k), S.QD(k), out.data()); }) : 0.0;
+        if (b >= warmup) mine.push_back(d), theirs.push_back(p), cas.push_back(c);
       }
-      std::printf("TIME %s %.2f %.2f\n", kNames[fn], median(mine), median(theirs));
+      if (fn < N_CASADI) std::printf("TIME %s %.2f %.2f %.2f\n", kNames[fn], median(mine), median(theirs), median(cas));
+      else std::printf("TIME %s %.2f %.2f\n", kNames[fn], median(mine), median(theirs));
     }
     return 0;
   }
   if (mode == "count" && argc == 7) {
     const int fn = fn_from_name(argv[4]);
-    const bool mine = std::strcmp(argv[5], "dyngen") == 0;
+    const bool mine = std::strcmp(argv[5], "dyngen") == 0, cas = std::strcmp(argv[5], "casadi") == 0;
     const long calls = std::atol(argv[6]);
-    if (fn < 0) return 2;
+    if (fn < 0 || (cas && fn >= N_CASADI)) return 2;
     double sink = 0.0;
     for (long c = 0; c < calls; ++c) {
       const int k = (int)(c % S.count);
-      sink += mine ? dyngen(fn, S.Q(k), S.QD(k), out.data()) : pinocchio(arm, fn, S.Q(k), S.QD(k), nullptr);
+      sink += mine  ? dyngen(fn, S.Q(k), S.QD(k), out.data())
+              : cas ? casadi(fn, S.Q(k), S.QD(k), out.data())
+                    : pinocchio(arm, fn, S.Q(k), S.QD(k), nullptr);
     }
     g_sink = sink;
     return 0;

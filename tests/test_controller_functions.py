@@ -116,3 +116,59 @@ def test_forward_dynamics_derivatives(built):
         worst["central differences of FD"] = max(worst.get("central differences of FD", 0.0), rel_err(D, numeric))
     assert worst["Pinocchio computeABADerivatives"] < TOL and worst["-M^-1 d rnea (Lagrangian M)"] < TOL, worst
     assert worst["central differences of FD"] < 1e-6, worst
+
+
+MANY = 1000  # the issue's count: every C call batched (one C loop), Pinocchio in a python loop
+
+
+def many_states(built, seed, count=MANY):
+    rng = np.random.default_rng(seed)
+    Q, QD, QDD = (np.array(x) for x in zip(*(random_state(built, rng) for _ in range(count))))
+    return Q, QD, QDD
+
+
+def per_state_rel_err(got, want) -> float:
+    """The largest over states of max |got - want| / max(1, max |want|) of that state."""
+    got, want = (np.asarray(x).reshape(len(x), -1) for x in (got, want))
+    return float(np.max(np.max(np.abs(got - want), axis=1) / np.maximum(1.0, np.max(np.abs(want), axis=1))))
+
+
+def test_at_1000_states_against_pinocchio_and_the_identities(built):
+    p = random_parameters(built.robot.dof, seed=21)
+    s, pi = built.c("standard_from_dynamic", p), built.c("pi_full", p)
+    Q, QD, QDD = many_states(built, 20)
+    pin_batch = pin_control.Batch(built.arm, p)
+    batch = built.c.batch
+    tau = batch("rnea", Q, QD, QDD, s)
+    C, Md = batch("coriolis_matrix", Q, QD, s), batch("mass_matrix_derivative", Q, QD, s)
+    skew = Md - 2 * C
+    checks = {
+        "rnea = Pinocchio rnea": (tau, pin_batch.rnea(Q, QD, QDD)),
+        "C = computeCoriolisMatrix": (C, pin_batch.coriolis_matrix(Q, QD)),
+        "M_dot - 2C skew-symmetric": (skew + skew.transpose(0, 2, 1), np.zeros_like(skew)),
+        "C qd + g = rnea(q, qd, 0)": (np.einsum("tij,tj->ti", C, QD) + batch("gravity", Q, s),
+                                      batch("rnea", Q, QD, np.zeros_like(QD), s)),
+        "Y(q, qd, qd, qdd) pi = rnea": (batch("regressor_slotine_li", Q, QD, QD, QDD) @ pi, tau),
+        "forward_dynamics = aba": (batch("forward_dynamics", Q, QD, tau, s), pin_batch.forward_dynamics(Q, QD, tau)),
+        "FD(ID(qdd)) = qdd": (batch("forward_dynamics", Q, QD, tau, s), QDD),
+        "rnea_derivatives = computeRNEADerivatives": (batch("rnea_derivatives", Q, QD, QDD, s),
+                                                     pin_batch.rnea_derivatives(Q, QD, QDD)),
+        "forward_dynamics_derivatives = computeABADerivatives": (batch("forward_dynamics_derivatives", Q, QD, tau, s),
+                                                                 pin_batch.aba_derivatives(Q, QD, tau)),
+    }
+    worst = {name: per_state_rel_err(got, want) for name, (got, want) in checks.items()}
+    assert all(err < TOL for err in worst.values()), worst
+
+
+def test_slotine_li_identity_at_1000_states(built):
+    """Y(q, qd, qr_d, qr_dd) pi = M qr_dd + C qr_d + g, with M, C, g the generated ones (each
+    checked against its oracle elsewhere), at independent reference velocities and accelerations."""
+    p = random_parameters(built.robot.dof, seed=23)
+    s, pi = built.c("standard_from_dynamic", p), built.c("pi_full", p)
+    Q, QD, _ = many_states(built, 22)
+    rng = np.random.default_rng(24)
+    QRD, QRDD = rng.uniform(-2, 2, Q.shape), rng.uniform(-3, 3, Q.shape)
+    batch = built.c.batch
+    want = (np.einsum("tij,tj->ti", batch("mass_matrix", Q, s), QRDD)
+            + np.einsum("tij,tj->ti", batch("coriolis_matrix", Q, QD, s), QRD) + batch("gravity", Q, s))
+    assert per_state_rel_err(batch("regressor_slotine_li", Q, QD, QRD, QRDD) @ pi, want) < TOL

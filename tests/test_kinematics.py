@@ -87,3 +87,24 @@ def test_no_tool_means_the_last_link_frame(lwr):
     q = np.linspace(-1, 1, lwr.robot.dof)
     assert np.array_equal(lwr.c("flange_pose", q), lwr.c("link_poses", q)[-4:])
     assert np.array_equal(lwr.c("jacobian", q), lwr.c("link_jacobians", q)[-6:])
+
+
+def test_at_1000_states_against_pinocchio(built):
+    """The issue's 1000 states: every C call batched (one C loop), Pinocchio (forwardKinematics,
+    computeJointJacobians, the classical acceleration) in a python loop over one model."""
+    rng = np.random.default_rng(11)
+    n = built.robot.dof
+    Q, QD = (np.array(x) for x in zip(*(random_state(built, rng) for _ in range(1000))))
+    model, data = kin.pinocchio_model(built.arm, kin.tool_matrix(built.yaml))
+    pin_side = [kin.pinocchio_kinematics(model, data, n, q, qd) for q, qd in zip(Q, QD)]
+    batch = built.c.batch
+    checks = {"link_poses": (batch("link_poses", Q).reshape(-1, n, 4, 4), [s["poses"][:n] for s in pin_side]),
+              "flange_pose": (batch("flange_pose", Q), [s["poses"][-1] for s in pin_side]),
+              "jacobian": (batch("jacobian", Q), [s["jacobians"][-1] for s in pin_side]),
+              "link_jacobians": (batch("link_jacobians", Q).reshape(-1, n, 6, n), [s["jacobians"][:n] for s in pin_side]),
+              "jacobian_dot_qd": (batch("jacobian_dot_qd", Q, QD), [s["jdot_qd"] for s in pin_side])}
+    worst = {}
+    for name, (got, want) in checks.items():
+        got, want = np.asarray(got).reshape(len(Q), -1), np.asarray(want).reshape(len(Q), -1)
+        worst[name] = float(np.max(np.max(np.abs(got - want), axis=1) / np.maximum(1.0, np.max(np.abs(want), axis=1))))
+    assert all(err < TOL for err in worst.values()), worst

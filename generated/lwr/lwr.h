@@ -42,9 +42,9 @@
  *   lwr_control                  586 mul, 511 add, 0 div, 6 sin/cos
  *   lwr_control_with_jacobian    757 mul, 626 add, 0 div, 7 sin/cos
  *   lwr_coriolis_matrix          1467 mul, 1401 add, 0 div, 6 sin/cos
- *   lwr_mass_matrix_derivative   1473 mul, 1422 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix_derivative   670 mul, 436 add, 0 div, 6 sin/cos
  *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 6 sin/cos
- *   lwr_forward_dynamics         1236 mul, 1038 add, 7 div, 6 sin/cos
+ *   lwr_forward_dynamics         1003 mul, 803 add, 7 div, 6 sin/cos
  *   lwr_rnea_derivatives         2955 mul, 2931 add, 0 div, 6 sin/cos
  *   lwr_forward_dynamics_derivatives 4715 mul, 4463 add, 7 div, 6 sin/cos
  *
@@ -318,7 +318,7 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
  *   qd       [7]  joint velocities
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   Mdot     [7 x 7]  row-major, symmetric (written)
- * 1473 mul, 1422 add, 0 div, 6 sin/cos
+ * 670 mul, 436 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *Mdot);
 
@@ -332,13 +332,13 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
  */
 void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_real *qr_d, const lwr_real *qr_dd, lwr_real *Y);
 
-/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)): the articulated-body algorithm or M = L D L^T, whichever has fewer operations for this arm (the source's section comments say which).
  *   q        [7]  joint positions [rad or m]
  *   qd       [7]  joint velocities
  *   tau      [7]  joint torques/forces
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   qdd      [7]  joint accelerations (written)
- * 1236 mul, 1038 add, 7 div, 6 sin/cos
+ * 1003 mul, 803 add, 7 div, 6 sin/cos
  */
 void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd);
 

@@ -506,7 +506,7 @@ inline Regressor regressor_slotine_li(const Eigen::MatrixBase<A0> &q, const Eige
     return Y;
 }
 
-/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)): the articulated-body algorithm or M = L D L^T, whichever has fewer operations for this arm (the source's section comments say which).
  * lwr_forward_dynamics(q: Joints, qd: Joints, tau: Joints, s: Parameters, qdd: Joints written) */
 template <typename A0, typename A1, typename A2, typename A3, typename Out0>
 inline void forward_dynamics(const Eigen::MatrixBase<A0> &q, const Eigen::MatrixBase<A1> &qd, const Eigen::MatrixBase<A2> &tau, const Eigen::MatrixBase<A3> &s, const Eigen::MatrixBase<Out0> &qdd)

@@ -42,9 +42,9 @@
  *   stanford_control             416 mul, 370 add, 0 div, 4 sin/cos
  *   stanford_control_with_jacobian 566 mul, 485 add, 0 div, 5 sin/cos
  *   stanford_coriolis_matrix     878 mul, 793 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix_derivative 883 mul, 808 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix_derivative 397 mul, 263 add, 0 div, 4 sin/cos
  *   stanford_regressor_slotine_li 456 mul, 290 add, 0 div, 4 sin/cos
- *   stanford_forward_dynamics    804 mul, 693 add, 6 div, 4 sin/cos
+ *   stanford_forward_dynamics    822 mul, 675 add, 6 div, 4 sin/cos
  *   stanford_rnea_derivatives    1795 mul, 1731 add, 0 div, 4 sin/cos
  *   stanford_forward_dynamics_derivatives 2936 mul, 2726 add, 6 div, 4 sin/cos
  *
@@ -318,7 +318,7 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
  *   qd       [6]  joint velocities
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   Mdot     [6 x 6]  row-major, symmetric (written)
- * 883 mul, 808 add, 0 div, 4 sin/cos
+ * 397 mul, 263 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot);
 
@@ -332,13 +332,13 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
  */
 void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *qd, const stanford_real *qr_d, const stanford_real *qr_dd, stanford_real *Y);
 
-/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.
+/* Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)): the articulated-body algorithm or M = L D L^T, whichever has fewer operations for this arm (the source's section comments say which).
  *   q        [6]  joint positions [rad or m]
  *   qd       [6]  joint velocities
  *   tau      [6]  joint torques/forces
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   qdd      [6]  joint accelerations (written)
- * 804 mul, 693 add, 6 div, 4 sin/cos
+ * 822 mul, 675 add, 6 div, 4 sin/cos
  */
 void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd);
 

@@ -4,7 +4,7 @@
  * Conventions, shapes and parameter orders: stanford.h.
  *
  *   stanford_coriolis_matrix     878 mul, 793 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix_derivative 883 mul, 808 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix_derivative 397 mul, 263 add, 0 div, 4 sin/cos
  */
 #include "stanford.h"
 
@@ -682,691 +682,230 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
 /* Time derivative of the inertia matrix M_dot(q, qd) = C + C^T. */
 void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot)
 {
-    /* joint angles */
-    const stanford_real x0 = STANFORD_K(0.5)*qd[0];
-    const stanford_real x1 = STANFORD_K(0.5)*qd[1];
-    const stanford_real x2 = STANFORD_K(0.5)*qd[2];
-    const stanford_real x3 = STANFORD_K(0.5)*qd[3];
-    const stanford_real x4 = STANFORD_K(0.5)*qd[4];
-    const stanford_real x5 = STANFORD_K(0.5)*qd[5];
-    /* link 2: velocities and accelerations */
-    stanford_real s2, c2;
-    STANFORD_SINCOS(q[1], &s2, &c2);
-    const stanford_real x6 = -s2*x0;
-    const stanford_real x7 = c2*x0;
-    const stanford_real x8 = -c2*x1;
-    const stanford_real x9 = -s2*x1;
-    const stanford_real x10 = -2*s2*x6;
-    const stanford_real x11 = c2*x6 - s2*x7;
-    const stanford_real x12 = 2*c2*x7;
-    const stanford_real x13 = -x10 - x12;
-    const stanford_real x14 = 2*x9;
-    const stanford_real x15 = -2*x8;
-    const stanford_real x16 = STANFORD_K(0.154)*x13;
-    /* link 3: velocities and accelerations */
-    const stanford_real x17 = -q[2]*x15 - 2*s2*x2 - x16;
-    const stanford_real x18 = q[2]*x11;
-    const stanford_real x19 = -q[2]*x10;
-    /* link 4: velocities and accelerations */
-    stanford_real s4, c4;
-    STANFORD_SINCOS(q[3], &s4, &c4);
-    const stanford_real x20 = -c4*x1 + s4*x6;
-    const stanford_real x21 = c4*x6 + s4*x1;
-    const stanford_real x22 = -s2*s4;
-    const stanford_real x23 = -c4*s2;
-    const stanford_real x24 = s4*x8;
-    const stanford_real x25 = c4*x8;
-    const stanford_real x26 = c4*x17 + s4*x18;
-    const stanford_real x27 = c4*x18 - s4*x17;
-    const stanford_real x28 = -x3 - x7;
-    const stanford_real x29 = x23*x3 + x24;
-    const stanford_real x30 = -x22*x3 + x25;
-    const stanford_real x31 = 2*x20*x22;
-    const stanford_real x32 = -c2*x20 + x22*x28;
-    const stanford_real x33 = x20*x23 + x21*x22;
-    const stanford_real x34 = -2*c2*x28;
-    const stanford_real x35 = -c2*x21 + x23*x28;
-    const stanford_real x36 = 2*x21*x23;
-    const stanford_real x37 = -x34 - x36;
-    const stanford_real x38 = -x31 - x36;
-    const stanford_real x39 = -x31 - x34;
-    const stanford_real x40 = -x30 + x32;
-    const stanford_real x41 = -x9 + x33;
-    const stanford_real x42 = x30 + x32;
-    const stanford_real x43 = -x29 + x35;
-    const stanford_real x44 = x9 + x33;
-    const stanford_real x45 = x29 + x35;
-    /* link 5: velocities and accelerations */
-    stanford_real s5, c5;
-    STANFORD_SINCOS(q[4], &s5, &c5);
-    const stanford_real x46 = c5*x20 + s5*x28;
-    const stanford_real x47 = -c5*x28 + s5*x20;
-    const stanford_real x48 = -c2*s5 + c5*x22;
-    const stanford_real x49 = c2*c5 + s5*x22;
-    const stanford_real x50 = c5*x29 - s5*x9;
-    const stanford_real x51 = c5*x9 + s5*x29;
-    const stanford_real x52 = c5*x26 - s5*x19;
-    const stanford_real x53 = c5*x19 + s5*x26;
-    const stanford_real x54 = x21 + x4;
-    const stanford_real x55 = -x4*x49 + x50;
-    const stanford_real x56 = x4*x48 + x51;
-    const stanford_real x57 = 2*x46*x48;
-    const stanford_real x58 = x23*x46 + x48*x54;
-    const stanford_real x59 = x46*x49 + x47*x48;
-    const stanford_real x60 = 2*x23*x54;
-    const stanford_real x61 = x23*x47 + x49*x54;
-    const stanford_real x62 = 2*x47*x49;
-    const stanford_real x63 = -x60 - x62;
-    const stanford_real x64 = -x57 - x62;
-    const stanford_real x65 = -x57 - x60;
-    const stanford_real x66 = -x56 + x58;
-    const stanford_real x67 = x30 + x59;
-    const stanford_real x68 = x56 + x58;
-    const stanford_real x69 = -x55 + x61;
-    const stanford_real x70 = -x30 + x59;
-    const stanford_real x71 = x55 + x61;
-    /* link 6: velocities and accelerations */
+    /* link 5: composite body */
     stanford_real s6, c6;
     STANFORD_SINCOS(q[5], &s6, &c6);
-    const stanford_real x72 = c6*x46 + s6*x54;
-    const stanford_real x73 = c6*x54 - s6*x46;
-    const stanford_real x74 = c6*x48 + s6*x23;
-    const stanford_real x75 = c6*x23 - s6*x48;
-    const stanford_real x76 = c6*x55 + s6*x30;
-    const stanford_real x77 = c6*x30 - s6*x55;
-    const stanford_real x78 = c6*x52 + s6*x27;
-    const stanford_real x79 = c6*x27 - s6*x52;
-    const stanford_real x80 = x47 + x5;
-    const stanford_real x81 = x5*x75 + x76;
-    const stanford_real x82 = -x5*x74 + x77;
-    const stanford_real x83 = 2*x72*x74;
-    const stanford_real x84 = x72*x75 + x73*x74;
-    const stanford_real x85 = x49*x72 + x74*x80;
-    const stanford_real x86 = 2*x73*x75;
-    const stanford_real x87 = x49*x73 + x75*x80;
-    const stanford_real x88 = 2*x49*x80;
-    const stanford_real x89 = -x86 - x88;
-    const stanford_real x90 = -x83 - x88;
-    const stanford_real x91 = -x83 - x86;
-    const stanford_real x92 = -x56 + x84;
-    const stanford_real x93 = x82 + x85;
-    const stanford_real x94 = x56 + x84;
-    const stanford_real x95 = -x81 + x87;
-    const stanford_real x96 = -x82 + x85;
-    const stanford_real x97 = x81 + x87;
-    const stanford_real x98 = x78 + STANFORD_K(0.263)*x93;
-    const stanford_real x99 = x79 + STANFORD_K(0.263)*x95;
-    const stanford_real x100 = x53 + STANFORD_K(0.263)*x91;
-    /* link 2: link wrench */
-    const stanford_real x101 = -s[11]*x12 + s[13]*x11;
-    const stanford_real x102 = s[11]*x11 - s[13]*x10;
-    const stanford_real x103 = x8*(s[14] + s[17] - s[19]) + (-s[15]*x11 + 2*s[16]*x9 - s[18]*x12 - s[13]*x16);
-    const stanford_real x104 = s[16]*(-x10 + x12) + x11*(s[14] - s[19]);
-    const stanford_real x105 = x9*(-s[14] + s[17] + s[19]) + (s[15]*x10 + 2*s[16]*x8 + s[18]*x11 + s[11]*x16);
-    /* link 3: link wrench */
-    const stanford_real x106 = s[20]*x17 + s[21]*x13 - s[22]*x14 - s[23]*x15;
-    const stanford_real x107 = s[20]*x18 - s[22]*x12 + s[23]*x11;
-    const stanford_real x108 = s[20]*x19 + s[22]*x11 - s[23]*x10;
-    const stanford_real x109 = s[28]*(x10 - x12) + s[22]*x19 - s[23]*x18 + x11*(-s[27] + s[29]);
-    const stanford_real x110 = x8*(s[24] + s[27] - s[29]) + (s[25]*x11 + s[26]*x12 + 2*s[28]*x9 - s[21]*x19 + s[23]*x17);
-    const stanford_real x111 = x9*(s[24] - s[27] + s[29]) + (-s[25]*x10 - s[26]*x11 + 2*s[28]*x8 + s[21]*x18 - s[22]*x17);
-    /* link 4: link wrench */
-    const stanford_real x112 = s[30]*x26 + s[31]*x37 + s[32]*x40 + s[33]*x41;
-    const stanford_real x113 = -s[30]*x19 + s[31]*x42 + s[32]*x38 + s[33]*x43;
-    const stanford_real x114 = s[30]*x27 + s[31]*x44 + s[32]*x45 + s[33]*x39;
-    const stanford_real x115 = s[35]*(-x9 - x33) + (s[36]*(x30 + x32) + (s[34]*x29 + s[38]*(x34 - x36) + s[32]*x27 + s[33]*x19 + x35*(-s[37] + s[39])));
-    const stanford_real x116 = s[35]*(x29 + x35) + (s[38]*(x30 - x32) + (s[36]*(-x31 + x36) - s[37]*x9 - s[31]*x27 + s[33]*x26 + x33*(s[34] - s[39])));
-    const stanford_real x117 = s[36]*(x29 - x35) + (s[38]*(-x9 + x33) + (s[35]*(x31 - x34) + s[39]*x30 - s[31]*x19 - s[32]*x26 + x32*(-s[34] + s[37])));
-    /* link 5: link wrench */
-    const stanford_real x118 = s[40]*x52 + s[41]*x63 + s[42]*x66 + s[43]*x67;
-    const stanford_real x119 = s[40]*x27 + s[41]*x68 + s[42]*x64 + s[43]*x69;
-    const stanford_real x120 = s[40]*x53 + s[41]*x70 + s[42]*x71 + s[43]*x65;
-    const stanford_real x121 = s[45]*(x30 - x59) + (s[46]*(x56 + x58) + (s[44]*x55 + s[48]*(x60 - x62) + s[42]*x53 - s[43]*x27 + x61*(-s[47] + s[49])));
-    const stanford_real x122 = s[45]*(x55 + x61) + (s[48]*(x56 - x58) + (s[46]*(-x57 + x62) + s[47]*x30 - s[41]*x53 + s[43]*x52 + x59*(s[44] - s[49])));
-    const stanford_real x123 = s[46]*(x55 - x61) + (s[48]*(x30 + x59) + (s[45]*(x57 - x60) + s[49]*x56 + s[41]*x27 - s[42]*x52 + x58*(-s[44] + s[47])));
-    /* link 6: link wrench */
-    const stanford_real x124 = s[50]*x98 + s[51]*x89 + s[52]*x92 + s[53]*x93;
-    const stanford_real x125 = s[50]*x99 + s[51]*x94 + s[52]*x90 + s[53]*x95;
-    const stanford_real x126 = s[50]*x100 + s[51]*x96 + s[52]*x97 + s[53]*x91;
-    const stanford_real x127 = s[55]*(x82 - x85) + (s[56]*(x56 + x84) + (s[54]*x81 + s[58]*(x86 - x88) + s[52]*x100 - s[53]*x99 + x87*(-s[57] + s[59])));
-    const stanford_real x128 = s[55]*(x81 + x87) + (s[58]*(x56 - x84) + (s[56]*(-x83 + x88) + s[57]*x82 - s[51]*x100 + s[53]*x98 + x85*(s[54] - s[59])));
-    const stanford_real x129 = s[56]*(x81 - x87) + (s[58]*(x82 + x85) + (s[55]*(x83 - x86) + s[59]*x56 + s[51]*x99 - s[52]*x98 + x84*(-s[54] + s[57])));
-    /* link 6: forces */
-    const stanford_real x130 = -STANFORD_K(0.263)*x125 + x127;
-    const stanford_real x131 = STANFORD_K(0.263)*x124 + x128;
-    const stanford_real x132 = c6*x124 - s6*x125;
-    const stanford_real x133 = c6*x125 + s6*x124;
-    const stanford_real x134 = c6*x130 - s6*x131;
-    const stanford_real x135 = c6*x131 + s6*x130;
-    /* link 5: forces */
-    const stanford_real x136 = x118 + x132;
-    const stanford_real x137 = x119 + x133;
-    const stanford_real x138 = x120 + x126;
-    const stanford_real x139 = x121 + x134;
-    const stanford_real x140 = x122 + x135;
-    const stanford_real x141 = x123 + x129;
-    const stanford_real x142 = c5*x136 + s5*x138;
-    const stanford_real x143 = -c5*x138 + s5*x136;
-    const stanford_real x144 = c5*x139 + s5*x141;
-    const stanford_real x145 = -c5*x141 + s5*x139;
-    /* link 4: forces */
-    const stanford_real x146 = x112 + x142;
-    const stanford_real x147 = x113 + x143;
-    const stanford_real x148 = x114 + x137;
-    const stanford_real x149 = x115 + x144;
-    const stanford_real x150 = x116 + x145;
-    const stanford_real x151 = x117 + x140;
-    const stanford_real x152 = c4*x146 - s4*x148;
-    const stanford_real x153 = c4*x148 + s4*x146;
-    const stanford_real x154 = c4*x149 - s4*x151;
-    const stanford_real x155 = c4*x151 + s4*x149;
-    /* link 3: forces */
-    const stanford_real x156 = x106 + x152;
-    const stanford_real x157 = x107 + x153;
-    const stanford_real x158 = x108 - x147;
-    const stanford_real x159 = x109 + x154;
-    const stanford_real x160 = x110 + x155;
-    const stanford_real x161 = x111 - x150;
-    const stanford_real x162 = -q[2]*x157 + x159;
-    const stanford_real x163 = q[2]*x156 + x160;
-    /* link 2: forces */
-    const stanford_real x164 = x101 + x157;
-    const stanford_real x165 = x102 + x158;
-    const stanford_real x166 = x103 + x163;
-    const stanford_real x167 = x104 - x162;
-    const stanford_real x168 = x105 + x161;
-    const stanford_real x169 = STANFORD_K(0.154)*x165 + x166;
-    const stanford_real x170 = -STANFORD_K(0.154)*x164 + x168;
-    const stanford_real x171 = -c2*x170 + s2*x169;
-    /* link 2: velocities and accelerations */
-    const stanford_real x172 = 2*x1;
-    const stanford_real x173 = 2*x6;
-    const stanford_real x174 = 2*x7;
-    /* link 3: velocities and accelerations */
-    const stanford_real x175 = -q[2]*x174;
-    const stanford_real x176 = 2*x2;
-    const stanford_real x177 = -q[2]*x172;
-    /* link 4: velocities and accelerations */
-    const stanford_real x178 = -s4*x7;
-    const stanford_real x179 = -c4*x7;
-    const stanford_real x180 = c4*x175 + s4*x176;
-    const stanford_real x181 = c4*x176 - s4*x175;
-    const stanford_real x182 = s4*x3 + x178;
-    const stanford_real x183 = c4*x3 + x179;
-    const stanford_real x184 = -2*c4*x20;
-    const stanford_real x185 = -c4*x28;
-    const stanford_real x186 = -c4*x21 + s4*x20;
-    const stanford_real x187 = s4*x28;
-    const stanford_real x188 = 2*s4*x21;
-    const stanford_real x189 = -x184 - x188;
-    const stanford_real x190 = -x183 + x185;
-    const stanford_real x191 = x186 - x6;
-    const stanford_real x192 = x183 + x185;
-    const stanford_real x193 = -x182 + x187;
-    const stanford_real x194 = x186 + x6;
-    const stanford_real x195 = x182 + x187;
-    /* link 5: velocities and accelerations */
-    const stanford_real x196 = -c4*c5;
-    const stanford_real x197 = -c4*s5;
-    const stanford_real x198 = c5*x182 - s5*x6;
-    const stanford_real x199 = c5*x6 + s5*x182;
-    const stanford_real x200 = c5*x180 - s5*x177;
-    const stanford_real x201 = c5*x177 + s5*x180;
-    const stanford_real x202 = -x197*x4 + x198;
-    const stanford_real x203 = x196*x4 + x199;
-    const stanford_real x204 = 2*x196*x46;
-    const stanford_real x205 = s4*x46 + x196*x54;
-    const stanford_real x206 = x196*x47 + x197*x46;
-    const stanford_real x207 = 2*s4*x54;
-    const stanford_real x208 = s4*x47 + x197*x54;
-    const stanford_real x209 = 2*x197*x47;
-    const stanford_real x210 = -x207 - x209;
-    const stanford_real x211 = -x204 - x209;
-    const stanford_real x212 = -x204 - x207;
-    const stanford_real x213 = -x203 + x205;
-    const stanford_real x214 = x183 + x206;
-    const stanford_real x215 = x203 + x205;
-    const stanford_real x216 = -x202 + x208;
-    const stanford_real x217 = -x183 + x206;
-    const stanford_real x218 = x202 + x208;
-    /* link 6: velocities and accelerations */
-    const stanford_real x219 = c6*x196 + s4*s6;
-    const stanford_real x220 = c6*s4 - s6*x196;
-    const stanford_real x221 = c6*x202 + s6*x183;
-    const stanford_real x222 = c6*x183 - s6*x202;
-    const stanford_real x223 = c6*x200 + s6*x181;
-    const stanford_real x224 = c6*x181 - s6*x200;
-    const stanford_real x225 = x220*x5 + x221;
-    const stanford_real x226 = -x219*x5 + x222;
-    const stanford_real x227 = 2*x219*x72;
-    const stanford_real x228 = x219*x73 + x220*x72;
-    const stanford_real x229 = x197*x72 + x219*x80;
-    const stanford_real x230 = 2*x220*x73;
-    const stanford_real x231 = x197*x73 + x220*x80;
-    const stanford_real x232 = 2*x197*x80;
-    const stanford_real x233 = -x230 - x232;
-    const stanford_real x234 = -x227 - x232;
-    const stanford_real x235 = -x227 - x230;
-    const stanford_real x236 = -x203 + x228;
-    const stanford_real x237 = x226 + x229;
-    const stanford_real x238 = x203 + x228;
-    const stanford_real x239 = -x225 + x231;
-    const stanford_real x240 = -x226 + x229;
-    const stanford_real x241 = x225 + x231;
-    const stanford_real x242 = x223 + STANFORD_K(0.263)*x237;
-    const stanford_real x243 = x224 + STANFORD_K(0.263)*x239;
-    const stanford_real x244 = x201 + STANFORD_K(0.263)*x235;
-    /* link 2: link wrench */
-    const stanford_real x245 = -s[11]*x172;
-    const stanford_real x246 = -s[13]*x172;
-    const stanford_real x247 = x7*(-s[14] - s[17] + s[19]) + (2*s[16]*x6 + s[18]*x172);
-    const stanford_real x248 = x6*(-s[14] + s[17] + s[19]) + (-s[15]*x172 - 2*s[16]*x7);
-    /* link 3: link wrench */
-    const stanford_real x249 = s[20]*x175 - s[22]*x173 - s[23]*x174;
-    const stanford_real x250 = s[20]*x176 - s[22]*x172;
-    const stanford_real x251 = s[20]*x177 - s[23]*x172;
-    const stanford_real x252 = s[22]*x177 - s[23]*x176;
-    const stanford_real x253 = x7*(-s[24] - s[27] + s[29]) + (-s[26]*x172 + 2*s[28]*x6 - s[21]*x177 + s[23]*x175);
-    const stanford_real x254 = x6*(s[24] - s[27] + s[29]) + (s[25]*x172 - 2*s[28]*x7 + s[21]*x176 - s[22]*x175);
-    /* link 4: link wrench */
-    const stanford_real x255 = s[30]*x180 - s[31]*x188 + s[32]*x190 + s[33]*x191;
-    const stanford_real x256 = -s[30]*x177 + s[31]*x192 + s[32]*x189 + s[33]*x193;
-    const stanford_real x257 = s[30]*x181 + s[31]*x194 + s[32]*x195 - s[33]*x184;
-    const stanford_real x258 = s[35]*(-x186 - x6) + (s[36]*(x183 + x185) + (s[34]*x182 - s[38]*x188 + s[32]*x181 + s[33]*x177 + x187*(-s[37] + s[39])));
-    const stanford_real x259 = s[35]*(x182 + x187) + (s[38]*(x183 - x185) + (s[36]*(-x184 + x188) - s[37]*x6 - s[31]*x181 + s[33]*x180 + x186*(s[34] - s[39])));
-    const stanford_real x260 = s[36]*(x182 - x187) + (s[38]*(x186 - x6) + (s[35]*x184 + s[39]*x183 - s[31]*x177 - s[32]*x180 + x185*(-s[34] + s[37])));
-    /* link 5: link wrench */
-    const stanford_real x261 = s[40]*x200 + s[41]*x210 + s[42]*x213 + s[43]*x214;
-    const stanford_real x262 = s[40]*x181 + s[41]*x215 + s[42]*x211 + s[43]*x216;
-    const stanford_real x263 = s[40]*x201 + s[41]*x217 + s[42]*x218 + s[43]*x212;
-    const stanford_real x264 = s[45]*(x183 - x206) + (s[46]*(x203 + x205) + (s[44]*x202 + s[48]*(x207 - x209) + s[42]*x201 - s[43]*x181 + x208*(-s[47] + s[49])));
-    const stanford_real x265 = s[45]*(x202 + x208) + (s[48]*(x203 - x205) + (s[46]*(-x204 + x209) + s[47]*x183 - s[41]*x201 + s[43]*x200 + x206*(s[44] - s[49])));
-    const stanford_real x266 = s[46]*(x202 - x208) + (s[48]*(x183 + x206) + (s[45]*(x204 - x207) + s[49]*x203 + s[41]*x181 - s[42]*x200 + x205*(-s[44] + s[47])));
-    /* link 6: link wrench */
-    const stanford_real x267 = s[50]*x242 + s[51]*x233 + s[52]*x236 + s[53]*x237;
-    const stanford_real x268 = s[50]*x243 + s[51]*x238 + s[52]*x234 + s[53]*x239;
-    const stanford_real x269 = s[50]*x244 + s[51]*x240 + s[52]*x241 + s[53]*x235;
-    const stanford_real x270 = s[55]*(x226 - x229) + (s[56]*(x203 + x228) + (s[54]*x225 + s[58]*(x230 - x232) + s[52]*x244 - s[53]*x243 + x231*(-s[57] + s[59])));
-    const stanford_real x271 = s[55]*(x225 + x231) + (s[58]*(x203 - x228) + (s[56]*(-x227 + x232) + s[57]*x226 - s[51]*x244 + s[53]*x242 + x229*(s[54] - s[59])));
-    const stanford_real x272 = s[56]*(x225 - x231) + (s[58]*(x226 + x229) + (s[55]*(x227 - x230) + s[59]*x203 + s[51]*x243 - s[52]*x242 + x228*(-s[54] + s[57])));
-    /* link 6: forces */
-    const stanford_real x273 = -STANFORD_K(0.263)*x268 + x270;
-    const stanford_real x274 = STANFORD_K(0.263)*x267 + x271;
-    const stanford_real x275 = c6*x267 - s6*x268;
-    const stanford_real x276 = c6*x268 + s6*x267;
-    const stanford_real x277 = c6*x273 - s6*x274;
-    const stanford_real x278 = c6*x274 + s6*x273;
-    /* link 5: forces */
-    const stanford_real x279 = x261 + x275;
-    const stanford_real x280 = x262 + x276;
-    const stanford_real x281 = x263 + x269;
-    const stanford_real x282 = x264 + x277;
-    const stanford_real x283 = x265 + x278;
-    const stanford_real x284 = x266 + x272;
-    const stanford_real x285 = c5*x279 + s5*x281;
-    const stanford_real x286 = -c5*x281 + s5*x279;
-    const stanford_real x287 = c5*x282 + s5*x284;
-    const stanford_real x288 = -c5*x284 + s5*x282;
-    /* link 4: forces */
-    const stanford_real x289 = x255 + x285;
-    const stanford_real x290 = x256 + x286;
-    const stanford_real x291 = x257 + x280;
-    const stanford_real x292 = x258 + x287;
-    const stanford_real x293 = x259 + x288;
-    const stanford_real x294 = x260 + x283;
-    const stanford_real x295 = c4*x289 - s4*x291;
-    const stanford_real x296 = c4*x291 + s4*x289;
-    const stanford_real x297 = c4*x292 - s4*x294;
-    const stanford_real x298 = c4*x294 + s4*x292;
-    /* link 3: forces */
-    const stanford_real x299 = x249 + x295;
-    const stanford_real x300 = x250 + x296;
-    const stanford_real x301 = x251 - x290;
-    const stanford_real x302 = x252 + x297;
-    const stanford_real x303 = x253 + x298;
-    const stanford_real x304 = x254 - x293;
-    const stanford_real x305 = -q[2]*x300 + x302;
-    const stanford_real x306 = q[2]*x299 + x303;
-    /* link 2: forces */
-    const stanford_real x307 = x245 + x300;
-    const stanford_real x308 = x246 + x301;
-    const stanford_real x309 = x247 + x306;
-    const stanford_real x310 = x248 + x304;
-    const stanford_real x311 = STANFORD_K(0.154)*x308 + x309;
-    const stanford_real x312 = -STANFORD_K(0.154)*x307 + x310;
-    const stanford_real x313 = -c2*x312 + s2*x311;
-    /* link 4: velocities and accelerations */
-    const stanford_real x314 = c4*x173 + s4*x172;
-    const stanford_real x315 = c4*x172 - s4*x173;
-    /* link 5: velocities and accelerations */
-    const stanford_real x316 = c5*x314;
-    const stanford_real x317 = s5*x314;
-    /* link 6: velocities and accelerations */
-    const stanford_real x318 = c6*x316 + s6*x315;
-    const stanford_real x319 = c6*x315 - s6*x316;
-    /* link 3: link wrench */
-    const stanford_real x320 = s[20]*x173;
-    const stanford_real x321 = s[20]*x172;
-    const stanford_real x322 = -s[23]*x172;
-    const stanford_real x323 = s[23]*x173;
-    const stanford_real x324 = s[21]*x172 - s[22]*x173;
-    /* link 4: link wrench */
-    const stanford_real x325 = s[30]*x314;
-    const stanford_real x326 = s[30]*x315;
-    const stanford_real x327 = s[32]*x315;
-    const stanford_real x328 = -s[31]*x315 + s[33]*x314;
-    const stanford_real x329 = -s[32]*x314;
-    /* link 5: link wrench */
-    const stanford_real x330 = s[40]*x316;
-    const stanford_real x331 = s[40]*x315;
-    const stanford_real x332 = s[40]*x317;
-    const stanford_real x333 = s[42]*x317 - s[43]*x315;
-    const stanford_real x334 = -s[41]*x317 + s[43]*x316;
-    const stanford_real x335 = s[41]*x315 - s[42]*x316;
-    /* link 6: link wrench */
-    const stanford_real x336 = s[50]*x318;
-    const stanford_real x337 = s[50]*x319;
-    const stanford_real x338 = s[50]*x317;
-    const stanford_real x339 = s[52]*x317 - s[53]*x319;
-    const stanford_real x340 = -s[51]*x317 + s[53]*x318;
-    const stanford_real x341 = s[51]*x319 - s[52]*x318;
-    /* link 6: forces */
-    const stanford_real x342 = -STANFORD_K(0.263)*x337 + x339;
-    const stanford_real x343 = STANFORD_K(0.263)*x336 + x340;
-    const stanford_real x344 = c6*x336 - s6*x337;
-    const stanford_real x345 = c6*x337 + s6*x336;
-    const stanford_real x346 = c6*x342 - s6*x343;
-    const stanford_real x347 = c6*x343 + s6*x342;
-    /* link 5: forces */
-    const stanford_real x348 = x330 + x344;
-    const stanford_real x349 = x331 + x345;
-    const stanford_real x350 = x332 + x338;
-    const stanford_real x351 = x333 + x346;
-    const stanford_real x352 = x334 + x347;
-    const stanford_real x353 = x335 + x341;
-    const stanford_real x354 = c5*x348 + s5*x350;
-    const stanford_real x355 = -c5*x350 + s5*x348;
-    const stanford_real x356 = c5*x351 + s5*x353;
-    const stanford_real x357 = -c5*x353 + s5*x351;
-    /* link 4: forces */
-    const stanford_real x358 = x325 + x354;
-    const stanford_real x359 = x326 + x349;
-    const stanford_real x360 = x327 + x356;
-    const stanford_real x361 = x328 + x357;
-    const stanford_real x362 = x329 + x352;
-    const stanford_real x363 = c4*x358 - s4*x359;
-    const stanford_real x364 = c4*x359 + s4*x358;
-    const stanford_real x365 = c4*x360 - s4*x362;
-    const stanford_real x366 = c4*x362 + s4*x360;
-    /* link 3: forces */
-    const stanford_real x367 = x320 + x363;
-    const stanford_real x368 = x321 + x364;
-    const stanford_real x369 = x322 + x365;
-    const stanford_real x370 = x323 + x366;
-    const stanford_real x371 = x324 - x361;
-    const stanford_real x372 = -q[2]*x368 + x369;
-    const stanford_real x373 = q[2]*x367 + x370;
-    /* link 2: forces */
-    const stanford_real x374 = -STANFORD_K(0.154)*x355 + x373;
-    const stanford_real x375 = -STANFORD_K(0.154)*x368 + x371;
-    const stanford_real x376 = -c2*x375 + s2*x374;
-    /* link 4: velocities and accelerations */
-    const stanford_real x377 = -2*x28;
-    const stanford_real x378 = -2*x20;
-    const stanford_real x379 = -2*x21;
-    /* link 5: velocities and accelerations */
-    const stanford_real x380 = c5*x21;
-    const stanford_real x381 = s5*x21;
-    const stanford_real x382 = -c5*x4 + x380;
-    const stanford_real x383 = -s5*x4 + x381;
-    const stanford_real x384 = -2*s5*x46;
-    const stanford_real x385 = -s5*x54;
-    const stanford_real x386 = c5*x46 - s5*x47;
-    const stanford_real x387 = c5*x54;
-    const stanford_real x388 = 2*c5*x47;
-    const stanford_real x389 = -x384 - x388;
-    const stanford_real x390 = -x383 + x385;
-    const stanford_real x391 = -x20 + x386;
-    const stanford_real x392 = x383 + x385;
-    const stanford_real x393 = -x382 + x387;
-    const stanford_real x394 = x20 + x386;
-    const stanford_real x395 = x382 + x387;
-    /* link 6: velocities and accelerations */
-    const stanford_real x396 = -c6*s5;
-    const stanford_real x397 = s5*s6;
-    const stanford_real x398 = c6*x382 - s6*x20;
-    const stanford_real x399 = -c6*x20 - s6*x382;
-    const stanford_real x400 = x397*x5 + x398;
-    const stanford_real x401 = -x396*x5 + x399;
-    const stanford_real x402 = 2*x396*x72;
-    const stanford_real x403 = x396*x73 + x397*x72;
-    const stanford_real x404 = c5*x72 + x396*x80;
-    const stanford_real x405 = 2*x397*x73;
-    const stanford_real x406 = c5*x73 + x397*x80;
-    const stanford_real x407 = 2*c5*x80;
-    const stanford_real x408 = -x405 - x407;
-    const stanford_real x409 = -x402 - x407;
-    const stanford_real x410 = -x402 - x405;
-    const stanford_real x411 = -x383 + x403;
-    const stanford_real x412 = x401 + x404;
-    const stanford_real x413 = x383 + x403;
-    const stanford_real x414 = -x400 + x406;
-    const stanford_real x415 = -x401 + x404;
-    const stanford_real x416 = x400 + x406;
-    const stanford_real x417 = STANFORD_K(0.263)*x412;
-    const stanford_real x418 = STANFORD_K(0.263)*x414;
-    const stanford_real x419 = STANFORD_K(0.263)*x410;
-    /* link 4: link wrench */
-    const stanford_real x420 = -s[31]*x377;
-    const stanford_real x421 = s[31]*x378 + s[33]*x379;
-    const stanford_real x422 = -s[33]*x377;
-    const stanford_real x423 = x21*(s[34] + s[37] - s[39]) + (-2*s[36]*x20 + s[38]*x377);
-    const stanford_real x424 = x20*(s[34] - s[37] - s[39]) + (-s[35]*x377 + 2*s[36]*x21);
-    /* link 5: link wrench */
-    const stanford_real x425 = -s[41]*x388 + s[42]*x390 + s[43]*x391;
-    const stanford_real x426 = s[41]*x392 + s[42]*x389 + s[43]*x393;
-    const stanford_real x427 = s[41]*x394 + s[42]*x395 - s[43]*x384;
-    const stanford_real x428 = s[45]*(-x20 - x386) + (s[46]*(x383 + x385) + (s[44]*x382 - s[48]*x388 + x387*(-s[47] + s[49])));
-    const stanford_real x429 = s[45]*(x382 + x387) + (s[48]*(x383 - x385) + (s[46]*(-x384 + x388) - s[47]*x20 + x386*(s[44] - s[49])));
-    const stanford_real x430 = s[46]*(x382 - x387) + (s[48]*(-x20 + x386) + (s[45]*x384 + s[49]*x383 + x385*(-s[44] + s[47])));
-    /* link 6: link wrench */
-    const stanford_real x431 = s[50]*x417 + s[51]*x408 + s[52]*x411 + s[53]*x412;
-    const stanford_real x432 = s[50]*x418 + s[51]*x413 + s[52]*x409 + s[53]*x414;
-    const stanford_real x433 = s[50]*x419 + s[51]*x415 + s[52]*x416 + s[53]*x410;
-    const stanford_real x434 = s[55]*(x401 - x404) + (s[56]*(x383 + x403) + (s[54]*x400 + s[58]*(x405 - x407) + s[52]*x419 - s[53]*x418 + x406*(-s[57] + s[59])));
-    const stanford_real x435 = s[55]*(x400 + x406) + (s[58]*(x383 - x403) + (s[56]*(-x402 + x407) + s[57]*x401 - s[51]*x419 + s[53]*x417 + x404*(s[54] - s[59])));
-    const stanford_real x436 = s[56]*(x400 - x406) + (s[58]*(x401 + x404) + (s[55]*(x402 - x405) + s[59]*x383 + s[51]*x418 - s[52]*x417 + x403*(-s[54] + s[57])));
-    /* link 6: forces */
-    const stanford_real x437 = -STANFORD_K(0.263)*x432 + x434;
-    const stanford_real x438 = STANFORD_K(0.263)*x431 + x435;
-    const stanford_real x439 = c6*x431 - s6*x432;
-    const stanford_real x440 = c6*x432 + s6*x431;
-    const stanford_real x441 = c6*x437 - s6*x438;
-    const stanford_real x442 = c6*x438 + s6*x437;
-    /* link 5: forces */
-    const stanford_real x443 = x425 + x439;
-    const stanford_real x444 = x426 + x440;
-    const stanford_real x445 = x427 + x433;
-    const stanford_real x446 = x428 + x441;
-    const stanford_real x447 = x429 + x442;
-    const stanford_real x448 = x430 + x436;
-    const stanford_real x449 = c5*x443 + s5*x445;
-    const stanford_real x450 = -c5*x445 + s5*x443;
-    const stanford_real x451 = c5*x446 + s5*x448;
-    const stanford_real x452 = -c5*x448 + s5*x446;
-    /* link 4: forces */
-    const stanford_real x453 = x420 + x449;
-    const stanford_real x454 = x421 + x450;
-    const stanford_real x455 = x422 + x444;
-    const stanford_real x456 = x423 + x451;
-    const stanford_real x457 = x424 + x447;
-    const stanford_real x458 = c4*x453 - s4*x455;
-    const stanford_real x459 = c4*x455 + s4*x453;
-    const stanford_real x460 = c4*x456 - s4*x457;
-    const stanford_real x461 = c4*x457 + s4*x456;
-    /* link 3: forces */
-    const stanford_real x462 = -q[2]*x459 + x460;
-    const stanford_real x463 = q[2]*x458 + x461;
-    /* link 2: forces */
-    const stanford_real x464 = -STANFORD_K(0.154)*x454 + x463;
-    const stanford_real x465 = -x452 - STANFORD_K(0.154)*x459;
-    const stanford_real x466 = -c2*x465 + s2*x464;
-    /* link 5: velocities and accelerations */
-    const stanford_real x467 = 2*x54;
-    const stanford_real x468 = 2*x46;
-    const stanford_real x469 = 2*x47;
-    /* link 6: velocities and accelerations */
-    const stanford_real x470 = -c6*x47;
-    const stanford_real x471 = s6*x47;
-    const stanford_real x472 = c6*x5 + x470;
-    const stanford_real x473 = -s6*x5 + x471;
-    const stanford_real x474 = 2*s6*x72;
-    const stanford_real x475 = c6*x72 + s6*x73;
-    const stanford_real x476 = s6*x80;
-    const stanford_real x477 = 2*c6*x73;
-    const stanford_real x478 = c6*x80;
-    const stanford_real x479 = -x474 - x477;
-    const stanford_real x480 = -x46 + x475;
-    const stanford_real x481 = x473 + x476;
-    const stanford_real x482 = x46 + x475;
-    const stanford_real x483 = -x472 + x478;
-    const stanford_real x484 = -x473 + x476;
-    const stanford_real x485 = x472 + x478;
-    const stanford_real x486 = STANFORD_K(0.263)*x481;
-    const stanford_real x487 = STANFORD_K(0.263)*x483;
-    const stanford_real x488 = STANFORD_K(0.263)*x479;
-    /* link 5: link wrench */
-    const stanford_real x489 = -s[41]*x467;
-    const stanford_real x490 = s[41]*x468 + s[43]*x469;
-    const stanford_real x491 = -s[43]*x467;
-    const stanford_real x492 = x47*(-s[44] - s[47] + s[49]) + (2*s[46]*x46 + s[48]*x467);
-    const stanford_real x493 = x46*(-s[44] + s[47] + s[49]) + (-s[45]*x467 - 2*s[46]*x47);
-    /* link 6: link wrench */
-    const stanford_real x494 = s[50]*x486 - s[51]*x477 + s[52]*x480 + s[53]*x481;
-    const stanford_real x495 = s[50]*x487 + s[51]*x482 - s[52]*x474 + s[53]*x483;
-    const stanford_real x496 = s[50]*x488 + s[51]*x484 + s[52]*x485 + s[53]*x479;
-    const stanford_real x497 = s[55]*(x473 - x476) + (s[56]*(x46 + x475) + (s[54]*x472 + s[58]*x477 + s[52]*x488 - s[53]*x487 + x478*(-s[57] + s[59])));
-    const stanford_real x498 = s[55]*(x472 + x478) + (s[58]*(x46 - x475) + (-s[56]*x474 + s[57]*x473 - s[51]*x488 + s[53]*x486 + x476*(s[54] - s[59])));
-    const stanford_real x499 = s[56]*(x472 - x478) + (s[58]*(x473 + x476) + (s[55]*(x474 - x477) + s[59]*x46 + s[51]*x487 - s[52]*x486 + x475*(-s[54] + s[57])));
-    /* link 6: forces */
-    const stanford_real x500 = -STANFORD_K(0.263)*x495 + x497;
-    const stanford_real x501 = STANFORD_K(0.263)*x494 + x498;
-    const stanford_real x502 = c6*x494 - s6*x495;
-    const stanford_real x503 = c6*x495 + s6*x494;
-    const stanford_real x504 = c6*x500 - s6*x501;
-    const stanford_real x505 = c6*x501 + s6*x500;
-    /* link 5: forces */
-    const stanford_real x506 = x489 + x502;
-    const stanford_real x507 = x490 + x503;
-    const stanford_real x508 = x491 + x496;
-    const stanford_real x509 = x492 + x504;
-    const stanford_real x510 = x493 + x499;
-    const stanford_real x511 = c5*x506 + s5*x508;
-    const stanford_real x512 = -c5*x508 + s5*x506;
-    const stanford_real x513 = c5*x509 + s5*x510;
-    const stanford_real x514 = -c5*x510 + s5*x509;
-    /* link 4: forces */
-    const stanford_real x515 = c4*x511 - s4*x507;
-    const stanford_real x516 = c4*x507 + s4*x511;
-    const stanford_real x517 = c4*x513 - s4*x505;
-    const stanford_real x518 = c4*x505 + s4*x513;
-    /* link 3: forces */
-    const stanford_real x519 = -q[2]*x516 + x517;
-    const stanford_real x520 = q[2]*x515 + x518;
-    /* link 2: forces */
-    const stanford_real x521 = -STANFORD_K(0.154)*x512 + x520;
-    const stanford_real x522 = -x514 - STANFORD_K(0.154)*x516;
-    const stanford_real x523 = -c2*x522 + s2*x521;
-    /* link 6: velocities and accelerations */
-    const stanford_real x524 = 2*x80;
-    const stanford_real x525 = 2*x72;
-    const stanford_real x526 = 2*x73;
-    /* link 6: link wrench */
-    const stanford_real x527 = -s[51]*x524;
-    const stanford_real x528 = -s[52]*x524;
-    const stanford_real x529 = s[51]*x525 + s[52]*x526;
-    const stanford_real x530 = x73*(s[54] - s[57] + s[59]) + (-2*s[55]*x72 - s[58]*x524);
-    const stanford_real x531 = x72*(s[54] - s[57] - s[59]) + (2*s[55]*x73 + s[56]*x524);
-    /* link 6: forces */
-    const stanford_real x532 = -STANFORD_K(0.263)*x528 + x530;
-    const stanford_real x533 = STANFORD_K(0.263)*x527 + x531;
-    const stanford_real x534 = c6*x527 - s6*x528;
-    const stanford_real x535 = c6*x528 + s6*x527;
-    const stanford_real x536 = c6*x532 - s6*x533;
-    const stanford_real x537 = c6*x533 + s6*x532;
-    /* link 5: forces */
-    const stanford_real x538 = c5*x534 + s5*x529;
-    const stanford_real x539 = -c5*x529 + s5*x534;
-    const stanford_real x540 = c5*x536;
-    const stanford_real x541 = s5*x536;
-    /* link 4: forces */
-    const stanford_real x542 = c4*x538 - s4*x535;
-    const stanford_real x543 = c4*x535 + s4*x538;
-    const stanford_real x544 = c4*x540 - s4*x537;
-    const stanford_real x545 = c4*x537 + s4*x540;
-    /* link 3: forces */
-    const stanford_real x546 = -q[2]*x543 + x544;
-    const stanford_real x547 = q[2]*x542 + x545;
-    /* link 2: forces */
-    const stanford_real x548 = -STANFORD_K(0.154)*x539 + x547;
-    const stanford_real x549 = -x541 - STANFORD_K(0.154)*x543;
-    const stanford_real x550 = -c2*x549 + s2*x548;
-    /* M_dot = C + C^T */
-    const stanford_real x551 = -2*x171;
-    const stanford_real x552 = x167 - x313;
-    const stanford_real x553 = x158 - x376;
-    const stanford_real x554 = -x150 - x466;
-    const stanford_real x555 = x140 - x523;
-    const stanford_real x556 = x129 - x550;
-    const stanford_real x557 = -2*x305;
-    const stanford_real x558 = x301 - x372;
-    const stanford_real x559 = -x293 - x462;
-    const stanford_real x560 = x283 - x519;
-    const stanford_real x561 = x272 - x546;
-    const stanford_real x562 = -2*x355;
-    const stanford_real x563 = -x361 - x454;
-    const stanford_real x564 = x352 - x512;
-    const stanford_real x565 = x341 - x539;
-    const stanford_real x566 = -2*x452;
-    const stanford_real x567 = x447 - x514;
-    const stanford_real x568 = x436 - x541;
-    const stanford_real x569 = 2*x505;
-    const stanford_real x570 = x499 + x537;
+    const stanford_real x0 = c6*s[51] - s[52]*s6;
+    const stanford_real x1 = c6*s[52] + s[51]*s6;
+    const stanford_real x2 = s[40] + s[50];
+    const stanford_real x3 = s[41] + x0;
+    const stanford_real x4 = s[42] + x1;
+    const stanford_real x5 = STANFORD_K(0.263)*s[50] + s[43] + s[53];
+    const stanford_real x6 = s[44] + c6*(s[54]*c6 - s[55]*s6) + STANFORD_K(0.069169)*s[50] + STANFORD_K(0.526)*s[53] - s6*(s[55]*c6 - s[57]*s6);
+    const stanford_real x7 = s[45] + c6*(s[55]*c6 - s[57]*s6) + s6*(s[54]*c6 - s[55]*s6);
+    const stanford_real x8 = s[46] + s[56]*c6 - s[58]*s6 - STANFORD_K(0.263)*x0;
+    const stanford_real x9 = s[47] + c6*(s[55]*s6 + s[57]*c6) + STANFORD_K(0.069169)*s[50] + STANFORD_K(0.526)*s[53] + s6*(s[54]*s6 + s[55]*c6);
+    const stanford_real x10 = s[56]*s6 + s[48] + s[58]*c6 - STANFORD_K(0.263)*x1;
+    const stanford_real x11 = s[49] + s[59];
+    /* link 4: composite body */
+    stanford_real s5, c5;
+    STANFORD_SINCOS(q[4], &s5, &c5);
+    const stanford_real x12 = c5*x3 + s5*x5;
+    const stanford_real x13 = -c5*x5 + s5*x3;
+    const stanford_real x14 = s[30] + x2;
+    const stanford_real x15 = s[31] + x12;
+    const stanford_real x16 = s[32] + x13;
+    const stanford_real x17 = s[33] + x4;
+    const stanford_real x18 = s[34] + c5*(c5*x6 + s5*x8) + s5*(c5*x8 + s5*x11);
+    const stanford_real x19 = s[35] - c5*(c5*x8 + s5*x11) + s5*(c5*x6 + s5*x8);
+    const stanford_real x20 = s[36] + c5*x7 + s5*x10;
+    const stanford_real x21 = s[37] - c5*(-c5*x11 + s5*x8) + s5*(-c5*x8 + s5*x6);
+    const stanford_real x22 = s[38] - c5*x10 + s5*x7;
+    const stanford_real x23 = s[39] + x9;
+    /* link 3: composite body */
+    stanford_real s4, c4;
+    STANFORD_SINCOS(q[3], &s4, &c4);
+    const stanford_real x24 = c4*x15 - s4*x17;
+    const stanford_real x25 = c4*x17 + s4*x15;
+    const stanford_real x26 = s[20] + x14;
+    const stanford_real x27 = s[21] + x24;
+    const stanford_real x28 = s[22] + x25;
+    const stanford_real x29 = s[23] - x16;
+    const stanford_real x30 = s[25] + c4*(c4*x20 - s4*x23) + s4*(c4*x18 - s4*x20);
+    const stanford_real x31 = s[26] - c4*x19 + s4*x22;
+    const stanford_real x32 = s[27] + c4*(c4*x23 + s4*x20) + s4*(c4*x20 + s4*x18);
+    const stanford_real x33 = s[28] - c4*x22 - s4*x19;
+    const stanford_real x34 = s[29] + x21;
+    /* link 2: composite body */
+    const stanford_real x35 = s[11] + x28;
+    const stanford_real x36 = s[13] + q[2]*x26 + x29;
+    const stanford_real x37 = s[14] + q[2]*q[2]*x26 + 2*q[2]*x29 + x32;
+    const stanford_real x38 = s[15] - x30;
+    const stanford_real x39 = s[16] - q[2]*x28 + x33;
+    const stanford_real x40 = s[18] + q[2]*x27 - x31;
+    const stanford_real x41 = s[19] + x34;
+    /* column 2: composite wrench */
+    const stanford_real x42 = -STANFORD_K(0.154)*x35 + x38;
+    const stanford_real x43 = -STANFORD_K(0.154)*x36 + x40;
+    /* column 3: to joint 2 */
+    const stanford_real x44 = STANFORD_K(0.154)*x26 - x27;
+    /* column 4: to joint 3 */
+    const stanford_real x45 = -c4*x22 - s4*x19;
+    /* column 4: to joint 2 */
+    const stanford_real x46 = -q[2]*x25 + x45;
+    const stanford_real x47 = x21 - STANFORD_K(0.154)*x24;
+    /* column 5: to joint 4 */
+    const stanford_real x48 = c5*x7 + s5*x10;
+    const stanford_real x49 = -c5*x10 + s5*x7;
+    /* column 5: to joint 3 */
+    const stanford_real x50 = -c4*x13;
+    const stanford_real x51 = -s4*x13;
+    const stanford_real x52 = c4*x9 + s4*x48;
+    /* column 5: to joint 2 */
+    const stanford_real x53 = q[2]*x50 + x52;
+    const stanford_real x54 = -STANFORD_K(0.154)*x12 + x53;
+    const stanford_real x55 = -x49 - STANFORD_K(0.154)*x51;
+    /* column 6: composite wrench */
+    const stanford_real x56 = s[56] - STANFORD_K(0.263)*s[51];
+    const stanford_real x57 = s[58] - STANFORD_K(0.263)*s[52];
+    /* column 6: to joint 5 */
+    const stanford_real x58 = c6*x56 - s6*x57;
+    const stanford_real x59 = c6*x57 + s6*x56;
+    /* column 6: to joint 4 */
+    const stanford_real x60 = -c5*x1;
+    const stanford_real x61 = -s5*x1;
+    const stanford_real x62 = s[59]*s5 + c5*x58;
+    const stanford_real x63 = -s[59]*c5 + s5*x58;
+    /* column 6: to joint 3 */
+    const stanford_real x64 = c4*x60 - s4*x0;
+    const stanford_real x65 = c4*x0 + s4*x60;
+    const stanford_real x66 = c4*x59 + s4*x62;
+    /* column 6: to joint 2 */
+    const stanford_real x67 = q[2]*x64 + x66;
+    const stanford_real x68 = -STANFORD_K(0.154)*x61 + x67;
+    const stanford_real x69 = -x63 - STANFORD_K(0.154)*x65;
+    /* M_dot = dM/dq qd */
+    const stanford_real x70 = qd[5]*(-c6*s[52] - s[51]*s6);
+    const stanford_real x71 = qd[5]*(c6*s[51] - s[52]*s6);
+    const stanford_real x72 = 2*(s[54]*c6 - s[55]*s6);
+    const stanford_real x73 = 2*(-s[55]*c6 + s[57]*s6);
+    const stanford_real x74 = qd[5]*(c6*x73 - s6*x72);
+    const stanford_real x75 = 2*s[55]*c6 + s6*(s[54] - s[57]);
+    const stanford_real x76 = -2*s[55]*s6 + c6*(s[54] - s[57]);
+    const stanford_real x77 = qd[5]*(c6*x76 - s6*x75);
+    const stanford_real x78 = qd[5]*(-s[56]*s6 - s[58]*c6) - STANFORD_K(0.263)*x70;
+    const stanford_real x79 = 2*(s[55]*s6 + s[57]*c6);
+    const stanford_real x80 = 2*(s[54]*s6 + s[55]*c6);
+    const stanford_real x81 = qd[5]*(c6*x80 - s6*x79);
+    const stanford_real x82 = qd[5]*(s[56]*c6 - s[58]*s6) - STANFORD_K(0.263)*x71;
+    const stanford_real x83 = c5*(qd[4]*x5 + x70) - qd[4]*s5*x3;
+    const stanford_real x84 = qd[4]*(c5*x3 + s5*x5) + s5*x70;
+    const stanford_real x85 = 2*(c5*x6 + s5*x8);
+    const stanford_real x86 = 2*(c5*x8 + s5*x11);
+    const stanford_real x87 = c5*c5;
+    const stanford_real x88 = 2*c5*s5;
+    const stanford_real x89 = qd[4]*(c5*x86 - s5*x85) + (x74*x87 + x78*x88);
+    const stanford_real x90 = -2*c5*x8 + s5*(-x11 + x6);
+    const stanford_real x91 = c5*(-x11 + x6) + 2*s5*x8;
+    const stanford_real x92 = c5*s5;
+    const stanford_real x93 = -c5*c5 + s5*s5;
+    const stanford_real x94 = qd[4]*(c5*x91 - s5*x90) + (x74*x92 + x78*x93);
+    const stanford_real x95 = c5*(qd[4]*x10 + x77) + s5*(-qd[4]*x7 + x82);
+    const stanford_real x96 = 2*(c5*x11 - s5*x8);
+    const stanford_real x97 = 2*(-c5*x8 + s5*x6);
+    const stanford_real x98 = s5*s5;
+    const stanford_real x99 = qd[4]*(c5*x97 - s5*x96) + (x74*x98 - x78*x88);
+    const stanford_real x100 = c5*(qd[4]*x7 - x82) + s5*(qd[4]*x10 + x77);
+    const stanford_real x101 = c4*(-qd[3]*x17 + x83) + s4*(-qd[3]*x15 - x71);
+    const stanford_real x102 = c4*(qd[3]*x15 + x71) + s4*(-qd[3]*x17 + x83);
+    const stanford_real x103 = 2*(c4*x18 - s4*x20);
+    const stanford_real x104 = 2*(-c4*x20 + s4*x23);
+    const stanford_real x105 = c4*c4;
+    const stanford_real x106 = -2*c4*s4;
+    const stanford_real x107 = s4*s4;
+    const stanford_real x108 = qd[3]*(c4*x104 - s4*x103) + (x81*x107 + x89*x105 + x95*x106);
+    const stanford_real x109 = 2*c4*x20 + s4*(x18 - x23);
+    const stanford_real x110 = c4*(x18 - x23) - 2*s4*x20;
+    const stanford_real x111 = c4*s4;
+    const stanford_real x112 = c4*c4 - s4*s4;
+    const stanford_real x113 = qd[3]*(c4*x110 - s4*x109) + (x95*x112 + x111*(-x81 + x89));
+    const stanford_real x114 = c4*(qd[3]*x22 - x94) + s4*(qd[3]*x19 + x100);
+    const stanford_real x115 = 2*(c4*x23 + s4*x20);
+    const stanford_real x116 = 2*(c4*x20 + s4*x18);
+    const stanford_real x117 = qd[3]*(c4*x116 - s4*x115) + (x81*x105 + x89*x107 - x95*x106);
+    const stanford_real x118 = c4*(-qd[3]*x19 - x100) + s4*(qd[3]*x22 - x94);
+    const stanford_real x119 = qd[2]*x26 - x84;
+    const stanford_real x120 = 2*(q[2]*x26 + x29);
+    const stanford_real x121 = 2*q[2];
+    const stanford_real x122 = qd[2]*x120 - x84*x121 + x117;
+    const stanford_real x123 = -q[2]*x102 - qd[2]*x28 + x118;
+    const stanford_real x124 = qd[2]*x120 - x84*x121 + x108;
+    const stanford_real x125 = q[2]*x101 + qd[2]*x27 - x114;
+    stanford_real s2, c2;
+    STANFORD_SINCOS(q[1], &s2, &c2);
+    const stanford_real x126 = 2*(c2*x41 - s2*x39);
+    const stanford_real x127 = 2*(-c2*x39 + s2*x37);
+    const stanford_real x128 = s2*s2;
+    const stanford_real x129 = -2*c2*s2;
+    const stanford_real x130 = c2*c2;
+    const stanford_real x131 = qd[1]*(c2*x127 - s2*x126) + (x99*x130 - STANFORD_K(0.308)*x101 + x122*x128 + x123*x129);
+    const stanford_real x132 = -STANFORD_K(0.154)*x102 - x113;
+    const stanford_real x133 = -STANFORD_K(0.154)*x119 + x125;
+    const stanford_real x134 = c2*(qd[1]*x42 - x133) + s2*(qd[1]*x43 + x132);
+    const stanford_real x135 = c2*qd[1]*x44 - s2*x101;
+    const stanford_real x136 = -q[2]*x101 - qd[2]*x24 + x114;
+    const stanford_real x137 = -q[2]*x102 - qd[2]*x25 + x118;
+    const stanford_real x138 = x99 - STANFORD_K(0.154)*x101;
+    const stanford_real x139 = c2*(qd[1]*x46 - x138) + s2*(qd[1]*x47 + x137);
+    const stanford_real x140 = -c4*x84 + qd[3]*s4*x13;
+    const stanford_real x141 = -c4*qd[3]*x13 - s4*x84;
+    const stanford_real x142 = c4*(-qd[3]*x9 + x95) + s4*(-qd[3]*x48 - x81);
+    const stanford_real x143 = c4*(qd[3]*x48 + x81) + s4*(-qd[3]*x9 + x95);
+    const stanford_real x144 = -q[2]*x141 - qd[2]*x51 + x142;
+    const stanford_real x145 = q[2]*x140 + qd[2]*x50 + x143;
+    const stanford_real x146 = -STANFORD_K(0.154)*x83 + x145;
+    const stanford_real x147 = -x100 - STANFORD_K(0.154)*x141;
+    const stanford_real x148 = c2*(qd[1]*x54 - x147) + s2*(qd[1]*x55 + x146);
+    const stanford_real x149 = qd[5]*(-c6*x57 - s6*x56);
+    const stanford_real x150 = qd[5]*(c6*x56 - s6*x57);
+    const stanford_real x151 = -c5*x71 + qd[4]*s5*x1;
+    const stanford_real x152 = -c5*qd[4]*x1 - s5*x71;
+    const stanford_real x153 = c5*(s[59]*qd[4] + x149) - qd[4]*s5*x58;
+    const stanford_real x154 = qd[4]*(s[59]*s5 + c5*x58) + s5*x149;
+    const stanford_real x155 = c4*(-qd[3]*x0 + x151) + s4*(-qd[3]*x60 - x70);
+    const stanford_real x156 = c4*(qd[3]*x60 + x70) + s4*(-qd[3]*x0 + x151);
+    const stanford_real x157 = c4*(-qd[3]*x59 + x153) + s4*(-qd[3]*x62 - x150);
+    const stanford_real x158 = c4*(qd[3]*x62 + x150) + s4*(-qd[3]*x59 + x153);
+    const stanford_real x159 = -q[2]*x156 - qd[2]*x65 + x157;
+    const stanford_real x160 = q[2]*x155 + qd[2]*x64 + x158;
+    const stanford_real x161 = -STANFORD_K(0.154)*x152 + x160;
+    const stanford_real x162 = -x154 - STANFORD_K(0.154)*x156;
+    const stanford_real x163 = c2*(qd[1]*x68 - x162) + s2*(qd[1]*x69 + x161);
     /* Mdot */
-    Mdot[0] = x551;
-    Mdot[1] = x552;
-    Mdot[2] = x553;
-    Mdot[3] = x554;
-    Mdot[4] = x555;
-    Mdot[5] = x556;
-    Mdot[6] = x552;
-    Mdot[7] = x557;
-    Mdot[8] = x558;
-    Mdot[9] = x559;
-    Mdot[10] = x560;
-    Mdot[11] = x561;
-    Mdot[12] = x553;
-    Mdot[13] = x558;
-    Mdot[14] = x562;
-    Mdot[15] = x563;
-    Mdot[16] = x564;
-    Mdot[17] = x565;
-    Mdot[18] = x554;
-    Mdot[19] = x559;
-    Mdot[20] = x563;
-    Mdot[21] = x566;
-    Mdot[22] = x567;
-    Mdot[23] = x568;
-    Mdot[24] = x555;
-    Mdot[25] = x560;
-    Mdot[26] = x564;
-    Mdot[27] = x567;
-    Mdot[28] = x569;
-    Mdot[29] = x570;
-    Mdot[30] = x556;
-    Mdot[31] = x561;
-    Mdot[32] = x565;
-    Mdot[33] = x568;
-    Mdot[34] = x570;
+    Mdot[0] = x131;
+    Mdot[1] = -x134;
+    Mdot[2] = -x135;
+    Mdot[3] = -x139;
+    Mdot[4] = -x148;
+    Mdot[5] = -x163;
+    Mdot[6] = -x134;
+    Mdot[7] = x124;
+    Mdot[8] = -x102;
+    Mdot[9] = -x136;
+    Mdot[10] = -x144;
+    Mdot[11] = -x159;
+    Mdot[12] = -x135;
+    Mdot[13] = -x102;
+    Mdot[14] = 0;
+    Mdot[15] = 0;
+    Mdot[16] = -x83;
+    Mdot[17] = -x152;
+    Mdot[18] = -x139;
+    Mdot[19] = -x136;
+    Mdot[20] = 0;
+    Mdot[21] = x99;
+    Mdot[22] = -x100;
+    Mdot[23] = -x154;
+    Mdot[24] = -x148;
+    Mdot[25] = -x144;
+    Mdot[26] = -x83;
+    Mdot[27] = -x100;
+    Mdot[28] = x81;
+    Mdot[29] = x150;
+    Mdot[30] = -x163;
+    Mdot[31] = -x159;
+    Mdot[32] = -x152;
+    Mdot[33] = -x154;
+    Mdot[34] = x150;
     Mdot[35] = 0;
 }

@@ -207,7 +207,8 @@ REGRESSOR_SLOTINE_LI = Function(
 FORWARD_DYNAMICS = Function(
     "forward_dynamics", "forward", "forward_dynamics", ("q", "qd", "tau", "s", "gravity"),
     Output("qdd", ("dof",), "joint accelerations", "Joints"),
-    "Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)), M = L D L^T.", Check())
+    "Forward dynamics qdd = M(q)^-1 (tau - c(q, qd) - g(q)): the articulated-body algorithm or M = L D L^T, "
+    "whichever has fewer operations for this arm (the source's section comments say which).", Check())
 RNEA_DERIVATIVES = Function(
     "rnea_derivatives", "derivatives", "rnea_derivatives", ("q", "qd", "qdd", "s", "gravity"),
     Output("D", ("dof", "state"), "row-major, [d tau / d q | d tau / d qd]", "Derivatives"),

@@ -14,6 +14,7 @@ from .derivation.kinematics_functions import KinematicsModels
 from .derivation.controller import controller_models
 from .derivation.models import Derivation
 from .description import Robot, load_robot
+from .emission.opcount import count_all
 from .emission.render import Emitted, emit
 from .emission.selftest import fixed_parameters
 from .progress import Progress
@@ -77,10 +78,16 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
                   "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),
                   "control": control_model(robot, bases),
                   "control_with_jacobian": control_model(robot, bases, with_jacobian=True),
-                  **controller_models(derivation)}
+                  **controller_models(derivation, operations)}
     with progress.step("emit C"):
         emitted = emit(robot, derivation, regressors, bases, models)
     return bases, emitted
+
+
+def operations(model) -> int:
+    """Multiplications, additions and divisions of a model's straight-line code."""
+    ops = count_all([a.expr for a in model.assignments] + list(model.outputs))
+    return ops.mul + ops.add + ops.div
 
 
 def generate(robot: Robot | str | Path, out_root="generated", progress: Progress | None = None) -> Generated:

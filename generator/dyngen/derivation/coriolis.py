@@ -91,20 +91,6 @@ def coriolis_matrix(derivation: Derivation) -> Model:
                  (derivation.n, derivation.n), "Christoffel Coriolis matrix C(q, qd), row-major", program, sym.trig)
 
 
-def mass_matrix_derivative(derivation: Derivation) -> Model:
-    """M_dot = C + C^T (M_dot - 2 C is skew-symmetric)."""
-    program, sym, chain = start(derivation)
-    C = coriolis_columns(derivation, chain, sym.qd)
-    program.section = "M_dot = C + C^T"
-    n = derivation.n
-    Md = sp.zeros(n, n)
-    for i in range(n):
-        for j in range(i, n):
-            Md[i, j] = Md[j, i] = program.let(C[i, j] + C[j, i])
-    return Model("mass_matrix_derivative", model_inputs(derivation, sym, qd=True), list(Md),
-                 (n, n), "time derivative of the inertia matrix, row-major", program, sym.trig)
-
-
 def reference_symbols(n: int) -> dict:
     return {"qr_d": [sp.Symbol(f"qrd{i + 1}", real=True) for i in range(n)],
             "qr_dd": [sp.Symbol(f"qrdd{i + 1}", real=True) for i in range(n)]}

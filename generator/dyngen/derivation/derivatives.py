@@ -19,6 +19,7 @@ import sympy as sp
 from .coriolis import joint_forces, model_inputs, start
 from .forward_dynamics import forward_dynamics_in, solve
 from .models import Derivation, Model
+from .newton_euler import joint_symbols
 from .program import Program
 
 
@@ -96,3 +97,24 @@ def forward_dynamics_derivatives(derivation: Derivation) -> Model:
                  [columns[k][i] for i in range(n) for k in range(2 * n)], (n, 2 * n),
                  "[d qdd / d q | d qdd / d qd], row-major", program, sym.trig)
 
+
+def mass_matrix_derivative(derivation: Derivation) -> Model:
+    """M_dot = sum_k dM/dq_k qd_k: one forward-mode direction (along qd) over M's composite-body
+    program (ForwardMode above), about half the operations of C + C^T (which equals it)."""
+    M = derivation.mass_matrix()
+    sym = joint_symbols(derivation.robot)
+    trig = {(joint, fn): s for s, (joint, fn) in M.trig.items()}
+    seed = {}
+    for k, joint in enumerate(derivation.robot.joint_models):
+        if joint.revolute:
+            s, c = trig[(k, "sin")], trig[(k, "cos")]
+            seed.update({s: c * sym.qd[k], c: -s * sym.qd[k]})
+        else:
+            seed[sym.q[k]] = sym.qd[k]
+    n = derivation.n
+    upper = [(i, j) for i in range(n) for j in range(i, n)]
+    M.program.section = "M_dot = dM/dq qd"
+    tangents = dict(zip(upper, ForwardMode(M.program, [M.outputs[i * n + j] for i, j in upper]).tangents(seed)))
+    Md = [tangents[(min(i, j), max(i, j))] for i in range(n) for j in range(n)]
+    return Model("mass_matrix_derivative", model_inputs(derivation, sym, qd=True), Md,
+                 (n, n), "time derivative of the inertia matrix, row-major", M.program, M.trig)

@@ -1,7 +1,10 @@
-"""Forward dynamics qdd = M(q)^-1 (tau - b(q, qd)) as straight-line code: M by unit
+"""Forward dynamics qdd = M(q)^-1 (tau - b(q, qd)) as straight-line code, two ways: the
+articulated-body algorithm (articulated_body.py) and, here, M by unit
 accelerations, the bias b = rnea(q, qd, 0) (gravity included) and a square-root-free
 Cholesky factorisation M = L D L^T (a serial chain's M is dense: no sparsity to use beyond
 its symmetry), all in one program so that the sines, cosines and rotations are shared.
+The emitted forward_dynamics is the one with fewer operations for the arm; the derivatives of
+forward dynamics (derivatives.py) always use the L D L^T factors, which apply M^-1 to 2N columns.
 """
 
 from __future__ import annotations
@@ -10,6 +13,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from .articulated_body import articulated_body
 from .coriolis import joint_forces, model_inputs, start
 from .models import Derivation, Model
 from .program import Program
@@ -84,7 +88,19 @@ def forward_dynamics_in(derivation: Derivation) -> ForwardDynamics:
     return ForwardDynamics(program, sym, chain, tau, factors, qdd)
 
 
-def forward_dynamics(derivation: Derivation) -> Model:
+def ldlt_forward_dynamics(derivation: Derivation) -> Model:
     fd = forward_dynamics_in(derivation)
     return Model("forward_dynamics", model_inputs(derivation, fd.symbols, qd=True, gravity=True, tau=fd.tau), fd.qdd, (derivation.n,),
                  "forward dynamics qdd = M^-1 (tau - c - g), L D L^T", fd.program, fd.symbols.trig)
+
+
+def candidates(derivation: Derivation) -> dict:
+    """Both derivations of forward dynamics, by method name."""
+    return {"ldlt": ldlt_forward_dynamics(derivation), "articulated_body": articulated_body(derivation)}
+
+
+def forward_dynamics(derivation: Derivation, operations) -> Model:
+    """The candidate with fewer operations (operations: model -> its count, the emitter's), the
+    L D L^T on a tie: a fixed function of the arm."""
+    models = candidates(derivation)
+    return min(models.values(), key=lambda m: (operations(m), m is not models["ldlt"]))

@@ -128,7 +128,6 @@ def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     names.update({a.symbol: f"x{k}" for k, a in enumerate(pruned)})  # dense numbering: stable diffs
     printer = Printer(prefix, names)
     real = f"{prefix}_real"
-    macro = prefix.upper()
     body = []
     trig_used = sorted({s for a in pruned for s in a.expr.free_symbols if s in model.trig} |
                        {s for o in outputs for s in sp.sympify(o).free_symbols if s in model.trig},
