@@ -6,6 +6,12 @@ links beyond the tip). Those other links keep their inertials as the user wrote 
 chain link gets the rest: s_link = s_body(new) - (s_body(file) - s_link(file)), exact because the
 standard parameters s (mass, first moment, inertia about the frame origin) add. It is written in
 the URDF link's own frame (the robot's link_frames), with its centre-of-mass inertia.
+
+That rest can be a valid sum but not a physical body of its own (a hand lumped beyond the tip,
+parameters moved a few per cent: the chain link's inertia breaks the triangle inequality, and
+MuJoCo refuses the file). Then the lumped links' inertials are scaled by the largest factor k
+in [0, 1] that leaves the chain link physical (their centres of mass kept; the body's sum, so
+the dynamics, unchanged), and a comment in the link says by how much.
 """
 
 from __future__ import annotations
@@ -56,9 +62,12 @@ def urdf_copy(robot, p) -> str:
         m_file, h_file, J_file = _link_values(original.nominal[i])
         xx, xy, xz, yy, yz, zz = p[i, 4:]
         m_new, h_new, J_new = _s(p[i, 0], p[i, 1:4], np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
-        m = m_new - (m_file - m_own)
-        h = h_new - (h_file - h_own)
-        J = J_new - (J_file - J_own)
+        k = _largest_share(m_new, h_new, J_new, m_file - m_own, h_file - h_own, J_file - J_own)
+        m = m_new - k * (m_file - m_own)
+        h = h_new - k * (h_file - h_own)
+        J = J_new - k * (J_file - J_own)
+        if k < 1:
+            _scale_lumped(root, file, link, set(robot.links), link == robot.links[-1], k)
         if m <= 0:
             raise InputError(robot.source, f'link "{link}"', "the new mass is smaller than that of the links "
                              "lumped into it; the copy cannot keep their inertials")
@@ -69,6 +78,55 @@ def urdf_copy(robot, p) -> str:
     prefix = text[:text.index("<robot")] if "<robot" in text else ""
     prefix = "\n".join(line for line in prefix.splitlines() if not line.startswith("<?xml"))
     return '<?xml version="1.0" encoding="utf-8"?>\n' + prefix + "\n" + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _physical(m, h, J) -> bool:
+    """Positive mass, and a centre-of-mass inertia that is positive definite and meets the
+    triangle inequality (what MuJoCo checks)."""
+    if m <= 0:
+        return False
+    c = h / m
+    e = np.linalg.eigvalsh(J - m * (c @ c * np.eye(3) - np.outer(c, c)))
+    return e[0] > 0 and e[2] <= (e[0] + e[1]) * (1 - 1e-3)  # a margin: MuJoCo checks in its own rounding
+
+
+def _largest_share(m_new, h_new, J_new, m_others, h_others, J_others) -> float:
+    """The largest k in [0, 1] (1, or found to 1e-6 by bisection) with s_new - k s_others physical."""
+    def ok(k):
+        return _physical(m_new - k * m_others, h_new - k * h_others, J_new - k * J_others)
+
+    if m_others == 0 or ok(1.0) or not ok(0.0):
+        return 1.0
+    lo, hi = 0.0, 1.0
+    while hi - lo > 1e-6:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo
+
+
+def _scale_lumped(root, file, link, chain, is_tip, k):
+    """Scale mass and inertia of every link lumped into chain link `link` by k (in the XML)."""
+    children = {}
+    for joint in file.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    lumped, todo = [], [link]
+    while todo:
+        for joint in children.get(todo.pop(), []):
+            if joint.child not in chain and (joint.type == "fixed" or is_tip):
+                lumped.append(joint.child)
+                todo.append(joint.child)
+    for element in root.findall("link"):
+        if element.get("name") in lumped and element.find("inertial") is not None:
+            inertial = element.find("inertial")
+            mass = inertial.find("mass")
+            mass.set("value", repr(float(mass.get("value")) * k))
+            inertia = inertial.find("inertia")
+            for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
+                if inertia.get(key) is not None:
+                    inertia.set(key, repr(float(inertia.get(key)) * k))
+    element = next(e for e in root.findall("link") if e.get("name") == link)
+    element.insert(0, ET.Comment(f" dyngen: the inertials of {', '.join(lumped)} scaled by {k:.6g} so that "
+                                 f"{link} stays a physical body (the sum is the extracted one) "))
 
 
 def _set_inertial(root, link, m, c, I):
