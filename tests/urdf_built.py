@@ -60,6 +60,8 @@ def mujoco_inverse(urdf_path: Path, joint_names, q, qd, qdd, tmp_path: Path):
     model = mujoco.MjModel.from_xml_path(str(stripped))
     model.opt.gravity[:] = [0, 0, -9.81]
     model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT  # joint limits: rnea has none
+    model.dof_damping[:] = 0  # a URDF's <dynamics damping> (the Panda's): rnea has no joint friction either
+    model.dof_frictionloss[:] = 0
     data = mujoco.MjData(model)
     order = [model.joint(name).id for name in joint_names]
     tau = np.zeros(np.shape(q))
