@@ -73,10 +73,10 @@ def test_recording_within_the_bound_is_the_in_memory_diagnosis(tmp_path, monkeyp
     result = diagnose(robot, load(FOLDER), nominal_parameters(LWR), [condition(read_recording(path, N))])
     assert np.allclose(doc["rms_before"], result.rms_before, rtol=1e-9)
     assert np.allclose(doc["rms_after"], result.rms_after, rtol=1e-9)
-    assert [e["effect"] for e in doc["selected"]] == [e["effect"] for e in result.selected]
+    assert [e["effect"] for e in doc["selected"]] == [e.effect for e in result.selected]
     for a, b in zip(doc["selected"], result.selected):
-        assert a["joints"] == b["joints"]
-        assert np.allclose(list(a["values"].values()), list(b["values"].values()), rtol=1e-9)
+        assert a["joints"] == list(b.joints)
+        assert np.allclose(list(a["values"].values()), list(b.values.values()), rtol=1e-9)
 
 
 def test_a_bad_row_deep_in_a_long_recording_is_one_line_and_nothing_written(tmp_path):

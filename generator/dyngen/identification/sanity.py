@@ -35,7 +35,7 @@ import numpy as np
 
 from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
 from ..terms import simple_model as baseline
-from .options import LAG_GRID, SMOOTHING_GRID
+from .identify_options import LAG_GRID, SMOOTHING_GRID
 
 ROTOR_RATIO = 100.0
 TIE = 1.0  # the simple model is preferred where its held-out RMS is below TIE x the identified model's
