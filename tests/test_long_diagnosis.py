@@ -91,3 +91,21 @@ def test_a_bad_row_deep_in_a_long_recording_is_one_line_and_nothing_written(tmp_
     assert out.returncode != 0
     assert out.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 5002, column q3: nan (NaN or infinite value)"]
     assert not (tmp_path / "d").exists()
+
+
+def test_a_control_run_through_the_command(tmp_path):
+    """`--control`: the same arm's second run. The sensor offset is in both runs, and an offset is
+    the arm's own (not one of across.DIFFERS: gain, payload, gravity scale), so it stays a plain
+    finding; a control file that is not there is one line, a non-zero exit and nothing written."""
+    path = write_robot(tmp_path / "run.csv", seed=6, seconds=5.0, offset=OFFSET)
+    control = write_robot(tmp_path / "control.csv", seed=7, seconds=5.0, offset=OFFSET)
+    run("--data", path, "--control", control, "--out", tmp_path / "d")
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    offset = next(e for e in doc["selected"] if e["effect"] == "offset" and e["joints"] == [3])
+    assert abs(offset["values"]["b"] - 1.5) < 0.1 and "suspect" not in offset  # an empty suspect is left out
+    out = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--params", str(LWR), "--model",
+                          str(FOLDER), "-q", "--data", str(path), "--control", str(tmp_path / "missing.csv"),
+                          "--out", str(tmp_path / "e")], capture_output=True, text=True, timeout=300,
+                         env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    assert out.returncode != 0 and len(out.stderr.strip().splitlines()) == 1, out.stderr
+    assert "missing.csv" in out.stderr and not (tmp_path / "e").exists()
