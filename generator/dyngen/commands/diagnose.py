@@ -9,8 +9,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from ..errors import InputError
-from ..errors import printable
+from ..errors import InputError, printable
 from ..options import add_arguments, resolve
 from ..progress import Progress
 from ..arguments import whole

@@ -22,7 +22,7 @@ import defusedxml.ElementTree as SafeET
 import numpy as np
 
 from ..description.joint_model import _floats
-from ..description.urdf import load_urdf
+from ..description.urdf import _inertial, load_urdf
 from ..description.urdf_xml import MAX_URDF_BYTES, read_urdf
 from ..errors import InputError
 from ..untrusted import read_text
@@ -55,8 +55,6 @@ def urdf_copy(robot, p) -> str:
         own = file.links[link].inertial
         m_own, h_own, J_own = 0.0, np.zeros(3), np.zeros((3, 3))
         if own is not None:
-            from ..description.urdf import _inertial
-
             body = _inertial(file.links[link]).moved(R, t)
             m_own, h_own, J_own = _s(body.mass, body.com, body.inertia)
         m_file, h_file, J_file = _link_values(original.nominal[i])
