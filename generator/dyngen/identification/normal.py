@@ -71,26 +71,44 @@ class Normal:
                     out.n[p, j] += bm.size
         return out
 
-    def replaced(self, pieces, changes: dict) -> "Normal":
-        """A copy in which label k's column is values(piece) ((T,) or (T, N), as piece.columns)
-        for every k: values of changes (the pieces' columns are updated)."""
+    def replaced(self, pieces, *variants: dict) -> list["Normal"]:
+        """Copies, one per variant, in which label k's column is values(piece) ((T,) or (T, N),
+        as piece.columns) for every k: values of the variant; all of them in one pass over the
+        pieces (blocks.py: a pass reads the recordings again)."""
+        outs = []
+        for changes in variants:
+            out = Normal.__new__(Normal)
+            out.r, out.labels, out.dof = self.r, self.labels, self.dof
+            out.G, out.g, out.bb, out.n = self.G.copy(), self.g.copy(), self.bb, self.n
+            for k in changes:
+                i = self.r + k
+                out.G[:, :, i, :] = out.G[:, :, :, i] = 0.0
+                out.g[:, :, i] = 0.0
+            outs.append(out)
+        for piece in pieces:
+            columns = piece.columns
+            for out, changes in zip(outs, variants):
+                piece.columns = dict(columns)
+                piece.columns.update({self.labels[k]: values(piece) for k, values in changes.items()})
+                for at, k in enumerate(changes):  # a cross term of two changed labels: added by the first
+                    label = self.labels[k]
+                    for j in (range(self.dof) if label[0] == "tilt" else [label[1]]):
+                        out._row(piece, j, k, set(list(changes)[:at]))
+        return outs
+
+    @classmethod
+    def per_joint(cls, normals: list) -> "Normal":
+        """Joint j's blocks from normals[j] (each differs from the others in joint columns only)."""
         out = Normal.__new__(Normal)
-        out.r, out.labels, out.dof = self.r, self.labels, self.dof
-        out.G, out.g, out.bb, out.n = self.G.copy(), self.g.copy(), self.bb, self.n
-        for k, values in changes.items():  # one after the other: each row meets the columns as they are now
-            i = self.r + k
-            out.G[:, :, i, :] = out.G[:, :, :, i] = 0.0
-            out.g[:, :, i] = 0.0
-            label = self.labels[k]
-            joints = range(self.dof) if label[0] == "tilt" else [label[1]]
-            for piece in pieces:
-                piece.columns[label] = values(piece)
-                for j in joints:
-                    out._row(piece, j, k)
+        first = normals[0]
+        out.r, out.labels, out.dof, out.bb, out.n = first.r, first.labels, first.dof, first.bb, first.n
+        out.G = np.stack([m.G[:, j] for j, m in enumerate(normals)], axis=1)
+        out.g = np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1)
         return out
 
-    def _row(self, piece, j: int, k: int) -> None:
-        """Adds label k's row and column of joint j's blocks (zero before) from the piece."""
+    def _row(self, piece, j: int, k: int, done=()) -> None:
+        """Adds label k's row and column of joint j's blocks (zero before) from the piece, but
+        the cross terms with the labels `done` (added already)."""
         i = self.r + k
         ks = local_labels(self.labels, j)
         idx = self.r + np.asarray(ks, dtype=int)
@@ -99,7 +117,7 @@ class Normal:
         for p, sl in segments(piece.part):
             cs = c[sl]
             cross_y = piece.Yj[j][sl].T @ cs
-            cross_f = np.array([o[sl] @ cs for o in others])
+            cross_f = np.array([0.0 if kk in done else o[sl] @ cs for kk, o in zip(ks, others)])
             for G in (self.G[p, j][:, i], self.G[p, j][i, :]):
                 G[:self.r] += cross_y
                 G[idx] += cross_f

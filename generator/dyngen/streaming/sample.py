@@ -44,21 +44,17 @@ class Sampled:
         return self.gap is not None
 
 
-def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> Sampled:
-    from ..data.chunks import chunks
-
-    blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
-    first = next(blocks)
-    local = _local(first, task.conditioning)
-    model = _model(task.folder)
-    sums = Sums.start(model, task.p, task.dof) if local else None
+def spread(blocks, max_rows: int = MAX_ROWS, window: float = WINDOW, each=None):
+    """(windows kept: lists of pieces, in time order; rows; first and last time) of the blocks
+    (data.Recording), each block passed to each(block) on the way."""
     kept: dict[int, list] = {}  # window number -> its pieces
-    stride, count, rows, t0, t_end = 1, 0, 0, float(first.t[0]), float(first.t[0])
-    for piece in itertools.chain([first], blocks):  # one block at a time, and the windows kept
+    stride, count, rows, t0, t_end = 1, 0, 0, None, None
+    for piece in blocks:  # one block at a time, and the windows kept
+        t0 = float(piece.t[0]) if t0 is None else t0
         rows += piece.t.size
         t_end = float(piece.t[-1])
-        if sums is not None:
-            sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
+        if each is not None:
+            each(piece)
         number = np.floor((piece.t - t0) / window).astype(int)
         for w in np.unique(number[number % stride == 0]):
             part = _part(piece, number == w)
@@ -68,11 +64,37 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
             stride *= 2
             for w in [w for w in kept if w % stride]:
                 count -= sum(p.t.size for p in kept.pop(w))
+    return [kept[w] for w in sorted(kept)], rows, t0, t_end
+
+
+def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window: float = WINDOW) -> list:
+    """The recording whole (within max_rows samples), else its evenly spread windows, read in blocks."""
+    from ..data.chunks import chunks
+
+    kept, rows, t0, _ = spread(chunks(path, dof, True, (), 8192, effort_topic), max_rows, window)
     if rows <= max_rows:
-        return Sampled([_joined(first.name, [p for w in sorted(kept) for p in kept[w]])], rows, t_end - t0, None)
+        return [_joined(kept[0][0].name, [p for w in kept for p in w])]
+    return [_joined(f"{w[0].name}@{w[0].t[0] - t0:.0f}s", w) for w in kept]
+
+
+def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> Sampled:
+    from ..data.chunks import chunks
+
+    blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
+    first = next(blocks)
+    local = _local(first, task.conditioning)
+    model = _model(task.folder)
+    sums = Sums.start(model, task.p, task.dof) if local else None
+
+    def add(piece):
+        if sums is not None:
+            sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
+
+    kept, rows, t0, t_end = spread(itertools.chain([first], blocks), max_rows, window, add)
+    if rows <= max_rows:
+        return Sampled([_joined(first.name, [p for w in kept for p in w])], rows, t_end - t0, None)
     gap = sums.result(first.name, True) if sums is not None else gap_run(task)  # the latter: read whole
-    windows = [_joined(f"{first.name}@{kept[w][0].t[0] - t0:.0f}s", kept[w]) for w in sorted(kept)]
-    return Sampled(windows, rows, t_end - t0, gap)
+    return Sampled([_joined(f"{first.name}@{w[0].t[0] - t0:.0f}s", w) for w in kept], rows, t_end - t0, gap)
 
 
 def _part(r, mask):
