@@ -20,6 +20,8 @@ wherever the lag is shorter than a block (LAG_GRID: at most 40 ms).
 from __future__ import annotations
 
 import itertools
+import os
+import tempfile
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
@@ -28,6 +30,7 @@ import numpy as np
 from .columns import Piece, coulomb_matrix
 
 ROWS = 8192  # samples per block (7 joints x 50 regressor columns of them: 23 MB)
+_IDENTIFICATIONS = itertools.count()
 
 
 @dataclass
@@ -45,6 +48,8 @@ class Source:
     effort_topic: str | None = None
     block_rows: int = ROWS
     _coulomb: dict = field(default_factory=dict)  # (smoothing, lags) -> whole column, this pass (held)
+    _parsed: bool = False  # the file's blocks are in the temporary folder
+    _temporary: object = None  # tempfile.TemporaryDirectory: removed with the Source
 
     @classmethod
     def held(cls, signals, block_rows: int = ROWS) -> "Source":
@@ -76,21 +81,54 @@ class Source:
         return source
 
     def blocks(self):
-        """(signals of the block: t, q, qd, qdd, tau; the samples before it: t, qd; index of its
-        first sample among the data samples) per block."""
+        """(signals of the block: t, q, qd, qdd, tau; the block before it or None; its number;
+        index of its first sample among the data samples) per block. A file is parsed on the
+        first pass only: its blocks are kept in a temporary folder for the next passes."""
         if self.signals is not None:
             s, keep = self.signals, _kept(self.signals)
             cut = {k: getattr(s, k)[keep] for k in ("t", "q", "qd", "qdd", "tau")}
-            for a in range(0, self.rows, self.block_rows):
+            for number, a in enumerate(range(0, self.rows, self.block_rows)):
                 part = slice(a, a + self.block_rows)
-                yield SimpleNamespace(**{k: v[part] for k, v in cut.items()}), None, a
+                yield SimpleNamespace(**{k: v[part] for k, v in cut.items()}), None, number, a
             return
+        before, start = None, 0
+        for number, block in enumerate(self._file_blocks()):
+            yield block, before, number, start
+            before, start = block, start + block.t.size
+
+    def _file_blocks(self):
         from ..data.chunks import chunks
 
-        before, start = None, 0
-        for block in chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic):
-            yield block, before, start
-            before, start = block, start + block.t.size
+        folder = self._folder()
+        if self._parsed:
+            for number in itertools.count():
+                path = os.path.join(folder, f"{number}.npy")
+                if not os.path.exists(path):
+                    return
+                data, n = np.load(path), self.dof
+                yield SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
+                                      qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
+            return
+        for number, block in enumerate(chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic)):
+            np.save(os.path.join(folder, f"{number}.npy"), np.column_stack([block.t, block.q, block.qd, block.qdd,
+                                                                            block.tau]))
+            yield block
+        self._parsed = True
+
+    def gravity(self, number: str, make) -> np.ndarray:
+        """make(), kept in the temporary folder for the next passes (the tilt's G(q): forward
+        kinematics in Python, the slowest part of a block)."""
+        path = os.path.join(self._folder(), f"gravity{number}.npy")
+        if os.path.exists(path):
+            return np.load(path)
+        out = make()
+        np.save(path, out)
+        return out
+
+    def _folder(self) -> str:
+        if self._temporary is None:
+            self._temporary = tempfile.TemporaryDirectory(prefix="dyngen-blocks-")
+        return self._temporary.name
 
     def coulomb(self, block, before, start, smoothing, lags) -> np.ndarray:
         """(T, N): the Coulomb column of the block, as columns.coulomb_matrix of the whole recording."""
@@ -113,46 +151,44 @@ def _kept(signals) -> slice:
 
 class Blocks:
     """Pieces (columns.Piece) of every block of every source, their label columns at the current
-    settings (smoothing, lags: per joint; tilt(q) -> (T, N, 2)): iterated once per pass."""
+    settings (smoothing, lags: per joint; tilt(G) -> (T, N, 2) of gravity(q) -> G (T, N, 3)):
+    iterated once per pass."""
 
-    def __init__(self, model, sources, parts, labels, smoothing, lags, tilt=None):
+    def __init__(self, model, sources, parts, labels, smoothing, lags, gravity=None, tilt=None):
         self.model, self.sources, self.parts, self.labels = model, sources, parts, labels
-        self.smoothing, self.lags, self.tilt = smoothing, lags, tilt
+        self.smoothing, self.lags, self.gravity, self.tilt = smoothing, lags, gravity, tilt
+        self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
 
     def __iter__(self):
         for source, part in zip(self.sources, self.parts):
             source._coulomb.clear()
-            for block, before, start in source.blocks():
-                yield self.piece(source, part, block, before, start)
+            for block, before, number, start in source.blocks():
+                yield self.piece(source, part, block, before, number, start)
 
     def fit_only(self, parts):
         """The pieces whose samples are all in `parts` (the fit's, not the --select recordings)."""
         return (p for p in self if np.isin(p.part, parts).all())
 
-    def piece(self, source, part, block, before, start) -> Piece:
+    def piece(self, source, part, block, before, number, start) -> Piece:
         Y = self.model.batch("regressor", block.q, block.qd, block.qdd)
         if isinstance(part, int):
-            number = np.full(block.t.size, part, dtype=int)
-        else:  # contiguous stretches of equal duration: columns.contiguous_parts
+            at = np.full(block.t.size, part, dtype=int)
+        else:  # contiguous stretches of equal duration: parts[0] of them
             u = (block.t - source.t0) / max(source.t1 - source.t0, 1e-300)
-            number = np.minimum((u * part[0]).astype(int), part[0] - 1)
+            at = np.minimum((u * part[0]).astype(int), part[0] - 1)
         p = Piece(block, slice(None), np.ascontiguousarray(Y.transpose(1, 0, 2)), np.asarray(block.tau, dtype=float),
-                  number, {})
+                  at, {})
         p.source, p.start = source, start
         p.coulomb = lambda smoothing, lags: source.coulomb(block, before, start, smoothing, lags)
-        coulomb = self.piece_coulomb(p) if any(k == "coulomb" for k, _ in self.labels) else None
-        tilt = self.tilt(block.q) if any(k == "tilt" for k, _ in self.labels) else None
+        coulomb = p.coulomb(self.smoothing, self.lags) if any(k == "coulomb" for k, _ in self.labels) else None
+        tilt = None
+        if any(k == "tilt" for k, _ in self.labels):
+            p.gravity = source.gravity(f"{self.token}-{number}", lambda: self.gravity(block.q))
+            tilt = self.tilt(p.gravity)
         p.columns = {lab: p.column(lab, coulomb, tilt) for lab in self.labels}
         return p
-
-    def piece_coulomb(self, p):
-        return p.coulomb(self.smoothing, self.lags)
 
 
 def sources_of(recordings, block_rows: int = ROWS) -> list:
     """Sources of conditioned signals or of Sources (as they are)."""
     return [r if isinstance(r, Source) else Source.held(r, block_rows) for r in recordings]
-
-
-def chained(*iterables):
-    return itertools.chain(*iterables)

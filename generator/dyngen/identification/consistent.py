@@ -67,10 +67,7 @@ def _coulomb_search(normal, blocks, fit, grid, make, tolerance: float):
     n = normal.n[fit].sum(axis=0)
     best, choice, which = np.full(normal.dof, np.inf), np.full(normal.dof, grid[0], dtype=float), np.zeros(normal.dof, int)
 
-    def changes(value):
-        return {k: (lambda p, j=labels[k][1]: p.cached(value, lambda p: make(p, value))[:, j]) for k in ks}
-
-    trials = normal.replaced(blocks, *[changes(v) for v in grid])
+    trials = normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in grid])
     for i, (value, trial) in enumerate(zip(grid, trials)):
         x = solve_unconstrained(*trial.total(fit))
         ms = trial.sse(x, fit).sum(axis=0) / np.maximum(n, 1)
@@ -170,7 +167,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     fit = list(range(folds))
     smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
-                    smoothing0, np.zeros(dof), lambda q: tilt.rotation_columns(robot, prior, q, g_vec))
+                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), _tilt_columns(g_vec))
     normal = Normal.build(blocks, labels, r, parts, dof)
 
     # 2. the Coulomb term
@@ -282,11 +279,8 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
     tilt_at = [i for i, k in enumerate(active) if labels[k][0] == "tilt"]
     if tilt_at:
         a = x[r + np.asarray(tilt_at)]
-
-        def rotation(q, a=a):  # the estimate's columns from here on (the statistics' pass reads them)
-            return tilt.rotation_columns(robot, prior, q, g_vec, a)
-
-        normal, = normal.replaced(blocks, {k: (lambda p, d=d: p.cached("rotation", lambda p: rotation(p.signals.q))[..., d])
+        rotation = _tilt_columns(g_vec, a)  # the estimate's columns from here on (the statistics' pass reads them)
+        normal, = normal.replaced(blocks, {k: (lambda p, d=d: p.cached("rotation", lambda p: rotation(p.gravity))[..., d])
                                            for k, d in zip([active[i] for i in tilt_at], range(2))})
         blocks.tilt = rotation
         x, rounds, result = fit_with(active)
@@ -298,6 +292,14 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
             active = [k for k in active if labels[k][0] != "tilt"]
             x, rounds, result = fit_with(active)
     return result, x, rounds, normal, active
+
+
+def _tilt_columns(g_vec, a=(0.0, 0.0)):
+    """G (T, N, 3) -> the tilt's columns linearised at a: tilt.rotation_columns of G."""
+    if g_vec is None:
+        return None
+    D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))
+    return lambda G: tilt.Tilt.columns(G, D[0], D[1], size, a)
 
 
 def velocity_limits(robot, sources) -> np.ndarray:

@@ -96,6 +96,29 @@ class Normal:
                         out._row(piece, j, k, set(list(changes)[:at]))
         return outs
 
+    def swapped(self, pieces, ks, makes) -> list["Normal"]:
+        """replaced() for the case of the Coulomb searches: one label per joint (ks, each its
+        joint's own), variant v's columns those of makes[v](piece) (T, N); each joint's variants
+        in one matrix product per block."""
+        outs = self.replaced([], *[{k: None for k in ks} for _ in makes])
+        for piece in pieces:
+            values = [make(piece) for make in makes]
+            for k in ks:
+                j, i = self.labels[k][1], self.r + k
+                local = local_labels(self.labels, j)
+                idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int)]
+                A, C = joint_design(piece, self.labels, j, local), np.column_stack([v[:, j] for v in values])
+                for p, sl in segments(piece.part):
+                    cross = A[sl].T @ C[sl]  # (columns, variants): the other columns as they are
+                    cross[self.r + local.index(k)] = (C[sl] ** 2).sum(axis=0)
+                    tau = C[sl].T @ piece.tau[sl, j]
+                    for v, out in enumerate(outs):
+                        out.G[p, j][i, idx] += cross[:, v]
+                        out.G[p, j][idx, i] += cross[:, v]
+                        out.G[p, j][i, i] -= cross[self.r + local.index(k), v]  # added twice above
+                        out.g[p, j][i] += tau[v]
+        return outs
+
     @classmethod
     def per_joint(cls, normals: list) -> "Normal":
         """Joint j's blocks from normals[j] (each differs from the others in joint columns only)."""

@@ -29,25 +29,30 @@ import numpy as np
 from scipy import signal
 
 from .least_squares import WEAK, Estimate
-from .normal import joint_design, local_labels
 
 BLOCK_TIMES = 20  # block length in integrated autocorrelation times of the residual
 MIN_BLOCKS = 10
 LAGS = 2048  # autocorrelation lags kept per recording and joint (the correlation time's sum)
 
 
+def _label_matrix(piece, labels, dof) -> np.ndarray:
+    """(T, N, L): every label's column in every joint's rows (zero where it does not enter)."""
+    out = np.zeros((piece.tau.shape[0], dof, len(labels)))
+    for k, label in enumerate(labels):
+        v = piece.columns[label]
+        if v.ndim == 2:
+            out[:, :, k] = v
+        else:
+            out[:, label[1], k] = v
+    return out
+
+
 def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int) -> list:
     """Per piece (T, N): measured less fitted torque for the values x of the columns keep."""
     full = np.zeros(r + len(labels))
     full[keep] = x
-    out = []
-    for piece in pieces:
-        e = piece.tau.copy()
-        for j in range(dof):
-            ks = local_labels(labels, j)
-            e[:, j] -= joint_design(piece, labels, j, ks) @ full[np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]]
-        out.append(e)
-    return out
+    return [piece.tau - np.einsum("jtr,r->tj", piece.Yj, full[:r]) - _label_matrix(piece, labels, dof) @ full[r:]
+            for piece in pieces]
 
 
 class _Correlation:
@@ -87,12 +92,8 @@ class _Correlation:
 
 def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
     """(T, c): per sample, sum over joints of a_t w_j^2 e_t (the fit's scores)."""
-    out = np.zeros((e.shape[0], r + len(labels)))
-    for j in range(dof):
-        ks = local_labels(labels, j)
-        out[:, np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]] += joint_design(piece, labels, j, ks) * (
-            weights[j] ** 2 * e[:, j])[:, None]
-    return out
+    we = weights ** 2 * e
+    return np.hstack([np.einsum("jtr,tj->tr", piece.Yj, we), np.einsum("tjk,tj->tk", _label_matrix(piece, labels, dof), we)])
 
 
 def _score_blocks(blocks, parts, labels, r, x, keep, weights, length: int, dof: int):
