@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Benchmark: hours of data and many recordings (dyngen.streaming).
 
-1. Peak memory and wall time of `dyngen identify --ols` (least squares accumulated in blocks)
-   on the real LWR4+ run tiled to 5, 30 and 60 minutes at 200 Hz (CSV), and to 60 minutes at
+1. Peak memory and wall time of `dyngen identify --ols` (least squares accumulated in blocks),
+   `dyngen identify` (the consistent identification, its recordings read in blocks on every pass:
+   identification/blocks.py) on the real LWR4+ run tiled to 5, 30 and 60 minutes at 200 Hz (CSV), and to 60 minutes at
    1 kHz (Parquet: 3.6 M rows of 7 joints), each in its own child process (peak_memory.py).
    Flat means: the peak does not grow with the length.
 2. 20 recordings of 5 minutes (the tiled run, each one from another of the three real runs):
@@ -11,11 +12,9 @@
    Also `dyngen diagnose` (the full diagnosis on evenly spread windows of at most --max-rows
    samples, the gap and simple model over every sample in blocks: streaming/sample.py) on the
    same files; a figure of the peaks against the length (results/streaming_memory.png).
-3. The command that still holds every row, for comparison: `dyngen identify` (consistent) on 5
-   and 30 minutes.
 Writes bench/results/streaming.md and streaming.json.
 
-    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel whole]
+    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel]
 """
 from __future__ import annotations
 
@@ -37,9 +36,9 @@ RESULTS = BENCH / "results"
 REAL = [ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv" for k in (1, 2, 3)]
 
 
-def identify(data: list, out: Path, model: Path, workers: int = 1):
-    cmd = [sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", "--ols", "--model", model,
-           "-o", out, "--workers", str(workers)]
+def identify(data: list, out: Path, model: Path, workers: int = 1, ols: bool = True):
+    cmd = [sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", *(["--ols"] if ols else []),
+           "--model", model, "-o", out, "--workers", str(workers)]
     for d in data:
         cmd += ["--data", d]
     m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
@@ -68,6 +67,7 @@ def diagnosis(path: Path, tmp: Path, model: Path):
 
 
 COMMANDS = {"identify --ols": lambda path, tmp, model: identify([path], tmp / "out.yaml", model),
+            "identify": lambda path, tmp, model: identify([path], tmp / "consistent" / "out.yaml", model, ols=False),
             "diagnose --survey": survey, "diagnose": diagnosis}
 
 
@@ -146,24 +146,6 @@ def part_parallel(tmp, model, quick, repeat) -> dict:
             "calibration": calibration(repeat)}
 
 
-def part_whole(tmp, model, quick) -> dict:
-    """The command that still holds every row: identify (consistent)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "generator")}
-    lwr = ROOT / "examples" / "lwr.yaml"
-    out = []  # (diagnose: in part 1, on a bounded sample)
-    for minutes in ((5,) if quick else (5, 30)):
-        path = tmp / f"lwr_{minutes}min.csv"
-        rows = write(path, minutes)
-        commands = [("identify (consistent)", ["identify", lwr, "--data", path, "-o", tmp / "c" / "id.yaml"])]
-        for what, argv in commands:
-            log(f"{what} on {minutes} min ...")
-            m = run_measured([sys.executable, "-m", "dyngen", *argv, "--model", model, "-q"], env=env)
-            out.append({"command": what, "minutes": minutes, "rows": rows, "seconds": m.seconds,
-                        "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib, "returncode": m.returncode})
-        path.unlink()
-    return {"rows": out}
-
-
 def figure(doc, path: Path) -> None:
     """Peak memory against the recording's length, per command (200 Hz CSV; the 1 kHz hour marked)."""
     import matplotlib
@@ -196,7 +178,8 @@ def markdown(doc) -> list:
           "jobs share the cores: wall times are upper bounds; CPU times are this command's own).", ""]
     if "memory" in doc:
         md += ["`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR "
-               "factors, dyngen.streaming) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
+               "factors, dyngen.streaming), `dyngen identify` (the consistent identification: beyond --max-rows "
+               "the recording is read in blocks on every pass, identification/blocks.py) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
                "streaming/gap.py) and `dyngen diagnose` (the full diagnosis on evenly spread 6-s windows of at most 24000 "
                "samples, the gap and simple model over every sample in blocks: streaming/sample.py) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
                "200 Hz) repeated end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest "
@@ -229,13 +212,6 @@ def markdown(doc) -> list:
                    f"{par['calibration']:.2f}x the wall time of 1 process (what the machine allowed two processes; "
                    "about 0.5 on an idle 2-core machine)."]
         md.append("")
-    if "whole" in doc:
-        md += ["The command that still holds every row (not in blocks yet), on the same tiled run:", "",
-               "| command | length | rows | wall | CPU | peak memory |", "|---|---|---:|---:|---:|---:|"]
-        for r in doc["whole"]["rows"]:
-            md.append(f"| {r['command']} | {r['minutes']} min | {r['rows']} | {r['seconds']:.1f} s | "
-                      f"{r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
-        md.append("")
     return md
 
 
@@ -243,7 +219,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
-    ap.add_argument("--parts", nargs="+", choices=("memory", "parallel", "whole"), default=["memory", "parallel", "whole"],
+    ap.add_argument("--parts", nargs="+", choices=("memory", "parallel"), default=["memory", "parallel"],
                     help="parts to run; the others are kept from the last results file")
     args = ap.parse_args(argv)
     tmp = Path(tempfile.mkdtemp(prefix="dyngen-streaming-"))
@@ -254,13 +230,11 @@ def main(argv=None) -> int:
     model = generate(load_robot(ROOT / "examples" / "lwr.yaml"), tmp / "gen").folder
     path = RESULTS / "streaming.json"
     doc = json.loads(path.read_text()) if path.is_file() else {}
-    doc = {k: v for k, v in doc.items() if k in ("memory", "parallel", "whole")}
+    doc = {k: v for k, v in doc.items() if k in ("memory", "parallel")}
     if "memory" in args.parts:
         doc["memory"] = part_memory(tmp, model, args.quick)
     if "parallel" in args.parts:
         doc["parallel"] = part_parallel(tmp, model, args.quick, args.repeat)
-    if "whole" in args.parts:
-        doc["whole"] = part_whole(tmp, model, args.quick)
     doc.update(machine=machine(), load=os.getloadavg())
     RESULTS.mkdir(exist_ok=True)
     path.write_text(json.dumps(doc, indent=1) + "\n")
