@@ -11,14 +11,14 @@ recording: friction, ripple, tilt, terms/), normal (normal equations per part an
 fit of normal equations by the extraction's driver), held_out (lambda and the optional parts on
 held-out data), statistics (sandwich standard deviations), options (identify's and the consistent
 identification's options), consistent_output (the result, its YAML and tables; the command:
-commands/identify_consistent.py); samples (stacked regressors and
-measurements from recordings), least_squares (the fit, condition number, standard deviations,
+commands/identify_consistent.py); samples (the least-squares fit of
+recordings, as identify --ols folds them), least_squares (the fit, condition number, standard deviations,
 unexcited coefficients), output (YAML, table).
 """
 
 from .consistent import Consistent, ConsistentOptions, identify_consistent
 from .least_squares import Estimate, fit
 from .output import identified_yaml, summary_table
-from .samples import identify, stacked
+from .samples import identify
 
-__all__ = ["Consistent", "ConsistentOptions", "identify_consistent", "Estimate", "fit", "identified_yaml", "identify", "stacked", "summary_table"]
+__all__ = ["Consistent", "ConsistentOptions", "identify_consistent", "Estimate", "fit", "identified_yaml", "identify", "summary_table"]
