@@ -14,7 +14,8 @@
    same files; a figure of the peaks against the length (results/streaming_memory.png).
 Writes bench/results/streaming.md and streaming.json.
 
-    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel]
+    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel] [--lengths 5 30 60 60k]
+                                    [--commands identify ...]
 """
 from __future__ import annotations
 
@@ -85,20 +86,26 @@ def values(path: Path) -> list:
     return [float(v) for v in re.findall(r"value: (\S+)\}", path.read_text())]
 
 
-def part_memory(tmp, model, quick) -> dict:
-    lengths = [(5, None, "csv"), (30, None, "csv")] + ([] if quick else [(60, None, "csv"), (60, 1000, "parquet")])
-    rows_out = []
-    for minutes, rate, suffix in lengths:
+LENGTHS = {"5": (5, None, "csv"), "30": (30, None, "csv"), "60": (60, None, "csv"), "60k": (60, 1000, "parquet")}
+
+
+def part_memory(tmp, model, lengths, commands, rows_out: list, save) -> None:
+    """Each command on each length; a row replaces the last results file's row of the same
+    command, length and rate, and the file is saved after every row (a run cut short keeps
+    what it measured)."""
+    for minutes, rate, suffix in (LENGTHS[k] for k in lengths):
         path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
         rows = write(path, minutes, rate)
-        for command, run in COMMANDS.items():
+        for command in commands:
             log(f"{command} on {path.name} ({rows} rows) ...")
-            m = run(path, tmp, model)
+            m = COMMANDS[command](path, tmp, model)
+            rows_out[:] = [r for r in rows_out if (r["command"], r["minutes"], r["rate"]) != (command, minutes, rate or 200)]
             rows_out.append({"command": command, "minutes": minutes, "rate": rate or 200, "format": suffix,
                              "rows": rows, "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
                              "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
+            rows_out.sort(key=lambda r: (list(COMMANDS).index(r["command"]), r["rate"], r["minutes"]))
+            save()
         path.unlink()
-    return {"rows": rows_out}
 
 
 def _burn(n: int) -> float:
@@ -221,6 +228,10 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
     ap.add_argument("--parts", nargs="+", choices=("memory", "parallel"), default=["memory", "parallel"],
                     help="parts to run; the others are kept from the last results file")
+    ap.add_argument("--lengths", nargs="+", choices=tuple(LENGTHS), default=list(LENGTHS),
+                    help="memory part: minutes at 200 Hz (CSV), 60k the hour at 1 kHz (Parquet)")
+    ap.add_argument("--commands", nargs="+", choices=tuple(COMMANDS), default=list(COMMANDS),
+                    help="memory part: the commands to measure")
     args = ap.parse_args(argv)
     tmp = Path(tempfile.mkdtemp(prefix="dyngen-streaming-"))
     log("generating the model ...")
@@ -231,18 +242,23 @@ def main(argv=None) -> int:
     path = RESULTS / "streaming.json"
     doc = json.loads(path.read_text()) if path.is_file() else {}
     doc = {k: v for k, v in doc.items() if k in ("memory", "parallel")}
+    doc.setdefault("memory", {"rows": []})
+
+    def save():
+        doc.update(machine=machine(), load=os.getloadavg())
+        RESULTS.mkdir(exist_ok=True)
+        path.write_text(json.dumps(doc, indent=1) + "\n")
+        md = markdown(doc)
+        if doc["memory"]["rows"]:
+            figure(doc, RESULTS / "streaming_memory.png")
+        (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
+        return md
+
     if "memory" in args.parts:
-        doc["memory"] = part_memory(tmp, model, args.quick)
+        part_memory(tmp, model, ["5", "30"] if args.quick else args.lengths, args.commands, doc["memory"]["rows"], save)
     if "parallel" in args.parts:
         doc["parallel"] = part_parallel(tmp, model, args.quick, args.repeat)
-    doc.update(machine=machine(), load=os.getloadavg())
-    RESULTS.mkdir(exist_ok=True)
-    path.write_text(json.dumps(doc, indent=1) + "\n")
-    md = markdown(doc)
-    if "memory" in doc:
-        figure(doc, RESULTS / "streaming_memory.png")
-    (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
-    print("\n".join(md))
+    print("\n".join(save()))
     return 0
 
 
