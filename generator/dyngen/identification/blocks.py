@@ -48,6 +48,7 @@ class Source:
     effort_topic: str | None = None
     block_rows: int = ROWS
     _coulomb: dict = field(default_factory=dict)  # (smoothing, lags) -> whole column, this pass (held)
+    _gravity: dict = field(default_factory=dict)  # the tilt's G(q) per block (held)
     _parsed: bool = False  # the file's blocks are in the temporary folder
     _temporary: object = None  # tempfile.TemporaryDirectory: removed with the Source
 
@@ -118,6 +119,10 @@ class Source:
     def gravity(self, number: str, make) -> np.ndarray:
         """make(), kept in the temporary folder for the next passes (the tilt's G(q): forward
         kinematics in Python, the slowest part of a block)."""
+        if self.signals is not None:  # held whole: G beside it in memory (3/4 of its signals' size)
+            if number not in self._gravity:
+                self._gravity[number] = make()
+            return self._gravity[number]
         path = os.path.join(self._folder(), f"gravity{number}.npy")
         if os.path.exists(path):
             return np.load(path)
