@@ -23,6 +23,7 @@ import itertools
 import os
 import tempfile
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -62,23 +63,18 @@ class Source:
 
     @classmethod
     def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS) -> "Source":
-        """One pass over the file: its length, time span and velocities (and the checks of
-        data.recording.check_informative on its blocks)."""
-        from ..data.chunks import chunks
-
-        rows, t0, t1, qd_max, moved, torque = 0, None, None, np.zeros(dof), False, False
-        first = None
-        for block in chunks(path, dof, True, (), block_rows, effort_topic):
+        """The file parsed once, its blocks kept for every pass: its length, time span and
+        velocities, and whether it moves and has torques (data.recording.check_informative)."""
+        source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
+                     dof=dof, effort_topic=effort_topic, block_rows=block_rows)
+        first, source.moved, source.torque = None, False, False
+        for block in source._file_blocks():
             first = first or block
-            rows += block.t.size
-            t0 = float(block.t[0]) if t0 is None else t0
-            t1 = float(block.t[-1])
-            qd_max = np.maximum(qd_max, np.abs(block.qd).max(axis=0))
-            moved = moved or bool(np.ptp(np.r_[first.q[:1], block.q], axis=0).max() > 0)
-            torque = torque or bool(np.any(block.tau))
-        source = cls(first.name, rows, t0, t1, qd_max, "qd, qdd as recorded, no filter", path=str(path), dof=dof,
-                     effort_topic=effort_topic, block_rows=block_rows)
-        source.moved, source.torque = moved, torque
+            source.rows += block.t.size
+            source.qd_max = np.maximum(source.qd_max, np.abs(block.qd).max(axis=0))
+            source.moved = source.moved or bool(np.ptp(np.r_[first.q[:1], block.q], axis=0).max() > 0)
+            source.torque = source.torque or bool(np.any(block.tau))
+        source.name, source.t0, source.t1 = first.name, float(first.t[0]), float(block.t[-1])
         return source
 
     def blocks(self):
