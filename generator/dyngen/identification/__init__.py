@@ -6,7 +6,8 @@
     result = identify_consistent(robot, model, folder, signals)   # physically consistent, with friction
 
 Modules: consistent (weighted least squares over consistent link parameters, friction, offsets and
-rotor inertia through the extraction's solver: the order of work), columns (the terms' columns per
+rotor inertia through the extraction's solver: the order of work), blocks (its recordings a block
+at a time, in passes), triangular (least squares accumulated in triangular factors), columns (the terms' columns per
 recording: friction, ripple, tilt, terms/), normal (normal equations per part and joint), solver (the consistent
 fit of normal equations by the extraction's driver), held_out (lambda and the optional parts on
 held-out data), statistics (sandwich standard deviations), options (identify's and the consistent

@@ -28,6 +28,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..terms import tilt
 from .columns import Piece, coulomb_matrix
 
 ROWS = 8192  # samples per block (7 joints x 50 regressor columns of them: 23 MB)
@@ -182,14 +183,32 @@ class Blocks:
         p.source, p.start = source, start
         p.coulomb = lambda smoothing, lags: source.coulomb(block, before, start, smoothing, lags)
         coulomb = p.coulomb(self.smoothing, self.lags) if any(k == "coulomb" for k, _ in self.labels) else None
-        tilt = None
+        tilted = None
         if any(k == "tilt" for k, _ in self.labels):
             p.gravity = source.gravity(f"{self.token}-{number}", lambda: self.gravity(block.q))
-            tilt = self.tilt(p.gravity)
-        p.columns = {lab: p.column(lab, coulomb, tilt) for lab in self.labels}
+            tilted = self.tilt(p.gravity)
+        p.columns = {lab: p.column(lab, coulomb, tilted) for lab in self.labels}
         return p
 
 
 def sources_of(recordings, block_rows: int = ROWS) -> list:
     """Sources of conditioned signals or of Sources (as they are)."""
     return [r if isinstance(r, Source) else Source.held(r, block_rows) for r in recordings]
+
+
+def tilt_columns(g_vec, a=(0.0, 0.0)):
+    """G (T, N, 3) -> the tilt's columns linearised at a: tilt.rotation_columns of G."""
+    if g_vec is None:
+        return None
+    D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))
+    return lambda G: tilt.Tilt.columns(G, D[0], D[1], size, a)
+
+
+def velocity_limits(robot, sources) -> np.ndarray:
+    """V_j: the YAML's velocity limit, or else 1.5 times the largest |qd_j| in the data."""
+    seen = np.max(np.vstack([s.qd_max for s in sources]), axis=0)
+    out = []
+    for j, joint in enumerate(robot.joints):
+        lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
+        out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
+    return np.array(out, dtype=float)

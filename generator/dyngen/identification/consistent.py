@@ -44,7 +44,7 @@ from ..terms import tilt
 from ..terms.body import armature_identifiable
 from ..terms.friction import SIMPLE_SCALE
 from . import held_out
-from .blocks import Blocks, sources_of
+from .blocks import Blocks, sources_of, tilt_columns, velocity_limits
 from .columns import PER_JOINT, group_of, kinds_of, name_of
 from .consistent_output import Consistent
 from .normal import Normal, solve_unconstrained
@@ -167,7 +167,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     fit = list(range(folds))
     smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
-                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), _tilt_columns(g_vec))
+                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), tilt_columns(g_vec))
     normal = Normal.build(blocks, labels, r, parts, dof)
 
     # 2. the Coulomb term
@@ -279,7 +279,7 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
     tilt_at = [i for i, k in enumerate(active) if labels[k][0] == "tilt"]
     if tilt_at:
         a = x[r + np.asarray(tilt_at)]
-        rotation = _tilt_columns(g_vec, a)  # the estimate's columns from here on (the statistics' pass reads them)
+        rotation = tilt_columns(g_vec, a)  # the estimate's columns from here on (the statistics' pass reads them)
         normal, = normal.replaced(blocks, {k: (lambda p, d=d: p.cached("rotation", lambda p: rotation(p.gravity))[..., d])
                                            for k, d in zip([active[i] for i in tilt_at], range(2))})
         blocks.tilt = rotation
@@ -292,21 +292,3 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
             active = [k for k in active if labels[k][0] != "tilt"]
             x, rounds, result = fit_with(active)
     return result, x, rounds, normal, active
-
-
-def _tilt_columns(g_vec, a=(0.0, 0.0)):
-    """G (T, N, 3) -> the tilt's columns linearised at a: tilt.rotation_columns of G."""
-    if g_vec is None:
-        return None
-    D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))
-    return lambda G: tilt.Tilt.columns(G, D[0], D[1], size, a)
-
-
-def velocity_limits(robot, sources) -> np.ndarray:
-    """V_j: the YAML's velocity limit, or else 1.5 times the largest |qd_j| in the data."""
-    seen = np.max(np.vstack([s.qd_max for s in sources]), axis=0)
-    out = []
-    for j, joint in enumerate(robot.joints):
-        lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
-        out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
-    return np.array(out, dtype=float)

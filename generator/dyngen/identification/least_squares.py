@@ -37,7 +37,7 @@ class Estimate:
 
 def fit(A: np.ndarray, b: np.ndarray, names: list[str], weak: float = WEAK) -> Estimate:
     """The fit of the rows [A | b], through their triangular factor (fit_factor): the same
-    computation as the rows accumulated block by block (streaming/triangular.py)."""
+    computation as the rows accumulated block by block (identification/triangular.py)."""
     rows = np.column_stack([np.asarray(A, dtype=float), np.asarray(b, dtype=float)])
     return fit_factor(rows if rows.shape[0] < rows.shape[1] else np.linalg.qr(rows, mode="r"), rows.shape[0], names,
                       weak)

@@ -15,6 +15,7 @@ import numpy as np
 from ..catalogue import REGRESSORS
 from ..errors import InputError
 from .least_squares import Estimate, fit_factor
+from .triangular import Triangular
 
 REGRESSOR = {kind: f.name for kind, f in REGRESSORS.items()}
 
@@ -23,13 +24,21 @@ def stacked_inertia_columns(manifest) -> list[str]:
     return list(manifest["stacked_inertia_order"])
 
 
+def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray, np.ndarray]:
+    """(Y (T, m, c), b (T, m)): the regressor rows and measurements of T samples, m rows each,
+    as identification.samples.stacked orders them."""
+    if kind == "gravity":
+        return model.batch(REGRESSOR[kind], q), tau
+    if kind == "inertia":
+        names = stacked_inertia_columns(model.manifest)
+        return model.batch(REGRESSOR[kind], q), np.column_stack([extra[c] for c in names])
+    return model.batch(REGRESSOR[kind], q, qd, qdd), tau
+
+
 def identify(model, signals: list, kind: str) -> Estimate:
     """The least-squares fit of every sample of the conditioned recordings: their rows folded
     into per-joint triangular factors as `dyngen identify --ols` folds its blocks
-    (streaming/step.py, triangular.py), then least_squares.fit_factor."""
-    from ..streaming.step import regressor_rows
-    from ..streaming.triangular import Triangular
-
+    (streaming/step.py, identification/triangular.py), then least_squares.fit_factor."""
     if kind not in REGRESSOR:
         raise ValueError(f"unknown kind {kind!r}; expected one of {', '.join(REGRESSOR)}")
     names = [e["standard"] for e in model.manifest["coefficients"][kind]["expressions"]]

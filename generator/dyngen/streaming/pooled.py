@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import InputError
 from . import engine, step
 from ..identification.least_squares import fit_factor
-from .triangular import Triangular
+from ..identification.triangular import Triangular
 
 STANDS_OUT = 1.5  # a recording differs when the pooled fit's residual on it is this many times the median
 
