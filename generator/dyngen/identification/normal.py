@@ -107,9 +107,10 @@ class Normal:
                 j, i = self.labels[k][1], self.r + k
                 local = local_labels(self.labels, j)
                 idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int)]
-                A, C = joint_design(piece, self.labels, j, local), np.column_stack([v[:, j] for v in values])
-                for p, sl in segments(piece.part):
-                    cross = A[sl].T @ C[sl]  # (columns, variants): the other columns as they are
+                F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local])
+                C = np.column_stack([v[:, j] for v in values])
+                for p, sl in segments(piece.part):  # (columns, variants): the other columns as they are
+                    cross = np.vstack([piece.Yj[j][sl].T @ C[sl], F[sl].T @ C[sl]])
                     cross[self.r + local.index(k)] = (C[sl] ** 2).sum(axis=0)
                     tau = C[sl].T @ piece.tau[sl, j]
                     for v, out in enumerate(outs):
