@@ -305,3 +305,20 @@ def test_read_in_blocks_equals_held_whole(tmp_path):
     np.testing.assert_allclose(streamed.pi, held.pi, rtol=1e-5, atol=1e-7)  # the barrier solver's tolerance
     for kind in ("coulomb", "viscous", "offset", "armature", "tilt"):
         np.testing.assert_allclose(streamed.friction[kind], held.friction[kind], rtol=1e-5, atol=1e-7)
+
+
+def test_a_bad_row_deep_in_a_recording_read_in_blocks_is_one_line_and_nothing_written(tmp_path):
+    """Beyond --max-rows the recording is read in blocks, but every block is checked on the first
+    pass, before anything is announced or written: one line naming the file and line."""
+    import subprocess
+    import sys
+
+    lines = (ROOT / "examples" / "lwr4-real" / "measurement_1.csv").read_text().splitlines()
+    path = tmp_path / "long.csv"
+    path.write_text("\n".join(lines[:4000] + ["19.99,1,2,x"] + lines[4000:4100]) + "\n")
+    out = tmp_path / "out" / "identified.yaml"
+    r = subprocess.run([sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", "--data", path,
+                        "--model", FOLDER, "--max-rows", "500", "-o", out], capture_output=True, text=True)
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 4001: 4 values, the header has 29 columns"]
+    assert not out.parent.exists()
