@@ -162,10 +162,23 @@ class Blocks:
         self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
 
     def __iter__(self):
-        for source, part in zip(self.sources, self.parts):
-            source._coulomb.clear()
-            for block, before, number, start in source.blocks():
-                yield self.piece(source, part, block, before, number, start)
+        """The next block's piece is made in a second thread while this one's is used (reading,
+        the C regressor and NumPy release the GIL: two cores on a pass); the order, and so every
+        sum, is that of one thread."""
+        from concurrent.futures import ThreadPoolExecutor
+
+        def made():
+            for source, part in zip(self.sources, self.parts):
+                source._coulomb.clear()
+                for block, before, number, start in source.blocks():
+                    yield self.piece(source, part, block, before, number, start)
+
+        pieces = made()
+        with ThreadPoolExecutor(1) as pool:
+            ahead = pool.submit(next, pieces, None)
+            while (piece := ahead.result()) is not None:
+                ahead = pool.submit(next, pieces, None)
+                yield piece
 
     def fit_only(self, parts):
         """The pieces whose samples are all in `parts` (the fit's, not the --select recordings)."""
