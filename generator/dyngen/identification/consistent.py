@@ -47,7 +47,7 @@ from . import held_out
 from .blocks import Blocks, sources_of, tilt_columns, velocity_limits
 from .columns import PER_JOINT, group_of, kinds_of, name_of
 from .consistent_output import Consistent
-from .normal import Normal, solve_unconstrained
+from .normal import Normal, Swaps, solve_unconstrained
 from .identify_options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
 from .solver import Solver
 from .statistics import estimate
@@ -56,18 +56,14 @@ from .statistics import estimate
 # step 2: the Coulomb term's smoothing and lag
 
 
-def _coulomb_search(normal, blocks, fit, grid, make, tolerance: float):
-    """Per joint, the value of grid whose Coulomb column (make(piece, value) -> (T, N)) leaves
-    joint j the least unconstrained residual on the fit parts; a value must beat the one before
-    by `tolerance` (relative). Every value in one pass over the blocks; joint j's normal
-    equations with its choice are those of the trial of that value (a joint's Coulomb column
-    meets its own rows only). Returns (choice per joint, normal with it)."""
-    labels = normal.labels
-    ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
+def _coulomb_search(normal, trials, fit, grid, tolerance: float):
+    """Per joint, the value of grid whose trial (normal with every Coulomb column at that value:
+    Swaps) leaves joint j the least unconstrained residual on the fit parts; a value must beat
+    the one before by `tolerance` (relative). Joint j's normal equations with its choice are
+    those of the trial of that value (a joint's Coulomb column meets its own rows only).
+    Returns (choice per joint, normal with it)."""
     n = normal.n[fit].sum(axis=0)
     best, choice, which = np.full(normal.dof, np.inf), np.full(normal.dof, grid[0], dtype=float), np.zeros(normal.dof, int)
-
-    trials = normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in grid])
     for i, (value, trial) in enumerate(zip(grid, trials)):
         x = solve_unconstrained(*trial.total(fit))
         ms = trial.sse(x, fit).sum(axis=0) / np.maximum(n, 1)
@@ -76,22 +72,27 @@ def _coulomb_search(normal, blocks, fit, grid, make, tolerance: float):
     return choice, Normal.per_joint([trials[i] for i in which])
 
 
-def _coulomb(blocks, normal, fit, options, dof):
-    """(smoothing, lags, normal): chosen per joint on the fit data unless given; the blocks'
-    settings follow the choice."""
-    def at(smoothing, lags):
-        return lambda p, value: p.coulomb(np.broadcast_to(smoothing(value), (dof,)), np.broadcast_to(lags(value), (dof,)))
+def _at(dof, smoothing, lags):
+    """make(piece, value): the piece's Coulomb columns at smoothing(value), lags(value)."""
+    return lambda p, value: p.coulomb(np.broadcast_to(smoothing(value), (dof,)), np.broadcast_to(lags(value), (dof,)))
 
+
+def _coulomb(blocks, normal, fit, options, dof, swaps=None):
+    """(smoothing, lags, normal): chosen per joint on the fit data unless given (swaps: the
+    smoothing grid's trials, summed in the normal equations' pass); the blocks' settings follow
+    the choice."""
     smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
-    if not any(kind == "coulomb" for kind, _ in normal.labels):
+    ks = [k for k, (kind, _) in enumerate(normal.labels) if kind == "coulomb"]
+    if not ks:
         return smoothing, lags, normal
-    if options.smoothing is None:
-        smoothing, normal = _coulomb_search(normal, blocks, fit, SMOOTHING_GRID, at(lambda v: v, lambda v: 0.0), 0.0)
+    if swaps is not None:
+        smoothing, normal = _coulomb_search(normal, swaps.normals(normal), fit, SMOOTHING_GRID, 0.0)
         blocks.smoothing = smoothing
     if options.friction_lag:
-        fixed = smoothing.copy()
-        lags, normal = _coulomb_search(normal, blocks, fit, LAG_GRID, at(lambda v: fixed, lambda v: v), 1e-3)
+        make = _at(dof, lambda v: smoothing, lambda v: v)
+        trials = normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID])
+        lags, normal = _coulomb_search(normal, trials, fit, LAG_GRID, 1e-3)
         blocks.lags = lags
     return smoothing, lags, normal
 
@@ -168,10 +169,13 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
                     smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), tilt_columns(g_vec))
-    normal = Normal.build(blocks, labels, r, parts, dof)
-
-    # 2. the Coulomb term
-    smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof)
+    ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
+    swaps = None  # 2. the Coulomb term's smoothing: every value of its grid summed in the same pass
+    if ks and options.smoothing is None:
+        make = _at(dof, lambda v: v, lambda v: 0.0)
+        swaps = Swaps(labels, r, parts, dof, ks, [lambda p, v=v: make(p, v) for v in SMOOTHING_GRID])
+    normal = Normal.build(blocks, labels, r, parts, dof, swaps.add if swaps else None)
+    smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof, swaps)
 
     # 3. noise per joint, weights; columns the data cannot separate
     n_fit = normal.n[fit].sum(axis=0)

@@ -55,9 +55,12 @@ class Normal:
         self.n = np.zeros((parts, dof))
 
     @classmethod
-    def build(cls, pieces, labels, r: int, parts: int, dof: int) -> "Normal":
+    def build(cls, pieces, labels, r: int, parts: int, dof: int, each=None) -> "Normal":
+        """each(piece): also called on every piece (another sum of the same pass)."""
         out = cls(r, labels, parts, dof)
         for piece in pieces:
+            if each is not None:
+                each(piece)
             for j in range(dof):
                 ks = local_labels(labels, j)
                 idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]
@@ -97,28 +100,11 @@ class Normal:
         return outs
 
     def swapped(self, pieces, ks, makes) -> list["Normal"]:
-        """replaced() for the case of the Coulomb searches: one label per joint (ks, each its
-        joint's own), variant v's columns those of makes[v](piece) (T, N); each joint's variants
-        in one matrix product per block."""
-        outs = self.replaced([], *[{k: None for k in ks} for _ in makes])
+        """replaced() for the Coulomb searches (Swaps), in one pass over the pieces."""
+        swaps = Swaps(self.labels, self.r, self.G.shape[0], self.dof, ks, makes)
         for piece in pieces:
-            values = [make(piece) for make in makes]
-            for k in ks:
-                j, i = self.labels[k][1], self.r + k
-                local = local_labels(self.labels, j)
-                idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int)]
-                F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local])
-                C = np.column_stack([v[:, j] for v in values])
-                for p, sl in segments(piece.part):  # (columns, variants): the other columns as they are
-                    cross = np.vstack([piece.Yj[j][sl].T @ C[sl], F[sl].T @ C[sl]])
-                    cross[self.r + local.index(k)] = (C[sl] ** 2).sum(axis=0)
-                    tau = C[sl].T @ piece.tau[sl, j]
-                    for v, out in enumerate(outs):
-                        out.G[p, j][i, idx] += cross[:, v]
-                        out.G[p, j][idx, i] += cross[:, v]
-                        out.G[p, j][i, i] -= cross[self.r + local.index(k), v]  # added twice above
-                        out.g[p, j][i] += tau[v]
-        return outs
+            swaps.add(piece)
+        return swaps.normals(self)
 
     @classmethod
     def per_joint(cls, normals: list) -> "Normal":
@@ -166,6 +152,45 @@ class Normal:
             x = full
         G, g, bb = self.G[parts], self.g[parts], self.bb[parts]
         return np.maximum(bb - 2 * np.einsum("pja,a->pj", g, x) + np.einsum("pjab,a,b->pj", G, x, x), 0.0)
+
+
+class Swaps:
+    """The Coulomb searches' variants: one label per joint (ks, each its joint's own), variant
+    v's columns those of makes[v](piece) (T, N), summed piece by piece (each joint's variants in
+    one matrix product per block, the other columns as they are); normals(base): per variant,
+    base with those labels' rows and columns replaced (what replaced() would give)."""
+
+    def __init__(self, labels, r: int, parts: int, dof: int, ks, makes):
+        self.labels, self.r, self.ks, self.makes = labels, r, ks, makes
+        self.rows = np.zeros((len(makes), parts, dof, r + len(labels)))
+        self.g = np.zeros((len(makes), parts, dof))
+
+    def add(self, piece) -> None:
+        values = [make(piece) for make in self.makes]
+        for k in self.ks:
+            j = self.labels[k][1]
+            local = local_labels(self.labels, j)
+            idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int)]
+            F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local])
+            C = np.column_stack([v[:, j] for v in values])
+            for p, sl in segments(piece.part):
+                cross = np.vstack([piece.Yj[j][sl].T @ C[sl], F[sl].T @ C[sl]])  # (columns, variants)
+                cross[self.r + local.index(k)] = (C[sl] ** 2).sum(axis=0)
+                self.rows[:, p, j, idx] += cross.T
+                self.g[:, p, j] += C[sl].T @ piece.tau[sl, j]
+
+    def normals(self, base: Normal) -> list:
+        outs = []
+        for v in range(len(self.makes)):
+            out = Normal.__new__(Normal)
+            out.r, out.labels, out.dof = base.r, base.labels, base.dof
+            out.G, out.g, out.bb, out.n = base.G.copy(), base.g.copy(), base.bb, base.n
+            for k in self.ks:
+                j, i = self.labels[k][1], self.r + k
+                out.G[:, j, i, :] = out.G[:, j, :, i] = self.rows[v, :, j]
+                out.g[:, j, i] = self.g[v, :, j]
+            outs.append(out)
+        return outs
 
 
 def solve_unconstrained(G, g, weak: float = WEAK) -> np.ndarray:
