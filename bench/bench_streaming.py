@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Benchmark: hours of data and many recordings (dyngen.streaming).
 
-1. Peak memory and wall time of `dyngen identify --ols` (least squares accumulated in blocks)
-   on the real LWR4+ run tiled to 5, 30 and 60 minutes at 200 Hz (CSV), and to 60 minutes at
+1. Peak memory and wall time of `dyngen identify --ols` (least squares accumulated in blocks),
+   `dyngen identify` (the consistent identification, its recordings read in blocks on every pass:
+   identification/blocks.py) on the real LWR4+ run tiled to 5, 30 and 60 minutes at 200 Hz (CSV), and to 60 minutes at
    1 kHz (Parquet: 3.6 M rows of 7 joints), each in its own child process (peak_memory.py).
    Flat means: the peak does not grow with the length.
 2. 20 recordings of 5 minutes (the tiled run, each one from another of the three real runs):
@@ -11,11 +12,10 @@
    Also `dyngen diagnose` (the full diagnosis on evenly spread windows of at most --max-rows
    samples, the gap and simple model over every sample in blocks: streaming/sample.py) on the
    same files; a figure of the peaks against the length (results/streaming_memory.png).
-3. The command that still holds every row, for comparison: `dyngen identify` (consistent) on 5
-   and 30 minutes.
 Writes bench/results/streaming.md and streaming.json.
 
-    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel whole]
+    python bench/bench_streaming.py [--quick] [--repeat N] [--parts memory parallel] [--lengths 5 30 60 60k]
+                                    [--commands identify ...]
 """
 from __future__ import annotations
 
@@ -37,9 +37,9 @@ RESULTS = BENCH / "results"
 REAL = [ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv" for k in (1, 2, 3)]
 
 
-def identify(data: list, out: Path, model: Path, workers: int = 1):
-    cmd = [sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", "--ols", "--model", model,
-           "-o", out, "--workers", str(workers)]
+def identify(data: list, out: Path, model: Path, workers: int = 1, ols: bool = True):
+    cmd = [sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", *(["--ols"] if ols else []),
+           "--model", model, "-o", out, "--workers", str(workers)]
     for d in data:
         cmd += ["--data", d]
     m = run_measured(cmd, env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
@@ -68,6 +68,7 @@ def diagnosis(path: Path, tmp: Path, model: Path):
 
 
 COMMANDS = {"identify --ols": lambda path, tmp, model: identify([path], tmp / "out.yaml", model),
+            "identify": lambda path, tmp, model: identify([path], tmp / "consistent" / "out.yaml", model, ols=False),
             "diagnose --survey": survey, "diagnose": diagnosis}
 
 
@@ -85,20 +86,26 @@ def values(path: Path) -> list:
     return [float(v) for v in re.findall(r"value: (\S+)\}", path.read_text())]
 
 
-def part_memory(tmp, model, quick) -> dict:
-    lengths = [(5, None, "csv"), (30, None, "csv")] + ([] if quick else [(60, None, "csv"), (60, 1000, "parquet")])
-    rows_out = []
-    for minutes, rate, suffix in lengths:
+LENGTHS = {"5": (5, None, "csv"), "30": (30, None, "csv"), "60": (60, None, "csv"), "60k": (60, 1000, "parquet")}
+
+
+def part_memory(tmp, model, lengths, commands, rows_out: list, save) -> None:
+    """Each command on each length; a row replaces the last results file's row of the same
+    command, length and rate, and the file is saved after every row (a run cut short keeps
+    what it measured)."""
+    for minutes, rate, suffix in (LENGTHS[k] for k in lengths):
         path = tmp / f"lwr_{minutes}min_{rate or 200}hz.{suffix}"
         rows = write(path, minutes, rate)
-        for command, run in COMMANDS.items():
+        for command in commands:
             log(f"{command} on {path.name} ({rows} rows) ...")
-            m = run(path, tmp, model)
+            m = COMMANDS[command](path, tmp, model)
+            rows_out[:] = [r for r in rows_out if (r["command"], r["minutes"], r["rate"]) != (command, minutes, rate or 200)]
             rows_out.append({"command": command, "minutes": minutes, "rate": rate or 200, "format": suffix,
                              "rows": rows, "file_mib": path.stat().st_size / 2 ** 20, "seconds": m.seconds,
                              "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib})
+            rows_out.sort(key=lambda r: (list(COMMANDS).index(r["command"]), r["rate"], r["minutes"]))
+            save()
         path.unlink()
-    return {"rows": rows_out}
 
 
 def _burn(n: int) -> float:
@@ -146,24 +153,6 @@ def part_parallel(tmp, model, quick, repeat) -> dict:
             "calibration": calibration(repeat)}
 
 
-def part_whole(tmp, model, quick) -> dict:
-    """The command that still holds every row: identify (consistent)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "generator")}
-    lwr = ROOT / "examples" / "lwr.yaml"
-    out = []  # (diagnose: in part 1, on a bounded sample)
-    for minutes in ((5,) if quick else (5, 30)):
-        path = tmp / f"lwr_{minutes}min.csv"
-        rows = write(path, minutes)
-        commands = [("identify (consistent)", ["identify", lwr, "--data", path, "-o", tmp / "c" / "id.yaml"])]
-        for what, argv in commands:
-            log(f"{what} on {minutes} min ...")
-            m = run_measured([sys.executable, "-m", "dyngen", *argv, "--model", model, "-q"], env=env)
-            out.append({"command": what, "minutes": minutes, "rows": rows, "seconds": m.seconds,
-                        "cpu_seconds": m.cpu_seconds, "peak_mib": m.max_rss_mib, "returncode": m.returncode})
-        path.unlink()
-    return {"rows": out}
-
-
 def figure(doc, path: Path) -> None:
     """Peak memory against the recording's length, per command (200 Hz CSV; the 1 kHz hour marked)."""
     import matplotlib
@@ -196,7 +185,8 @@ def markdown(doc) -> list:
           "jobs share the cores: wall times are upper bounds; CPU times are this command's own).", ""]
     if "memory" in doc:
         md += ["`dyngen identify --ols` (least squares accumulated in blocks of 8192 samples into per-joint QR "
-               "factors, dyngen.streaming) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
+               "factors, dyngen.streaming), `dyngen identify` (the consistent identification: beyond --max-rows "
+               "the recording is read in blocks on every pass, identification/blocks.py) and `dyngen diagnose --survey` (the gap and the simple model in blocks, "
                "streaming/gap.py) and `dyngen diagnose` (the full diagnosis on evenly spread 6-s windows of at most 24000 "
                "samples, the gap and simple model over every sample in blocks: streaming/sample.py) on the real LWR4+ run (examples/lwr4-real/measurement_1.csv, 25 s at "
                "200 Hz) repeated end to end; the 1 kHz hour resampled by linear interpolation. Peak: the largest "
@@ -229,13 +219,6 @@ def markdown(doc) -> list:
                    f"{par['calibration']:.2f}x the wall time of 1 process (what the machine allowed two processes; "
                    "about 0.5 on an idle 2-core machine)."]
         md.append("")
-    if "whole" in doc:
-        md += ["The command that still holds every row (not in blocks yet), on the same tiled run:", "",
-               "| command | length | rows | wall | CPU | peak memory |", "|---|---|---:|---:|---:|---:|"]
-        for r in doc["whole"]["rows"]:
-            md.append(f"| {r['command']} | {r['minutes']} min | {r['rows']} | {r['seconds']:.1f} s | "
-                      f"{r['cpu_seconds']:.1f} s | {r['peak_mib']:.0f} MiB |")
-        md.append("")
     return md
 
 
@@ -243,8 +226,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
-    ap.add_argument("--parts", nargs="+", choices=("memory", "parallel", "whole"), default=["memory", "parallel", "whole"],
+    ap.add_argument("--parts", nargs="+", choices=("memory", "parallel"), default=["memory", "parallel"],
                     help="parts to run; the others are kept from the last results file")
+    ap.add_argument("--lengths", nargs="+", choices=tuple(LENGTHS), default=list(LENGTHS),
+                    help="memory part: minutes at 200 Hz (CSV), 60k the hour at 1 kHz (Parquet)")
+    ap.add_argument("--commands", nargs="+", choices=tuple(COMMANDS), default=list(COMMANDS),
+                    help="memory part: the commands to measure")
     args = ap.parse_args(argv)
     tmp = Path(tempfile.mkdtemp(prefix="dyngen-streaming-"))
     log("generating the model ...")
@@ -254,21 +241,24 @@ def main(argv=None) -> int:
     model = generate(load_robot(ROOT / "examples" / "lwr.yaml"), tmp / "gen").folder
     path = RESULTS / "streaming.json"
     doc = json.loads(path.read_text()) if path.is_file() else {}
-    doc = {k: v for k, v in doc.items() if k in ("memory", "parallel", "whole")}
+    doc = {k: v for k, v in doc.items() if k in ("memory", "parallel")}
+    doc.setdefault("memory", {"rows": []})
+
+    def save():
+        doc.update(machine=machine(), load=os.getloadavg())
+        RESULTS.mkdir(exist_ok=True)
+        path.write_text(json.dumps(doc, indent=1) + "\n")
+        md = markdown(doc)
+        if doc["memory"]["rows"]:
+            figure(doc, RESULTS / "streaming_memory.png")
+        (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
+        return md
+
     if "memory" in args.parts:
-        doc["memory"] = part_memory(tmp, model, args.quick)
+        part_memory(tmp, model, ["5", "30"] if args.quick else args.lengths, args.commands, doc["memory"]["rows"], save)
     if "parallel" in args.parts:
         doc["parallel"] = part_parallel(tmp, model, args.quick, args.repeat)
-    if "whole" in args.parts:
-        doc["whole"] = part_whole(tmp, model, args.quick)
-    doc.update(machine=machine(), load=os.getloadavg())
-    RESULTS.mkdir(exist_ok=True)
-    path.write_text(json.dumps(doc, indent=1) + "\n")
-    md = markdown(doc)
-    if "memory" in doc:
-        figure(doc, RESULTS / "streaming_memory.png")
-    (RESULTS / "streaming.md").write_text("\n".join(md).rstrip() + "\n")
-    print("\n".join(md))
+    print("\n".join(save()))
     return 0
 
 

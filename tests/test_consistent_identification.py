@@ -265,3 +265,60 @@ def test_real_lwr_beats_the_simple_model_on_every_joint(tmp_path):
         assert all(c.friction["viscous"][j - 1] >= 0 for j in range(1, 8) if j not in falling)
         held_out = np.sqrt(np.mean((test.tau - c.predict(model, test)) ** 2, axis=0))
         assert np.all(held_out < simple[last]), (last, held_out)
+
+
+def test_read_in_blocks_equals_held_whole(tmp_path):
+    """A recording read from its file in blocks of 700 samples on every pass (what `dyngen
+    identify` does beyond --max-rows: identification/blocks.py) is identified as the same
+    recording conditioned and held whole (one block): the normal equations, both Coulomb
+    searches (smoothing, then the lag, which reads the block before), the tilt's rotation and
+    the statistics (correlation time, sandwich blocks that straddle the file's blocks) summed
+    block by block equal the one-block sums to rounding. The real LWR4+ runs on a regular clock
+    (so that conditioning keeps the columns as recorded), fit on measurement 1, every choice on
+    measurement 3 (--select, read the same way)."""
+    from dyngen.data import read_recording
+    from dyngen.identification.blocks import Source
+
+    paths = []
+    for k in (1, 3):
+        data = np.loadtxt(ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv", delimiter=",", skiprows=1)
+        data[:, 0] = 0.005 * np.arange(data.shape[0])
+        paths.append(tmp_path / f"m{k}.csv")
+        header = (ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv").read_text().partition("\n")[0]
+        np.savetxt(paths[-1], data, delimiter=",", header=header, comments="", fmt="%.10g")
+    robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(FOLDER)
+    whole = [condition(read_recording(p, 7)) for p in paths]
+    assert [s.note for s in whole] == ["qd, qdd as recorded, no filter"] * 2 and whole[0].t.size > 5 * 700
+    options = ConsistentOptions(folds=3)
+    held = identify_consistent(robot, model, FOLDER, whole[:1], options, select=whole[1:])
+    blocks = [Source.of_file(p, 7, block_rows=700) for p in paths]
+    streamed = identify_consistent(robot, model, FOLDER, blocks[:1], options, select=blocks[1:])
+    assert held.tilt_model is not None and np.any(held.lags > 0)  # every pass ran
+    for what in ("regularisation", "dropped_columns", "at_bounds"):
+        assert getattr(streamed, what) == getattr(held, what), what
+    assert [g[4] for g in streamed.groups] == [g[4] for g in held.groups]
+    np.testing.assert_array_equal(streamed.smoothing, held.smoothing)
+    np.testing.assert_array_equal(streamed.lags, held.lags)
+    np.testing.assert_allclose(streamed.sigma, held.sigma, rtol=1e-9)
+    np.testing.assert_allclose(streamed.ols.values, held.ols.values, rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(streamed.ols.std, held.ols.std, rtol=1e-7)
+    np.testing.assert_allclose(streamed.pi, held.pi, rtol=1e-5, atol=1e-7)  # the barrier solver's tolerance
+    for kind in ("coulomb", "viscous", "offset", "armature", "tilt"):
+        np.testing.assert_allclose(streamed.friction[kind], held.friction[kind], rtol=1e-5, atol=1e-7)
+
+
+def test_a_bad_row_deep_in_a_recording_read_in_blocks_is_one_line_and_nothing_written(tmp_path):
+    """Beyond --max-rows the recording is read in blocks, but every block is checked on the first
+    pass, before anything is announced or written: one line naming the file and line."""
+    import subprocess
+    import sys
+
+    lines = (ROOT / "examples" / "lwr4-real" / "measurement_1.csv").read_text().splitlines()
+    path = tmp_path / "long.csv"
+    path.write_text("\n".join(lines[:4000] + ["19.99,1,2,x"] + lines[4000:4100]) + "\n")
+    out = tmp_path / "out" / "identified.yaml"
+    r = subprocess.run([sys.executable, "-m", "dyngen", "identify", ROOT / "examples" / "lwr.yaml", "--data", path,
+                        "--model", FOLDER, "--max-rows", "500", "-o", out], capture_output=True, text=True)
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 4001: 4 values, the header has 29 columns"]
+    assert not out.parent.exists()

@@ -109,3 +109,29 @@ def test_a_control_run_through_the_command(tmp_path):
                          env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
     assert out.returncode != 0 and len(out.stderr.strip().splitlines()) == 1, out.stderr
     assert "missing.csv" in out.stderr and not (tmp_path / "e").exists()
+
+
+def test_split_pieces_read_in_blocks_never_mix_roles(tmp_path):
+    """--split on a recording over --max-rows: each piece (fit, select, test) read in blocks into
+    evenly spread windows of its own time range; within the bound, the pieces are data/split.py's
+    cuts of the whole recording, sample for sample."""
+    from types import SimpleNamespace
+
+    from dyngen.commands.long_diagnosis import read_split
+    from dyngen.data.split import split_recording
+
+    path = write_robot(tmp_path / "long.csv", seed=4, seconds=80.0, offset=OFFSET)  # 16000 samples, 0-80 s
+    run("--data", path, "--split", "0.6,0.2,0.2", "--max-rows", 3000, "--out", tmp_path / "d")
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    for role, (a, b) in {"fit": (0, 48), "select": (48, 64), "test": (64, 80)}.items():
+        names = doc[role]
+        assert len(names) >= 2 and all(n.startswith(f"long.csv [{a / 0.8:.0f}%-{b / 0.8:.0f}%]@") for n in names)
+        starts = [float(n.rpartition("@")[2].rstrip("s")) for n in names]  # from the piece's start
+        assert all(0 <= s < b - a for s in starts), (role, starts)
+    args = SimpleNamespace(effort_topic=None, cutoff="auto", order=4, differentiate=False)
+    whole = split_recording(read_recording(path, N), (0.6, 0.2, 0.2))
+    got = read_split([path], load_robot(LWR), args, (0.6, 0.2, 0.2), 10 ** 6)
+    for piece, (signals,) in zip(whole, got):
+        assert signals.name == piece.name
+        np.testing.assert_array_equal(signals.t, piece.t)
+        np.testing.assert_array_equal(signals.tau, piece.tau)

@@ -94,6 +94,10 @@ def test_blocks_equal_the_in_memory_fit(tmp_path, model, kind):
     b = np.concatenate([s.tau.reshape(-1) for s in signals])
     x = np.linalg.lstsq(Y, b, rcond=None)[0]
     assert np.allclose(Y @ streamed.estimate.values, Y @ x, atol=1e-8 * np.abs(b).max())
+    if not streamed.estimate.unexcited:  # the textbook deviations and the condition number, by numpy
+        sigma2 = np.sum((b - Y @ x) ** 2) / (b.size - Y.shape[1])
+        assert np.allclose(streamed.estimate.std, np.sqrt(sigma2 * np.diag(np.linalg.inv(Y.T @ Y))), rtol=1e-5)
+        assert streamed.estimate.condition == pytest.approx(np.linalg.cond(Y), rel=1e-6)
 
 
 def test_conditioning_of_the_whole_recording_when_blocks_cannot_do_it(tmp_path, model):

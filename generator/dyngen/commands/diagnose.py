@@ -59,7 +59,8 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
     parser.add_argument("--max-rows", type=whole(MIN_DIAGNOSIS_SAMPLES, 10 ** 9), default=None, metavar="N",
                         help="a --data recording of more samples is diagnosed on evenly spread 6-s windows of at most "
                              "N samples in all, its gap and simple model reported over every sample (read in blocks: "
-                             f"memory independent of its length; default {MAX_ROWS})")
+                             "memory independent of its length); so are --select, --test and each piece of --split, "
+                             f"read in blocks (default {MAX_ROWS})")
     group = parser.add_argument_group("diagnosis")
     add_arguments(group, Options)
     group.add_argument("--no-reidentify", dest="reidentify", action="store_const", const=False,
@@ -69,8 +70,7 @@ def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
 
 def main(argv, prog="dyngen diagnose") -> int:
     args = parser(prog).parse_args(argv)
-    from ..data import condition, read_recording
-    from ..data.split import parse_fractions, split_recording
+    from ..data.split import parse_fractions
     from ..description import load_robot
     from ..diagnosis import Options, diagnose
     from ..diagnosis.effects import check_names
@@ -104,21 +104,19 @@ def main(argv, prog="dyngen diagnose") -> int:
         if args.select or tests:
             raise InputError("--split", "", "cuts the --data recordings into fit, select and test: give no "
                              "--select, --test or --holdout with it")
-        fractions = parse_fractions(args.split)
-        pieces = [split_recording(read_recording(x, robot.dof, effort_topic=args.effort_topic), fractions)
-                  for x in args.data]
-        for recording in (r for rs in pieces for r in rs if r is not None):
+        from .long_diagnosis import read_split
+
+        fit, select, test = read_split(args.data, robot, args, parse_fractions(args.split), args.max_rows or MAX_ROWS)
+        for recording in [*fit, *select, *test]:
             check_enough(recording.name, recording.t)
-        fit, select, test = ([condition(r[k], conditioning_of(args)) for r in pieces if r[k] is not None]
-                             for k in range(3))
     else:  # --data read in blocks once the model is compiled (long_diagnosis.py); their headers now
-        from .long_diagnosis import check_headers
+        from .long_diagnosis import check_headers, read_windows
 
         check_headers(args.data, robot, args)
-        select = read_all(args.select, robot, args) if args.select else []
-        test = read_all(tests, robot, args) if tests else []
-        for path, recording in zip([*(args.select or []), *tests], [*select, *test]):
-            check_enough(Path(path).name, recording.t)
+        select = read_windows(args.select or [], robot, args, args.max_rows or MAX_ROWS)
+        test = read_windows(tests, robot, args, args.max_rows or MAX_ROWS)
+        for recording in [*select, *test]:
+            check_enough(recording.name, recording.t)
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = compiled_model(args, robot, progress)

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from ..arguments import whole
 from ..options import add_arguments, resolve
 from ..progress import Progress
-from .recordings import add_data_options, compiled_model, read_all
+from .recordings import HELD_ROWS, add_data_options, compiled_model, read_sources
 
 
 def parser(prog="dyngen identify") -> argparse.ArgumentParser:
@@ -37,6 +38,11 @@ def parser(prog="dyngen identify") -> argparse.ArgumentParser:
                             "(default: the YAML's parameters.nominal)")
     group.add_argument("--select", action="append", metavar="CSV",
                        help="recording(s) to choose the regularisation on (never fitted)")
+    group.add_argument("--max-rows", type=whole(16, 10 ** 9), default=HELD_ROWS, metavar="N",
+                       help="a --data or --select recording of more samples, with qd and qdd recorded and no filter "
+                            "asked for, is read from its file in blocks on every pass (memory independent of its "
+                            "length; its columns as recorded, without the repairs of uneven stamps that need the "
+                            f"whole recording); default {HELD_ROWS}")
     add_arguments(group, ConsistentOptions)
     return parser
 
@@ -59,11 +65,10 @@ def main(argv, prog="dyngen identify") -> int:
         from .identify_least_squares import run_least_squares
 
         return run_least_squares(args, robot, kind, required, progress, out)
-    signals = read_all(args.data, robot, args, require_torques=kind != "inertia", required=required,
-                       need_motion=kind == "full")
+    sources = read_sources(args.data, robot, args)  # in blocks where they can be (identification/blocks.py)
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
-    return run_consistent(args, robot, model, signals, progress)
+    return run_consistent(args, robot, model, sources, progress)
 
 
 def check_outputs(args, robot, kind: str, ols: bool) -> Path:

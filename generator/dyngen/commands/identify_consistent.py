@@ -11,19 +11,20 @@ from ..options import resolve
 
 
 def run_consistent(args, robot, model, signals, progress) -> int:
+    """signals: identification.blocks.Source of every --data recording (commands/recordings.py)."""
     from ..atomic import write_file
     from ..data.parameters_file import read_link_parameters
     from ..export import write_all
     from ..identification.consistent import ConsistentOptions, identify_consistent
     from ..identification.consistent_output import consistent_table, consistent_yaml, summary_lines
-    from .recordings import conditioning_text, read_all
+    from .recordings import conditioning_text, read_sources
 
     options = resolve(ConsistentOptions, args, {})
     if "none" in options.candidates:  # names were checked by the parser (dyngen.options)
         options = replace(options, candidates=())
     if args.prior:
         options = replace(options, prior=read_link_parameters(args.prior, robot.dof))
-    select = read_all(args.select, robot, args) if args.select else None
+    select = read_sources(args.select, robot, args) if args.select else None
     start = time.perf_counter()
     with progress.step("consistent identification (weighted least squares, barrier solver)"):
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
@@ -35,7 +36,8 @@ def run_consistent(args, robot, model, signals, progress) -> int:
 
     prior = options.prior if options.prior is not None else (
         np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
-    sanity, sanity_table, result = check(robot, model, result, signals, select, prior)
+    sanity, sanity_table, result = check(robot, model, result, _sampled(signals, robot, args),
+                                        _sampled(select, robot, args), prior)
     # ---
     out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
     sources = [s.name for s in signals]  # printable: data/recording.py
@@ -57,3 +59,22 @@ def run_consistent(args, robot, model, signals, progress) -> int:
         print("\n".join(f"warning: {w}" for w in sanity), file=sys.stderr)
     return 0
 
+
+def _sampled(sources, robot, args):
+    """Conditioned signals of the sources for the sanity check: a recording held whole as it is,
+    one read in blocks whole within streaming.sample.MAX_ROWS samples, else evenly spread
+    windows of it (the ranges and the simple model's comparison on a sample, not every row)."""
+    from ..data import condition
+    from ..streaming.sample import windows
+    from .recordings import MIN_DIAGNOSIS_SAMPLES, conditioning_of
+
+    if sources is None:
+        return None
+    out = []
+    for s in sources:
+        if s.signals is not None:
+            out.append(s.signals)
+            continue
+        out += [condition(w, conditioning_of(args)) for w in windows(s.path, robot.dof, s.effort_topic)
+                if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+    return out

@@ -32,6 +32,54 @@ def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
     return [condition(r, conditioning_of(args)) for r in recordings], sampled
 
 
+def read_windows(paths, robot, args, max_rows: int) -> list:
+    """--select and --test recordings, read in blocks: whole within max_rows samples, else
+    evenly spread windows of them (streaming/sample.py); conditioned, each on its own."""
+    from ..data import condition
+    from ..data.recording import check_informative
+    from ..streaming.sample import windows
+
+    recordings = []
+    for path in paths:
+        got = windows(path, robot.dof, args.effort_topic, max_rows)
+        recordings += got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+    check_informative(recordings, True)
+    return [condition(r, conditioning_of(args)) for r in recordings]
+
+
+def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list, list]:
+    """--split: every --data recording cut in time into fit, select and test (data/split.py's
+    edges), read in blocks twice (its time span, then the pieces); each piece whole within
+    max_rows samples, else evenly spread windows of it. (fit, select, test) conditioned."""
+    from ..data import condition
+    from ..data.chunks import chunks
+    from ..errors import InputError
+    from ..streaming.sample import Spread, _part
+
+    roles = ([], [], [])
+    edges = np.concatenate([[0.0], np.cumsum(fractions)])
+    edges[-1] = 1.0
+    for path in paths:
+        t0, t1 = None, None
+        for block in chunks(path, robot.dof, True, (), 8192, args.effort_topic):
+            t0, t1, name = block.t[0] if t0 is None else t0, block.t[-1], block.name
+        spreads = [Spread(max_rows) if b > a else None for a, b in zip(edges[:-1], edges[1:])]
+        for block in chunks(path, robot.dof, True, (), 8192, args.effort_topic):
+            for k, spread in enumerate(spreads):
+                if spread is not None:
+                    keep = (block.t >= t0 + edges[k] * (t1 - t0)) & (
+                        (block.t < t0 + edges[k + 1] * (t1 - t0)) if edges[k + 1] < 1.0 else True)
+                    spread.add(_part(block, keep))
+        for k, spread in enumerate(spreads):
+            if spread is None:
+                continue
+            if spread.rows < 8:
+                raise InputError(name, "--split", f"the piece {edges[k]:.0%}-{edges[k + 1]:.0%} has {spread.rows} samples")
+            got = spread.windows(f"{name} [{edges[k]:.0%}-{edges[k + 1]:.0%}]")
+            roles[k].extend(got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES])
+    return tuple([condition(r, conditioning_of(args)) for r in role] for role in roles)
+
+
 def summary(got, windows) -> dict:
     from ..streaming.gap import _rms, _solve
 

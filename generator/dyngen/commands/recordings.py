@@ -7,11 +7,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from ..arguments import whole
+from ..data import columnar
 from ..errors import InputError
 from ..options import add_arguments, resolve
 
 MIN_DIAGNOSIS_SAMPLES = 50
+HELD_ROWS = 120000  # identify: recordings of more samples are read in blocks on every pass (10 min at 200 Hz)
 
 
 def add_data_options(parser: argparse.ArgumentParser) -> None:
@@ -98,3 +102,29 @@ def read_all(paths, robot, args, require_torques=True, required=(), need_motion=
     recordings = [read_recording(p, robot.dof, require_torques, required, topic) for p in paths]
     check_informative(recordings, need_motion)
     return [condition(r, conditioning_of(args)) for r in recordings]
+
+
+def read_sources(paths, robot, args) -> list:
+    """The recordings as the consistent identification reads them (identification/blocks.py):
+    in blocks from the file where conditioning would use its columns as recorded (one pass now
+    for its length and the checks of data.recording.check_informative), else read and
+    conditioned whole."""
+    from ..data import condition, read_recording
+    from ..data.chunks import chunks
+    from ..data.recording import Recording, check_informative
+    from ..identification.blocks import Source
+    from ..streaming.step import _local
+
+    topic, conditioning = getattr(args, "effort_topic", None), conditioning_of(args)
+    read = []  # a Source read in blocks, or the Recording read whole
+    for path in paths:
+        first = next(chunks(path, robot.dof, True, (), 64, topic))
+        source = Source.of_file(path, robot.dof, topic) if _local(first, conditioning) and \
+            columnar.format_of(path) != "rosbag" else None
+        streamed = source is not None and source.rows > getattr(args, "max_rows", HELD_ROWS)
+        read.append(source if streamed else read_recording(path, robot.dof, True, (), topic))
+    # what check_informative reads of a Source: a two-sample stand-in that moves and has torques as the file does
+    check_informative([r if isinstance(r, Recording) else Recording(
+        r.name, np.arange(2.0), np.arange(2.0)[:, None] * np.ones(robot.dof) * r.moved,
+        np.ones((2, robot.dof)) * r.torque) for r in read], True)
+    return [r if isinstance(r, Source) else Source.held(condition(r, conditioning)) for r in read]

@@ -94,11 +94,11 @@ def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
 
 @dataclass
 class Piece:
-    """One recording as the fit sees it: its data samples only (the filter's start-up cut at
-    both ends), the regressor evaluated once, and which part (fold) each sample belongs to."""
+    """A block of one recording as the fit sees it (blocks.py): its data samples, the regressor
+    evaluated once, and which part (fold) each sample belongs to."""
 
-    signals: object  # the conditioned recording, whole (columns are computed on it, then cut)
-    keep: slice  # the data samples
+    signals: object  # the block's samples: t, q, qd, qdd, tau
+    keep: slice  # the data samples among them
     Yj: np.ndarray  # (N, T, r) base regressor at the kept samples, joint by joint
     tau: np.ndarray  # (T, N)
     part: np.ndarray  # (T,) fold index
@@ -110,36 +110,9 @@ class Piece:
             return tilt[..., j]
         return joint_column(self.signals, kind, j, coulomb_full)[self.keep]
 
-
-def piece(model, signals, part: np.ndarray | int) -> Piece:
-    """The recording's regressor and torques at its data samples; part: per sample or one for all."""
-    T = len(signals.t)
-    k = int(getattr(signals, "trim", 0) or 0)
-    keep = slice(k, T - k) if 0 < k and 2 * k < T else slice(0, T)
-    Y = model.batch("regressor", signals.q[keep], signals.qd[keep], signals.qdd[keep])
-    n = Y.shape[0]
-    part = np.full(n, part, dtype=int) if np.ndim(part) == 0 else np.asarray(part, dtype=int)
-    Yj = np.ascontiguousarray(Y.transpose(1, 0, 2))
-    return Piece(signals, keep, Yj, np.asarray(signals.tau[keep], dtype=float), part, {})
-
-
-def contiguous_parts(signals, folds: int) -> np.ndarray:
-    """Per data sample, its part 0 .. folds - 1: contiguous stretches of equal duration. Held-out
-    parts are other stretches of motion, not samples interleaved with the fit (which the fit
-    would predict almost as well as its own, favouring no regularisation)."""
-    T = len(signals.t)
-    k = int(getattr(signals, "trim", 0) or 0)
-    t = signals.t[k:T - k] if 0 < k and 2 * k < T else signals.t
-    u = (t - t[0]) / max(t[-1] - t[0], 1e-300)
-    return np.minimum((u * folds).astype(int), folds - 1)
-
-
-def fill(pieces, labels, smoothing, lags, tilt_values=None) -> None:
-    """Every piece's column values for labels (tilt_values(signals at the kept samples) ->
-    (T, N, 2) for the tilt labels)."""
-    for p in pieces:
-        coulomb = coulomb_matrix(p.signals, smoothing, lags) if any(k == "coulomb" for k, _ in labels) else None
-        tilt = None
-        if any(k == "tilt" for k, _ in labels):
-            tilt = tilt_values(p.signals.q[p.keep])
-        p.columns = {lab: p.column(lab, coulomb, tilt) for lab in labels}
+    def cached(self, key, make):
+        """make(self), computed once per piece (a column that several labels read)."""
+        memo = self.__dict__.setdefault("memo", {})
+        if key not in memo:
+            memo[key] = make(self)
+        return memo[key]

@@ -44,9 +44,10 @@ from ..terms import tilt
 from ..terms.body import armature_identifiable
 from ..terms.friction import SIMPLE_SCALE
 from . import held_out
-from .columns import PER_JOINT, coulomb_matrix, contiguous_parts, fill, group_of, kinds_of, name_of, piece
+from .blocks import Blocks, sources_of, tilt_columns, velocity_limits
+from .columns import PER_JOINT, group_of, kinds_of, name_of
 from .consistent_output import Consistent
-from .normal import Normal, solve_unconstrained
+from .normal import Normal, Swaps, solve_unconstrained
 from .identify_options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
 from .solver import Solver
 from .statistics import estimate
@@ -55,40 +56,44 @@ from .statistics import estimate
 # step 2: the Coulomb term's smoothing and lag
 
 
-def _coulomb_search(normal, pieces, fit, grid, make, tolerance: float):
-    """Per joint, the value of grid whose Coulomb column (make(piece, value) -> (T, N) at the
-    kept samples) leaves joint j the least unconstrained residual on the fit parts; a value must
-    beat the one before by `tolerance` (relative). Returns (choice per joint, normal with it)."""
-    labels = normal.labels
-    ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
+def _coulomb_search(normal, trials, fit, grid, tolerance: float):
+    """Per joint, the value of grid whose trial (normal with every Coulomb column at that value:
+    Swaps) leaves joint j the least unconstrained residual on the fit parts; a value must beat
+    the one before by `tolerance` (relative). Joint j's normal equations with its choice are
+    those of the trial of that value (a joint's Coulomb column meets its own rows only).
+    Returns (choice per joint, normal with it)."""
     n = normal.n[fit].sum(axis=0)
-    best, choice = np.full(normal.dof, np.inf), np.full(normal.dof, grid[0], dtype=float)
-    for value in grid:
-        columns = {id(p): make(p, value) for p in pieces}
-        trial = normal.replaced(pieces, {k: (lambda p, j=labels[k][1]: columns[id(p)][:, j]) for k in ks})
+    best, choice, which = np.full(normal.dof, np.inf), np.full(normal.dof, grid[0], dtype=float), np.zeros(normal.dof, int)
+    for i, (value, trial) in enumerate(zip(grid, trials)):
         x = solve_unconstrained(*trial.total(fit))
         ms = trial.sse(x, fit).sum(axis=0) / np.maximum(n, 1)
         better = ms < best * (1 - tolerance)
-        best[better], choice[better] = ms[better], value
-    columns = {id(p): make(p, choice) for p in pieces}
-    return choice, normal.replaced(pieces, {k: (lambda p, j=labels[k][1]: columns[id(p)][:, j]) for k in ks})
+        best[better], choice[better], which[better] = ms[better], value, i
+    return choice, Normal.per_joint([trials[i] for i in which])
 
 
-def _coulomb(pieces, normal, fit, options, dof):
-    """(smoothing, lags, normal): chosen per joint on the fit data unless given."""
-    def at(smoothing, lags):
-        return lambda p, value: coulomb_matrix(p.signals, np.broadcast_to(smoothing(value), (dof,)),
-                                               np.broadcast_to(lags(value), (dof,)))[p.keep]
+def _at(dof, smoothing, lags):
+    """make(piece, value): the piece's Coulomb columns at smoothing(value), lags(value)."""
+    return lambda p, value: p.coulomb(np.broadcast_to(smoothing(value), (dof,)), np.broadcast_to(lags(value), (dof,)))
 
+
+def _coulomb(blocks, normal, fit, options, dof, swaps=None):
+    """(smoothing, lags, normal): chosen per joint on the fit data unless given (swaps: the
+    smoothing grid's trials, summed in the normal equations' pass); the blocks' settings follow
+    the choice."""
     smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
-    if not any(kind == "coulomb" for kind, _ in normal.labels):
+    ks = [k for k, (kind, _) in enumerate(normal.labels) if kind == "coulomb"]
+    if not ks:
         return smoothing, lags, normal
-    if options.smoothing is None:
-        smoothing, normal = _coulomb_search(normal, pieces, fit, SMOOTHING_GRID, at(lambda v: v, lambda v: 0.0), 0.0)
+    if swaps is not None:
+        smoothing, normal = _coulomb_search(normal, swaps.normals(normal), fit, SMOOTHING_GRID, 0.0)
+        blocks.smoothing = smoothing
     if options.friction_lag:
-        fixed = smoothing.copy()
-        lags, normal = _coulomb_search(normal, pieces, fit, LAG_GRID, at(lambda v: fixed, lambda v: v), 1e-3)
+        make = _at(dof, lambda v: smoothing, lambda v: v)
+        trials = normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID])
+        lags, normal = _coulomb_search(normal, trials, fit, LAG_GRID, 1e-3)
+        blocks.lags = lags
     return smoothing, lags, normal
 
 
@@ -128,8 +133,9 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
                         select=None) -> Consistent:
     """robot: description (bounds, total mass, nominal, velocity limits, gravity); model:
     runtime.load of its generated folder `folder` (which holds <robot>_extract.cpp); signals_list:
-    conditioned recordings with torques to fit; select: recordings to make the held-out choices
-    on (default: cross-validation over contiguous parts of the fit recordings)."""
+    conditioned recordings with torques to fit, or blocks.Source (a file read in blocks); select:
+    the same, to make the held-out choices on (default: cross-validation over contiguous parts of
+    the fit recordings)."""
     options = options or ConsistentOptions()
     if options.friction_bound not in BOUNDS:
         raise ValueError(f"friction_bound {options.friction_bound!r}: expected one of {', '.join(BOUNDS)}")
@@ -145,10 +151,11 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     g_vec = tilt.gravity_of(robot)
     tilt_mode = options.tilt if options.tilt is not None else ("auto" if "tilt" in options.candidates else False)
     with_tilt = bool(tilt_mode) and prior is not None and g_vec is not None
-    rows = dof * sum(len(s.t) - 2 * int(getattr(s, "trim", 0) or 0) for s in signals_list)
+    sources, select_sources = sources_of(signals_list, options.block_rows), sources_of(select or [], options.block_rows)
+    rows = dof * sum(s.rows for s in sources)
     unknowns = r + len(kinds_of(options.friction)) * dof
     if rows <= 2 * unknowns:  # before anything is compiled or solved
-        raise InputError(", ".join(s.name for s in signals_list), "",
+        raise InputError(", ".join(s.name for s in sources), "",
                          f"under-determined: {rows} equations for {unknowns} coefficients and friction values; "
                          f"record at least {2 * unknowns // dof + 1} samples (many more, on an exciting trajectory, "
                          "for a usable estimate)")
@@ -157,16 +164,18 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
 
     # 1. regressor, columns and normal equations per part and joint
     folds = max(2, int(options.folds))
-    pieces = [piece(model, s, contiguous_parts(s, folds)) for s in signals_list]
-    pieces += [piece(model, s, folds) for s in (select or [])]
     parts = folds + (1 if select else 0)
     fit = list(range(folds))
     smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
-    fill(pieces, labels, smoothing0, np.zeros(dof), lambda q: tilt.rotation_columns(robot, prior, q, g_vec))
-    normal = Normal.build(pieces, labels, r, parts, dof)
-
-    # 2. the Coulomb term
-    smoothing, lags, normal = _coulomb(pieces, normal, fit, options, dof)
+    blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
+                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), tilt_columns(g_vec))
+    ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
+    swaps = None  # 2. the Coulomb term's smoothing: every value of its grid summed in the same pass
+    if ks and options.smoothing is None:
+        make = _at(dof, lambda v: v, lambda v: 0.0)
+        swaps = Swaps(labels, r, parts, dof, ks, [lambda p, v=v: make(p, v) for v in SMOOTHING_GRID])
+    normal = Normal.build(blocks, labels, r, parts, dof, swaps.add if swaps else None)
+    smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof, swaps)
 
     # 3. noise per joint, weights; columns the data cannot separate
     n_fit = normal.n[fit].sum(axis=0)
@@ -181,7 +190,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     active = [k for k in range(len(labels)) if k not in drop]
 
     # 4. lambda; 5. optional groups
-    solver = Solver(robot, model, folder, options, r, velocity_limits(robot, signals_list), prior)
+    solver = Solver(robot, model, folder, options, r, velocity_limits(robot, sources), prior)
     workers = options.workers or min(2, os.cpu_count() or 1)
     splits = held_out.Folds.make(parts, bool(select), weights)
     # joints whose friction may fall with speed (a candidate, or all with friction_bound "dissipative")
@@ -204,14 +213,14 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
 
     # 6. the consistent fit on all fit data
     notes = []
-    result, x, rounds, normal, active = _final(solver, normal, pieces, fit, weights, active, cone, lam, robot, prior,
+    result, x, rounds, normal, active = _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior,
                                                g_vec, notes, dropped)
     final_labels = [labels[k] for k in active]
     keep = np.r_[np.arange(r), r + np.asarray(active, dtype=int)]
 
     # 7. statistics of the same columns
     column_names = names + [name_of(lab) for lab in final_labels]
-    ols = estimate(normal, fit, weights, pieces, column_names, keep, dof)
+    ols = estimate(normal, fit, weights, blocks, column_names, keep, dof)
     rms = np.sqrt(normal.sse(x, fit, keep).sum(axis=0) / np.maximum(n_fit, 1))
     ols_rms = np.sqrt(normal.sse(ols.values, fit, keep).sum(axis=0) / np.maximum(n_fit, 1))
 
@@ -255,7 +264,7 @@ def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam,
     return sorted(out), out_cone, decisions
 
 
-def _final(solver, normal, pieces, fit, weights, active, cone, lam, robot, prior, g_vec, notes, dropped):
+def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior, g_vec, notes, dropped):
     """Step 6: the consistent fit on all fit data; a tilt refitted as a rotation (the shortening
     along gravity at the estimate), refused (and the fit redone without it) beyond
     tilt.MAX_TILT_DEG. The tilt's torques are those of the prior's links: a horizontal gravity
@@ -274,9 +283,10 @@ def _final(solver, normal, pieces, fit, weights, active, cone, lam, robot, prior
     tilt_at = [i for i, k in enumerate(active) if labels[k][0] == "tilt"]
     if tilt_at:
         a = x[r + np.asarray(tilt_at)]
-        rotation = {id(p): tilt.rotation_columns(robot, prior, p.signals.q[p.keep], g_vec, a) for p in pieces}
-        normal = normal.replaced(pieces, {k: (lambda p, d=d: rotation[id(p)][..., d])
-                                          for k, d in zip([active[i] for i in tilt_at], range(2))})
+        rotation = tilt_columns(g_vec, a)  # the estimate's columns from here on (the statistics' pass reads them)
+        normal, = normal.replaced(blocks, {k: (lambda p, d=d: p.cached("rotation", lambda p: rotation(p.gravity))[..., d])
+                                           for k, d in zip([active[i] for i in tilt_at], range(2))})
+        blocks.tilt = rotation
         x, rounds, result = fit_with(active)
         a = x[r + np.asarray(tilt_at)]
         if tilt.angle_deg(g_vec, a) > tilt.MAX_TILT_DEG:
@@ -286,13 +296,3 @@ def _final(solver, normal, pieces, fit, weights, active, cone, lam, robot, prior
             active = [k for k in active if labels[k][0] != "tilt"]
             x, rounds, result = fit_with(active)
     return result, x, rounds, normal, active
-
-
-def velocity_limits(robot, signals_list) -> np.ndarray:
-    """V_j: the YAML's velocity limit, or else 1.5 times the largest |qd_j| in the data."""
-    seen = np.max(np.vstack([np.abs(s.qd) for s in signals_list]), axis=0)
-    out = []
-    for j, joint in enumerate(robot.joints):
-        lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
-        out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
-    return np.array(out, dtype=float)

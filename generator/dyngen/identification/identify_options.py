@@ -64,4 +64,5 @@ class ConsistentOptions:
     friction_lag: bool = True  # Coulomb term follows the velocity with a per-joint lag from LAG_GRID
     friction_bound: str = "viscous"  # "viscous": Fc, Fv >= 0 but where "falling" is chosen; "dissipative":
     # Fc + Fv v_max >= 0 on every joint (solver.py)
+    block_rows: int = 8192  # samples per block of a recording held whole (blocks.py)
     workers: int = 0  # driver runs at once in the cross-validation (0: up to 2, as the cores allow)

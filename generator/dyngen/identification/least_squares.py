@@ -36,26 +36,34 @@ class Estimate:
 
 
 def fit(A: np.ndarray, b: np.ndarray, names: list[str], weak: float = WEAK) -> Estimate:
-    A = np.asarray(A, dtype=float)
-    b = np.asarray(b, dtype=float)
-    rows, cols = A.shape
+    """The fit of the rows [A | b], through their triangular factor (fit_factor): the same
+    computation as the rows accumulated block by block (identification/triangular.py)."""
+    rows = np.column_stack([np.asarray(A, dtype=float), np.asarray(b, dtype=float)])
+    return fit_factor(rows if rows.shape[0] < rows.shape[1] else np.linalg.qr(rows, mode="r"), rows.shape[0], names,
+                      weak)
+
+
+def fit_factor(R: np.ndarray, rows: int, names: list[str], weak: float = WEAK) -> Estimate:
+    """The fit of `rows` rows whose [A | b] has the triangular factor R (R^T R = [A b]^T [A b]):
+    the singular values and right singular vectors of A are those of R's first c columns, U^T b
+    comes through its last column, the residual |b - A x| is |R (x, -1)|."""
+    c = R.shape[1] - 1
+    A, b = R[:, :c], R[:, c]
     norms = np.linalg.norm(A, axis=0)
     scale = np.where(norms > 0, norms, 1.0)
     U, sv, Vt = np.linalg.svd(A / scale, full_matrices=False)
     strong = sv > weak * sv[0]
     # Minimum-norm solution in the scaled variables over the excited directions only.
-    x_scaled = Vt[strong].T @ ((U[:, strong].T @ b) / sv[strong])
-    x = x_scaled / scale
-    residual = b - A @ x
-    dof = max(rows - int(strong.sum()), 1)
-    sigma2 = float(residual @ residual) / dof
+    x = Vt[strong].T @ ((U[:, strong].T @ b) / sv[strong]) / scale
+    sse = float(np.sum((R @ np.r_[x, -1.0]) ** 2))
+    sigma2 = sse / max(rows - int(strong.sum()), 1)
     loading = (Vt[~strong] ** 2).sum(axis=0)  # share of each coefficient in the weak directions
-    unexcited = [k for k in range(cols) if loading[k] > 0.5 or norms[k] == 0]
+    unexcited = [k for k in range(c) if loading[k] > 0.5 or norms[k] == 0]
     cov_scaled = (Vt[strong].T / sv[strong] ** 2) @ Vt[strong]
     std = np.sqrt(sigma2 * np.diag(cov_scaled)) / scale
     std[unexcited] = np.inf
     raw = np.linalg.svd(A, compute_uv=False)
     condition = float(raw[0] / raw[-1]) if raw[-1] > 0 else float("inf")
     scaled_condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
-    return Estimate(list(names), x, std, condition, scaled_condition, float(np.sqrt(np.mean(residual ** 2))),
-                    rows, unexcited)
+    return Estimate(list(names), x, std, condition, scaled_condition, float(np.sqrt(sse / max(rows, 1))), rows,
+                    unexcited)

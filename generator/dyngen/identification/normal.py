@@ -55,9 +55,12 @@ class Normal:
         self.n = np.zeros((parts, dof))
 
     @classmethod
-    def build(cls, pieces, labels, r: int, parts: int, dof: int) -> "Normal":
+    def build(cls, pieces, labels, r: int, parts: int, dof: int, each=None) -> "Normal":
+        """each(piece): also called on every piece (another sum of the same pass)."""
         out = cls(r, labels, parts, dof)
         for piece in pieces:
+            if each is not None:
+                each(piece)
             for j in range(dof):
                 ks = local_labels(labels, j)
                 idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]
@@ -71,26 +74,51 @@ class Normal:
                     out.n[p, j] += bm.size
         return out
 
-    def replaced(self, pieces, changes: dict) -> "Normal":
-        """A copy in which label k's column is values(piece) ((T,) or (T, N), as piece.columns)
-        for every k: values of changes (the pieces' columns are updated)."""
+    def replaced(self, pieces, *variants: dict) -> list["Normal"]:
+        """Copies, one per variant, in which label k's column is values(piece) ((T,) or (T, N),
+        as piece.columns) for every k: values of the variant; all of them in one pass over the
+        pieces (blocks.py: a pass reads the recordings again)."""
+        outs = []
+        for changes in variants:
+            out = Normal.__new__(Normal)
+            out.r, out.labels, out.dof = self.r, self.labels, self.dof
+            out.G, out.g, out.bb, out.n = self.G.copy(), self.g.copy(), self.bb, self.n
+            for k in changes:
+                i = self.r + k
+                out.G[:, :, i, :] = out.G[:, :, :, i] = 0.0
+                out.g[:, :, i] = 0.0
+            outs.append(out)
+        for piece in pieces:
+            columns = piece.columns
+            for out, changes in zip(outs, variants):
+                piece.columns = dict(columns)
+                piece.columns.update({self.labels[k]: values(piece) for k, values in changes.items()})
+                for at, k in enumerate(changes):  # a cross term of two changed labels: added by the first
+                    label = self.labels[k]
+                    for j in (range(self.dof) if label[0] == "tilt" else [label[1]]):
+                        out._row(piece, j, k, set(list(changes)[:at]))
+        return outs
+
+    def swapped(self, pieces, ks, makes) -> list["Normal"]:
+        """replaced() for the Coulomb searches (Swaps), in one pass over the pieces."""
+        swaps = Swaps(self.labels, self.r, self.G.shape[0], self.dof, ks, makes)
+        for piece in pieces:
+            swaps.add(piece)
+        return swaps.normals(self)
+
+    @classmethod
+    def per_joint(cls, normals: list) -> "Normal":
+        """Joint j's blocks from normals[j] (each differs from the others in joint columns only)."""
         out = Normal.__new__(Normal)
-        out.r, out.labels, out.dof = self.r, self.labels, self.dof
-        out.G, out.g, out.bb, out.n = self.G.copy(), self.g.copy(), self.bb, self.n
-        for k, values in changes.items():  # one after the other: each row meets the columns as they are now
-            i = self.r + k
-            out.G[:, :, i, :] = out.G[:, :, :, i] = 0.0
-            out.g[:, :, i] = 0.0
-            label = self.labels[k]
-            joints = range(self.dof) if label[0] == "tilt" else [label[1]]
-            for piece in pieces:
-                piece.columns[label] = values(piece)
-                for j in joints:
-                    out._row(piece, j, k)
+        first = normals[0]
+        out.r, out.labels, out.dof, out.bb, out.n = first.r, first.labels, first.dof, first.bb, first.n
+        out.G = np.stack([m.G[:, j] for j, m in enumerate(normals)], axis=1)
+        out.g = np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1)
         return out
 
-    def _row(self, piece, j: int, k: int) -> None:
-        """Adds label k's row and column of joint j's blocks (zero before) from the piece."""
+    def _row(self, piece, j: int, k: int, done=()) -> None:
+        """Adds label k's row and column of joint j's blocks (zero before) from the piece, but
+        the cross terms with the labels `done` (added already)."""
         i = self.r + k
         ks = local_labels(self.labels, j)
         idx = self.r + np.asarray(ks, dtype=int)
@@ -99,7 +127,7 @@ class Normal:
         for p, sl in segments(piece.part):
             cs = c[sl]
             cross_y = piece.Yj[j][sl].T @ cs
-            cross_f = np.array([o[sl] @ cs for o in others])
+            cross_f = np.array([0.0 if kk in done else o[sl] @ cs for kk, o in zip(ks, others)])
             for G in (self.G[p, j][:, i], self.G[p, j][i, :]):
                 G[:self.r] += cross_y
                 G[idx] += cross_f
@@ -124,6 +152,45 @@ class Normal:
             x = full
         G, g, bb = self.G[parts], self.g[parts], self.bb[parts]
         return np.maximum(bb - 2 * np.einsum("pja,a->pj", g, x) + np.einsum("pjab,a,b->pj", G, x, x), 0.0)
+
+
+class Swaps:
+    """The Coulomb searches' variants: one label per joint (ks, each its joint's own), variant
+    v's columns those of makes[v](piece) (T, N), summed piece by piece (each joint's variants in
+    one matrix product per block, the other columns as they are); normals(base): per variant,
+    base with those labels' rows and columns replaced (what replaced() would give)."""
+
+    def __init__(self, labels, r: int, parts: int, dof: int, ks, makes):
+        self.labels, self.r, self.ks, self.makes = labels, r, ks, makes
+        self.rows = np.zeros((len(makes), parts, dof, r + len(labels)))
+        self.g = np.zeros((len(makes), parts, dof))
+
+    def add(self, piece) -> None:
+        values = [make(piece) for make in self.makes]
+        for k in self.ks:
+            j = self.labels[k][1]
+            local = local_labels(self.labels, j)
+            idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int)]
+            F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local])
+            C = np.column_stack([v[:, j] for v in values])
+            for p, sl in segments(piece.part):
+                cross = np.vstack([piece.Yj[j][sl].T @ C[sl], F[sl].T @ C[sl]])  # (columns, variants)
+                cross[self.r + local.index(k)] = (C[sl] ** 2).sum(axis=0)
+                self.rows[:, p, j, idx] += cross.T
+                self.g[:, p, j] += C[sl].T @ piece.tau[sl, j]
+
+    def normals(self, base: Normal) -> list:
+        outs = []
+        for v in range(len(self.makes)):
+            out = Normal.__new__(Normal)
+            out.r, out.labels, out.dof = base.r, base.labels, base.dof
+            out.G, out.g, out.bb, out.n = base.G.copy(), base.g.copy(), base.bb, base.n
+            for k in self.ks:
+                j, i = self.labels[k][1], self.r + k
+                out.G[:, j, i, :] = out.G[:, j, :, i] = self.rows[v, :, j]
+                out.g[:, j, i] = self.g[v, :, j]
+            outs.append(out)
+        return outs
 
 
 def solve_unconstrained(G, g, weak: float = WEAK) -> np.ndarray:

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..catalogue import REGRESSORS
 from ..errors import InputError
-from .least_squares import Estimate, fit
+from .least_squares import Estimate, fit_factor
+from .triangular import Triangular
 
 REGRESSOR = {kind: f.name for kind, f in REGRESSORS.items()}
 
@@ -23,38 +24,42 @@ def stacked_inertia_columns(manifest) -> list[str]:
     return list(manifest["stacked_inertia_order"])
 
 
-def stacked(model, signals: list, kind: str) -> tuple[np.ndarray, np.ndarray]:
-    """(A, b): the regressor rows of every sample of every recording, and the measurements."""
-    if kind not in REGRESSOR:
-        raise ValueError(f"unknown kind {kind!r}; expected one of {', '.join(REGRESSOR)}")
-    blocks, values = [], []
-    for s in signals:
-        if kind == "gravity":
-            Y, b = model.batch(REGRESSOR[kind], s.q), s.tau
-        elif kind == "inertia":
-            names = stacked_inertia_columns(model.manifest)
-            missing = [c for c in names if c not in s.extra]
-            if missing:
-                raise InputError(s.name, "line 1 (header)", f"missing column(s) {', '.join(missing)} "
-                                 "(stacked inertia matrix, needed for --kind inertia)")
-            Y, b = model.batch(REGRESSOR[kind], s.q), np.column_stack([s.extra[c] for c in names])
-        else:
-            Y, b = model.batch(REGRESSOR[kind], s.q, s.qd, s.qdd), s.tau
-        blocks.append(Y.reshape(-1, Y.shape[-1]))
-        values.append(np.asarray(b).reshape(-1))
-    return np.vstack(blocks), np.concatenate(values)
+def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray, np.ndarray]:
+    """(Y (T, m, c), b (T, m)): the regressor rows and measurements of T samples, m rows each,
+    as identification.samples.stacked orders them."""
+    if kind == "gravity":
+        return model.batch(REGRESSOR[kind], q), tau
+    if kind == "inertia":
+        names = stacked_inertia_columns(model.manifest)
+        return model.batch(REGRESSOR[kind], q), np.column_stack([extra[c] for c in names])
+    return model.batch(REGRESSOR[kind], q, qd, qdd), tau
 
 
 def identify(model, signals: list, kind: str) -> Estimate:
-    A, b = stacked(model, signals, kind)
+    """The least-squares fit of every sample of the conditioned recordings: their rows folded
+    into per-joint triangular factors as `dyngen identify --ols` folds its blocks
+    (streaming/step.py, identification/triangular.py), then least_squares.fit_factor."""
+    if kind not in REGRESSOR:
+        raise ValueError(f"unknown kind {kind!r}; expected one of {', '.join(REGRESSOR)}")
     names = [e["standard"] for e in model.manifest["coefficients"][kind]["expressions"]]
     files = ", ".join(s.name for s in signals)
-    if A.shape[0] <= A.shape[1]:
-        per_sample = A.shape[0] // max(sum(len(s.t) for s in signals), 1) or 1
-        raise InputError(files, "", f"under-determined: {A.shape[0]} equations for {A.shape[1]} {kind} "
-                         f"coefficients; record at least {A.shape[1] // per_sample + 1} samples (many more, "
+    factors = None
+    for s in signals:
+        if kind == "inertia":
+            missing = [c for c in stacked_inertia_columns(model.manifest) if c not in s.extra]
+            if missing:
+                raise InputError(s.name, "line 1 (header)", f"missing column(s) {', '.join(missing)} "
+                                 "(stacked inertia matrix, needed for --kind inertia)")
+        Y, b = regressor_rows(model, kind, s.q, s.qd, s.qdd, s.tau, s.extra)
+        factors = factors or Triangular(Y.shape[-1], Y.shape[1])
+        factors.add(Y, b)
+    rows = int(factors.rows.sum())
+    if rows <= factors.c:
+        per_sample = factors.dof
+        raise InputError(files, "", f"under-determined: {rows} equations for {factors.c} {kind} "
+                         f"coefficients; record at least {factors.c // per_sample + 1} samples (many more, "
                          "on an exciting trajectory, for a usable estimate)")
     try:
-        return fit(A, b, names)
+        return fit_factor(factors.factor(), rows, names)
     except np.linalg.LinAlgError as err:
         raise InputError(files, "", f"least squares failed ({err}); check the recordings for extreme values") from None

@@ -26,52 +26,110 @@ textbook deviation.
 from __future__ import annotations
 
 import numpy as np
+from scipy import signal
 
-from ..data.correlation import integrated_time
 from .least_squares import WEAK, Estimate
-from .normal import joint_design, local_labels
 
 BLOCK_TIMES = 20  # block length in integrated autocorrelation times of the residual
 MIN_BLOCKS = 10
+LAGS = 2048  # autocorrelation lags kept per recording and joint (the correlation time's sum)
+
+
+def _label_matrix(piece, labels, dof) -> np.ndarray:
+    """(T, N, L): every label's column in every joint's rows (zero where it does not enter)."""
+    out = np.zeros((piece.tau.shape[0], dof, len(labels)))
+    for k, label in enumerate(labels):
+        v = piece.columns[label]
+        if v.ndim == 2:
+            out[:, :, k] = v
+        else:
+            out[:, label[1], k] = v
+    return out
 
 
 def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int) -> list:
     """Per piece (T, N): measured less fitted torque for the values x of the columns keep."""
     full = np.zeros(r + len(labels))
     full[keep] = x
-    out = []
-    for piece in pieces:
-        e = piece.tau.copy()
-        for j in range(dof):
-            ks = local_labels(labels, j)
-            e[:, j] -= joint_design(piece, labels, j, ks) @ full[np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]]
-        out.append(e)
-    return out
+    return [piece.tau - np.einsum("jtr,r->tj", piece.Yj, full[:r]) - _label_matrix(piece, labels, dof) @ full[r:]
+            for piece in pieces]
 
 
-def _scores(pieces, labels, r, keep, weights, res, length: int, dof: int) -> np.ndarray:
-    """(blocks, len(keep)): per contiguous block of `length` samples of each piece, sum_t a_t w e_t."""
-    c = r + len(labels)
-    out = []
-    for piece, e in zip(pieces, res):
-        T = e.shape[0]
-        starts = np.arange(0, T - length + 1, length)
-        if starts.size == 0:
-            continue
-        s = np.zeros((starts.size, c))
-        for j in range(dof):
-            ks = local_labels(labels, j)
-            idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]
-            A = joint_design(piece, labels, j, ks)[:starts[-1] + length]
-            weighted = A * (weights[j] ** 2 * e[:starts[-1] + length, j])[:, None]
-            s[:, idx] += np.add.reduceat(weighted, starts, axis=0)
-        out.append(s[:, keep])
-    return np.vstack(out) if out else np.zeros((0, len(keep)))
+class _Correlation:
+    """data.correlation.integrated_time of a series given a block at a time: the lag products
+    up to LAGS, the sum, the first and last LAGS values. The same number wherever rho first
+    drops below 0.05 within LAGS samples (else the sum stops at LAGS)."""
+
+    def __init__(self):
+        self.n, self.total = 0, 0.0
+        self.products = np.zeros(LAGS + 1)
+        self.head, self.tail = np.zeros(0), np.zeros(0)
+
+    def add(self, x: np.ndarray) -> None:
+        z = np.r_[np.zeros(LAGS - self.tail.size), self.tail, x]
+        self.products += signal.correlate(z, x, mode="valid")[::-1]  # [k]: sum_t x_t x_(t-k), t in this block
+        self.n, self.total = self.n + x.size, self.total + float(x.sum())
+        self.head = np.r_[self.head, x[:LAGS + 1 - self.head.size]]
+        self.tail = np.r_[self.tail, x][-LAGS:]
+
+    def time(self) -> float:
+        n = self.n
+        if n < 4:
+            return 1.0
+        m, lags = self.total / n, min(n - 1, LAGS)
+        k = np.arange(lags + 1)
+        last = np.r_[0.0, np.cumsum(self.tail[::-1])][k]  # sums of the last k and the first k values
+        first = np.r_[0.0, np.cumsum(self.head)][k]
+        acf = self.products[k] - m * (2 * self.total - last - first) + (n - k) * m * m
+        if not acf[0] > 1e-24 * max(self.products[0], 1e-300):
+            return 1.0
+        rho = acf / acf[0]
+        limit = min(lags, n // 4)
+        below = np.flatnonzero(rho[1:limit + 1] < 0.05)
+        stop = below[0] + 1 if below.size else limit + 1
+        return float(max(1.0, 1.0 + 2.0 * rho[1:stop].sum()))
 
 
-def estimate(normal, parts, weights, pieces, names, keep, dof: int) -> Estimate:
+def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
+    """(T, c): per sample, sum over joints of a_t w_j^2 e_t (the fit's scores)."""
+    we = weights ** 2 * e
+    return np.hstack([np.einsum("jtr,tj->tr", piece.Yj, we), np.einsum("tjk,tj->tk", _label_matrix(piece, labels, dof), we)])
+
+
+def _score_blocks(blocks, parts, labels, r, x, keep, weights, length: int, dof: int):
+    """(sum over blocks of s s^T, count): s the scores (columns keep) of a contiguous block of
+    `length` samples of a recording, counted from its first data sample (a last, shorter
+    block is left out)."""
+    S, count = np.zeros((len(keep), len(keep))), 0
+    current, index, open_sum = None, -1, None
+
+    def close():
+        nonlocal S, count
+        if open_sum is not None and (index + 1) * length <= current.rows:
+            s = open_sum[keep]
+            S, count = S + np.outer(s, s), count + 1
+
+    for piece in blocks.fit_only(parts):
+        if piece.source is not current:
+            close()
+            current, index, open_sum = piece.source, -1, None
+        e = residuals([piece], labels, r, x, keep, dof)[0]
+        at = (piece.start + np.arange(e.shape[0])) // length
+        starts = np.r_[0, np.flatnonzero(np.diff(at)) + 1]
+        for number, part in zip(at[starts], np.add.reduceat(_score_rows(piece, labels, r, weights, e, dof), starts)):
+            if number == index:
+                open_sum = open_sum + part
+            else:
+                close()
+                index, open_sum = number, part
+    close()
+    return S, count
+
+
+def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     """The weighted unconstrained fit of the columns keep (indices into coefficients, then
-    labels) on the given parts, with standard deviations as above."""
+    labels) on the given parts, with standard deviations as above; two passes over the fit
+    recordings' blocks (blocks.py): the residuals' size and correlation time, then the scores."""
     G, g = normal.total(parts, weights, keep)
     cols = len(keep)
     norms = np.sqrt(np.maximum(np.diag(G), 0.0))
@@ -83,18 +141,20 @@ def estimate(normal, parts, weights, pieces, names, keep, dof: int) -> Estimate:
     inverse = (V[:, strong] / ev[strong]) @ V[:, strong].T / np.outer(scale, scale)  # H^-1 on the excited directions
     x = inverse @ g
     rows = int(normal.n[parts].sum())
-    fit_pieces = [p for p in pieces if np.isin(p.part, parts).all()]
-    res = residuals(fit_pieces, normal.labels, normal.r, x, keep, dof)
-    weighted = np.concatenate([(e * weights).reshape(-1) for e in res])
-    sigma2 = float(weighted @ weighted) / max(rows - int(strong.sum()), 1)
+    labels, r = normal.labels, normal.r
+    sse, correlation = 0.0, {}
+    for piece in blocks.fit_only(parts):
+        e = residuals([piece], labels, r, x, keep, dof)[0]
+        sse += float(((e * weights) ** 2).sum())
+        for j in range(dof):
+            correlation.setdefault((id(piece.source), j), _Correlation()).add(e[:, j])
+    sigma2 = sse / max(rows - int(strong.sum()), 1)
     textbook = np.sqrt(np.maximum(sigma2 * np.diag(inverse), 0.0))
-    times = [integrated_time(e[:, j]) for e in res for j in range(dof) if e.shape[0] > 8]
+    times = [c.time() for c in correlation.values() if c.n > 8]
     tau = max(times) if times else 1.0
-    length = int(np.ceil(BLOCK_TIMES * tau))
-    scores = _scores(fit_pieces, normal.labels, normal.r, keep, weights, res, length, dof)
-    if scores.shape[0] >= MIN_BLOCKS:
-        sandwich = np.einsum("ab,kb->ka", inverse, scores)
-        std = np.maximum(np.sqrt((sandwich ** 2).sum(axis=0)), textbook)
+    S, count = _score_blocks(blocks, parts, labels, r, x, keep, weights, int(np.ceil(BLOCK_TIMES * tau)), dof)
+    if count >= MIN_BLOCKS:
+        std = np.maximum(np.sqrt(np.maximum(np.diag(inverse @ S @ inverse), 0.0)), textbook)
     else:
         std = textbook * np.sqrt(tau)
     loading = (V[:, ~strong].T ** 2).sum(axis=0)
@@ -103,4 +163,4 @@ def estimate(normal, parts, weights, pieces, names, keep, dof: int) -> Estimate:
     raw = np.sqrt(np.maximum(np.linalg.eigvalsh(G), 0.0))
     condition = float(raw[-1] / raw[0]) if raw[0] > 0 else float("inf")
     scaled = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
-    return Estimate(list(names), x, std, condition, scaled, float(np.sqrt(np.mean(weighted ** 2))), rows, unexcited)
+    return Estimate(list(names), x, std, condition, scaled, float(np.sqrt(sse / max(rows, 1))), rows, unexcited)

@@ -4,7 +4,7 @@ for many recordings of one arm type, is the gap the same on every robot, and whi
 Per recording and joint j, the gap r_j = tau_j - rnea_j(q, qd, qdd; p) with the given link
 parameters p, and the simple model of diagnosis/baseline.py (offset b + Coulomb Fc tanh(qd/0.02)
 + viscous Fv qd, per joint) accumulated as triangular factors of [1, tanh(qd/0.02), qd | r_j]
-(triangular.py): the gap's RMS and mean, and the simple model's fit, each recording's own and
+(identification/triangular.py): the gap's RMS and mean, and the simple model's fit, each recording's own and
 the pooled one, with its residual on every recording, come from 4 x 4 numbers per joint.
 The blocks are conditioned as step.py does (recorded qd, qdd and no filter: blocks; else the
 recording whole, the tanh column through its filter as in diagnosis/baseline.py).
@@ -19,7 +19,7 @@ import numpy as np
 
 from . import engine
 from .step import _local, _model
-from .triangular import fold
+from ..identification.triangular import fold
 
 VELOCITY = 0.02  # rad/s, diagnosis.baseline.VELOCITY: the simple model's tanh scale
 

@@ -17,7 +17,8 @@ import numpy as np
 
 from ..errors import InputError
 from . import engine, step
-from .triangular import Triangular, fit
+from ..identification.least_squares import fit_factor
+from ..identification.triangular import Triangular
 
 STANDS_OUT = 1.5  # a recording differs when the pooled fit's residual on it is this many times the median
 
@@ -66,7 +67,7 @@ def identify_recordings(tasks: list, names: list, workers=None, scheduler=None) 
                          f"at least {total.c // per_sample + 1} samples (many more, on an exciting trajectory, "
                          "for a usable estimate)")
     try:
-        estimate = fit(total.factor(), rows, names)
+        estimate = fit_factor(total.factor(), rows, names)
     except np.linalg.LinAlgError as err:
         raise InputError(", ".join(s.name for s in sums), "", f"least squares failed ({err}); check the recordings "
                          "for extreme values") from None
@@ -79,7 +80,7 @@ def _own(factors: Triangular, names) -> np.ndarray:
     rows = int(factors.rows.sum())
     if rows <= factors.c or len(names) == 0:
         return np.full(factors.dof, np.nan)
-    x = fit(factors.factor(), rows, names).values
+    x = fit_factor(factors.factor(), rows, names).values
     return np.sqrt(factors.sse(x) / np.maximum(factors.rows, 1))
 
 

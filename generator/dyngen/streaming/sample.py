@@ -44,6 +44,50 @@ class Sampled:
         return self.gap is not None
 
 
+class Spread:
+    """Evenly spread windows of blocks (data.Recording) given one at a time, at most max_rows
+    samples in all (the module's rule); windows(name): the recording whole while within the
+    bound, else its windows named <name>@<start>s."""
+
+    def __init__(self, max_rows: int = MAX_ROWS, window: float = WINDOW):
+        self.max_rows, self.window = max_rows, window
+        self.kept: dict[int, list] = {}  # window number -> its pieces
+        self.stride, self.count, self.rows, self.t0, self.t_end = 1, 0, 0, None, None
+
+    def add(self, piece) -> None:
+        if piece.t.size == 0:
+            return
+        self.t0 = float(piece.t[0]) if self.t0 is None else self.t0
+        self.rows += piece.t.size
+        self.t_end = float(piece.t[-1])
+        number = np.floor((piece.t - self.t0) / self.window).astype(int)
+        for w in np.unique(number[number % self.stride == 0]):
+            part = _part(piece, number == w)
+            self.kept.setdefault(int(w), []).append(part)
+            self.count += part.t.size
+        while self.count > self.max_rows and len(self.kept) > 1:  # every other window goes
+            self.stride *= 2
+            for w in [w for w in self.kept if w % self.stride]:
+                self.count -= sum(p.t.size for p in self.kept.pop(w))
+
+    def windows(self, name: str) -> list:
+        kept = [self.kept[w] for w in sorted(self.kept)]
+        if self.rows <= self.max_rows:
+            return [_joined(name, [p for w in kept for p in w])]
+        return [_joined(f"{name}@{w[0].t[0] - self.t0:.0f}s", w) for w in kept]
+
+
+def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window: float = WINDOW) -> list:
+    """The recording whole (within max_rows samples), else its evenly spread windows, read in blocks."""
+    from ..data.chunks import chunks
+
+    spread, name = Spread(max_rows, window), None
+    for block in chunks(path, dof, True, (), 8192, effort_topic):
+        spread.add(block)
+        name = block.name
+    return spread.windows(name)
+
+
 def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> Sampled:
     from ..data.chunks import chunks
 
@@ -52,27 +96,16 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
     local = _local(first, task.conditioning)
     model = _model(task.folder)
     sums = Sums.start(model, task.p, task.dof) if local else None
-    kept: dict[int, list] = {}  # window number -> its pieces
-    stride, count, rows, t0, t_end = 1, 0, 0, float(first.t[0]), float(first.t[0])
+    spread = Spread(max_rows, window)
     for piece in itertools.chain([first], blocks):  # one block at a time, and the windows kept
-        rows += piece.t.size
-        t_end = float(piece.t[-1])
+        spread.add(piece)
         if sums is not None:
             sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
-        number = np.floor((piece.t - t0) / window).astype(int)
-        for w in np.unique(number[number % stride == 0]):
-            part = _part(piece, number == w)
-            kept.setdefault(int(w), []).append(part)
-            count += part.t.size
-        while count > max_rows and len(kept) > 1:  # every other window goes
-            stride *= 2
-            for w in [w for w in kept if w % stride]:
-                count -= sum(p.t.size for p in kept.pop(w))
-    if rows <= max_rows:
-        return Sampled([_joined(first.name, [p for w in sorted(kept) for p in kept[w]])], rows, t_end - t0, None)
+    seconds = spread.t_end - spread.t0
+    if spread.rows <= max_rows:
+        return Sampled(spread.windows(first.name), spread.rows, seconds, None)
     gap = sums.result(first.name, True) if sums is not None else gap_run(task)  # the latter: read whole
-    windows = [_joined(f"{first.name}@{kept[w][0].t[0] - t0:.0f}s", kept[w]) for w in sorted(kept)]
-    return Sampled(windows, rows, t_end - t0, gap)
+    return Sampled(spread.windows(first.name), spread.rows, seconds, gap)
 
 
 def _part(r, mask):

@@ -1,6 +1,6 @@
 """The per-recording step of identification by least squares: read one recording in blocks,
 evaluate the generated regressor on each block and fold its rows into per-joint triangular
-factors (triangular.py). What it returns is (c+1)^2 numbers per joint, whatever the
+factors (identification/triangular.py). What it returns is (c+1)^2 numbers per joint, whatever the
 recording's length; the step runs in a worker process or on a Dask worker (engine.py), so its
 task and result are plain picklable data.
 
@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .triangular import Triangular
+from ..identification.samples import regressor_rows
+from ..identification.triangular import Triangular
 
 KINDS = ("full", "gravity", "inertia")
 
@@ -59,19 +60,6 @@ def _local(first, conditioning) -> bool:
 
     return first.qd is not None and first.qdd is not None and not conditioning.differentiate \
         and conditioning.cutoff in (AUTO, None)
-
-
-def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray, np.ndarray]:
-    """(Y (T, m, c), b (T, m)): the regressor rows and measurements of T samples, m rows each,
-    as identification.samples.stacked orders them."""
-    from ..identification.samples import REGRESSOR, stacked_inertia_columns
-
-    if kind == "gravity":
-        return model.batch(REGRESSOR[kind], q), tau
-    if kind == "inertia":
-        names = stacked_inertia_columns(model.manifest)
-        return model.batch(REGRESSOR[kind], q), np.column_stack([extra[c] for c in names])
-    return model.batch(REGRESSOR[kind], q, qd, qdd), tau
 
 
 def run(task: Task) -> Sums:

@@ -10,16 +10,14 @@ R_j holds everything a least-squares fit over those rows needs: the singular val
 singular vectors of A_j (those of R_j's first c columns), U^T b (through R_j's last column) and
 the part of b no x can explain (the last diagonal entry). Factors of several recordings, joints
 or machines stack the same way, so the pooled fit, each recording's own fit and any fit's
-residual on any recording and joint come from these (c+1)^2 numbers. `fit` gives what
-identification.least_squares.fit gives for the stacked rows (the in-memory oracle, equal to
-rounding): values, standard deviations, condition numbers, unexcited coefficients.
+residual on any recording and joint come from these (c+1)^2 numbers: their fit is
+identification.least_squares.fit_factor, which the in-memory fit of the stacked rows also goes
+through (one code path; equal to rounding).
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from ..identification.least_squares import WEAK, Estimate
 
 
 def fold(R: np.ndarray | None, rows: np.ndarray) -> np.ndarray:
@@ -66,28 +64,3 @@ class Triangular:
         """(dof,): each joint's sum of squared residuals |b_j - A_j x|^2."""
         v = np.r_[x, -1.0]
         return np.array([float(np.sum((self._full(j) @ v) ** 2)) for j in range(self.dof)])
-
-
-def fit(R: np.ndarray, rows: int, names: list[str], weak: float = WEAK) -> Estimate:
-    """identification.least_squares.fit of the rows whose [A | b] factor is R."""
-    c = R.shape[1] - 1
-    A, b = R[:, :c], R[:, c]
-    norms = np.linalg.norm(A, axis=0)
-    scale = np.where(norms > 0, norms, 1.0)
-    U, sv, Vt = np.linalg.svd(A / scale, full_matrices=False)
-    strong = sv > weak * sv[0]
-    x_scaled = Vt[strong].T @ ((U[:, strong].T @ b) / sv[strong])
-    x = x_scaled / scale
-    sse = float(np.sum((R @ np.r_[x, -1.0]) ** 2))  # |b - A x|^2 over the original rows
-    dof = max(rows - int(strong.sum()), 1)
-    sigma2 = sse / dof
-    loading = (Vt[~strong] ** 2).sum(axis=0)
-    unexcited = [k for k in range(c) if loading[k] > 0.5 or norms[k] == 0]
-    cov_scaled = (Vt[strong].T / sv[strong] ** 2) @ Vt[strong]
-    std = np.sqrt(sigma2 * np.diag(cov_scaled)) / scale
-    std[unexcited] = np.inf
-    raw = np.linalg.svd(A, compute_uv=False)
-    condition = float(raw[0] / raw[-1]) if raw[-1] > 0 else float("inf")
-    scaled_condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
-    return Estimate(list(names), x, std, condition, scaled_condition, float(np.sqrt(sse / max(rows, 1))),
-                    rows, unexcited)

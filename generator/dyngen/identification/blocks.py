@@ -1,0 +1,227 @@
+"""The consistent identification's recordings, a block of samples at a time (memory of one
+block, not of the recording: the regressor of 3.6 M samples of 7 joints would be 8 GB).
+
+A Source is one recording as the fit reads it, in passes: every pass (the normal equations,
+each search of a column's setting, the statistics) reads its blocks again.
+  - from its file (Source.of_file), when conditioning the recording would use its columns as
+    recorded (qd and qdd recorded, no filter: what streaming/step.py reads in blocks): the
+    blocks are read from the file on every pass;
+  - from conditioned signals held whole (Source.held: positions to differentiate, a zero-phase
+    filter and the automatic cutoff need the whole recording): the blocks are slices of them.
+Both give the same blocks of the same samples (the data samples, the filter's start-up cut),
+so one code path serves a recording of any length; a recording read whole is the in-memory
+computation with blocks of any size (tests/test_consistent_identification.py).
+
+The Coulomb column follows the velocity with a lag (columns.lagged): a block's column is
+computed with the previous block's velocities before it, which is the whole recording's column
+wherever the lag is shorter than a block (LAG_GRID: at most 40 ms).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from ..terms import tilt
+from .columns import Piece, coulomb_matrix
+
+ROWS = 8192  # samples per block (7 joints x 50 regressor columns of them: 23 MB)
+_IDENTIFICATIONS = itertools.count()
+
+
+@dataclass
+class Source:
+    name: str
+    rows: int  # data samples
+    t0: float  # time of the first and last data sample (the contiguous parts)
+    t1: float
+    qd_max: np.ndarray  # (N,) largest |qd|: the velocity limits' default
+    note: str  # what conditioning did
+    warnings: list = field(default_factory=list)
+    signals: object = None  # the conditioned recording, held whole (None: read from `path`)
+    path: str | None = None
+    dof: int = 0
+    effort_topic: str | None = None
+    block_rows: int = ROWS
+    _coulomb: dict = field(default_factory=dict)  # (smoothing, lags) -> whole column, this pass (held)
+    _gravity: dict = field(default_factory=dict)  # the tilt's G(q) per block (held)
+    _parsed: bool = False  # the file's blocks are in the temporary folder
+    _temporary: object = None  # tempfile.TemporaryDirectory: removed with the Source
+
+    @classmethod
+    def held(cls, signals, block_rows: int = ROWS) -> "Source":
+        keep = _kept(signals)
+        t = signals.t[keep]
+        return cls(signals.name, t.size, float(t[0]), float(t[-1]), np.abs(signals.qd).max(axis=0),
+                   getattr(signals, "note", ""), list(getattr(signals, "warnings", [])), signals,
+                   block_rows=block_rows)
+
+    @classmethod
+    def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS) -> "Source":
+        """The file parsed once, its blocks kept for every pass: its length, time span and
+        velocities, and whether it moves and has torques (data.recording.check_informative)."""
+        source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
+                     dof=dof, effort_topic=effort_topic, block_rows=block_rows)
+        first, source.moved, source.torque = None, False, False
+        for block in source._file_blocks():
+            first = first or block
+            source.rows += block.t.size
+            source.qd_max = np.maximum(source.qd_max, np.abs(block.qd).max(axis=0))
+            source.moved = source.moved or bool(np.ptp(np.r_[first.q[:1], block.q], axis=0).max() > 0)
+            source.torque = source.torque or bool(np.any(block.tau))
+        source.name, source.t0, source.t1 = first.name, float(first.t[0]), float(block.t[-1])
+        return source
+
+    def blocks(self):
+        """(signals of the block: t, q, qd, qdd, tau; the block before it or None; its number;
+        index of its first sample among the data samples) per block. A file is parsed on the
+        first pass only: its blocks are kept in a temporary folder for the next passes."""
+        if self.signals is not None:
+            s, keep = self.signals, _kept(self.signals)
+            cut = {k: getattr(s, k)[keep] for k in ("t", "q", "qd", "qdd", "tau")}
+            for number, a in enumerate(range(0, self.rows, self.block_rows)):
+                part = slice(a, a + self.block_rows)
+                yield SimpleNamespace(**{k: v[part] for k, v in cut.items()}), None, number, a
+            return
+        before, start = None, 0
+        for number, block in enumerate(self._file_blocks()):
+            yield block, before, number, start
+            before, start = block, start + block.t.size
+
+    def _file_blocks(self):
+        from ..data.chunks import chunks
+
+        folder = self._folder()
+        if self._parsed:
+            for number in itertools.count():
+                path = os.path.join(folder, f"{number}.npy")
+                if not os.path.exists(path):
+                    return
+                data, n = np.load(path), self.dof
+                yield SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
+                                      qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
+            return
+        for number, block in enumerate(chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic)):
+            np.save(os.path.join(folder, f"{number}.npy"), np.column_stack([block.t, block.q, block.qd, block.qdd,
+                                                                            block.tau]))
+            yield block
+        self._parsed = True
+
+    def gravity(self, number: str, make) -> np.ndarray:
+        """make(), kept in the temporary folder for the next passes (the tilt's G(q): forward
+        kinematics in Python, the slowest part of a block)."""
+        if self.signals is not None:  # held whole: G beside it in memory (3/4 of its signals' size)
+            if number not in self._gravity:
+                self._gravity[number] = make()
+            return self._gravity[number]
+        path = os.path.join(self._folder(), f"gravity{number}.npy")
+        if os.path.exists(path):
+            return np.load(path)
+        out = make()
+        np.save(path, out)
+        return out
+
+    def _folder(self) -> str:
+        if self._temporary is None:
+            self._temporary = tempfile.TemporaryDirectory(prefix="dyngen-blocks-")
+        return self._temporary.name
+
+    def coulomb(self, block, before, start, smoothing, lags) -> np.ndarray:
+        """(T, N): the Coulomb column of the block, as columns.coulomb_matrix of the whole recording."""
+        if self.signals is not None:  # through the recording's own filter: computed whole, once a pass
+            key = (tuple(np.broadcast_to(smoothing, (self.qd_max.size,))), tuple(np.broadcast_to(lags, (self.qd_max.size,))))
+            if key not in self._coulomb:
+                self._coulomb[key] = coulomb_matrix(self.signals, smoothing, lags)[_kept(self.signals)]
+            return self._coulomb[key][start:start + block.t.size]
+        if before is None:
+            return coulomb_matrix(block, smoothing, lags)
+        joined = SimpleNamespace(t=np.r_[before.t, block.t], qd=np.vstack([before.qd, block.qd]))
+        return coulomb_matrix(joined, smoothing, lags)[before.t.size:]
+
+
+def _kept(signals) -> slice:
+    T = len(signals.t)
+    k = int(getattr(signals, "trim", 0) or 0)
+    return slice(k, T - k) if 0 < k and 2 * k < T else slice(0, T)
+
+
+class Blocks:
+    """Pieces (columns.Piece) of every block of every source, their label columns at the current
+    settings (smoothing, lags: per joint; tilt(G) -> (T, N, 2) of gravity(q) -> G (T, N, 3)):
+    iterated once per pass."""
+
+    def __init__(self, model, sources, parts, labels, smoothing, lags, gravity=None, tilt=None):
+        self.model, self.sources, self.parts, self.labels = model, sources, parts, labels
+        self.smoothing, self.lags, self.gravity, self.tilt = smoothing, lags, gravity, tilt
+        self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
+
+    def __iter__(self):
+        """The next block's piece is made in a second thread while this one's is used (reading,
+        the C regressor and NumPy release the GIL: two cores on a pass); the order, and so every
+        sum, is that of one thread."""
+        from concurrent.futures import ThreadPoolExecutor
+
+        def made():
+            for source, part in zip(self.sources, self.parts):
+                source._coulomb.clear()
+                for block, before, number, start in source.blocks():
+                    yield self.piece(source, part, block, before, number, start)
+
+        pieces = made()
+        with ThreadPoolExecutor(1) as pool:
+            ahead = pool.submit(next, pieces, None)
+            while (piece := ahead.result()) is not None:
+                ahead = pool.submit(next, pieces, None)
+                yield piece
+
+    def fit_only(self, parts):
+        """The pieces whose samples are all in `parts` (the fit's, not the --select recordings)."""
+        return (p for p in self if np.isin(p.part, parts).all())
+
+    def piece(self, source, part, block, before, number, start) -> Piece:
+        Y = self.model.batch("regressor", block.q, block.qd, block.qdd)
+        if isinstance(part, int):
+            at = np.full(block.t.size, part, dtype=int)
+        else:  # contiguous stretches of equal duration: parts[0] of them
+            u = (block.t - source.t0) / max(source.t1 - source.t0, 1e-300)
+            at = np.minimum((u * part[0]).astype(int), part[0] - 1)
+        p = Piece(block, slice(None), np.ascontiguousarray(Y.transpose(1, 0, 2)), np.asarray(block.tau, dtype=float),
+                  at, {})
+        p.source, p.start = source, start
+        p.coulomb = lambda smoothing, lags: source.coulomb(block, before, start, smoothing, lags)
+        coulomb = p.coulomb(self.smoothing, self.lags) if any(k == "coulomb" for k, _ in self.labels) else None
+        tilted = None
+        if any(k == "tilt" for k, _ in self.labels):
+            p.gravity = source.gravity(f"{self.token}-{number}", lambda: self.gravity(block.q))
+            tilted = self.tilt(p.gravity)
+        p.columns = {lab: p.column(lab, coulomb, tilted) for lab in self.labels}
+        return p
+
+
+def sources_of(recordings, block_rows: int = ROWS) -> list:
+    """Sources of conditioned signals or of Sources (as they are)."""
+    return [r if isinstance(r, Source) else Source.held(r, block_rows) for r in recordings]
+
+
+def tilt_columns(g_vec, a=(0.0, 0.0)):
+    """G (T, N, 3) -> the tilt's columns linearised at a: tilt.rotation_columns of G."""
+    if g_vec is None:
+        return None
+    D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))
+    return lambda G: tilt.Tilt.columns(G, D[0], D[1], size, a)
+
+
+def velocity_limits(robot, sources) -> np.ndarray:
+    """V_j: the YAML's velocity limit, or else 1.5 times the largest |qd_j| in the data."""
+    seen = np.max(np.vstack([s.qd_max for s in sources]), axis=0)
+    out = []
+    for j, joint in enumerate(robot.joints):
+        lim = joint.limits.velocity if joint.limits is not None and joint.limits.velocity else None
+        out.append(lim if lim is not None else 1.5 * max(seen[j], 1e-3))
+    return np.array(out, dtype=float)
