@@ -15,11 +15,10 @@ import pytest
 from conftest import ROOT
 
 from dyngen.description import load_robot
-from dyngen.diagnosis.effects import Context, Coulomb, Direction, Stribeck, Viscous
-from dyngen.diagnosis.updated_model import friction_vector
 from dyngen.diagnosis.record import Finding
+from dyngen.diagnosis.updated_model import friction_vector
 from dyngen.runtime import load
-from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, friction_torque
+from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, Context, Coulomb, Direction, Stribeck, Viscous, friction_torque
 
 N = 7
 
@@ -109,8 +108,7 @@ def test_one_tilt_for_identify_and_diagnose():
     gravity along -z), and the turned gravity vector keeps its size."""
     from oracles.random_params import random_parameters
 
-    from dyngen.diagnosis.effects import Tilt
-    from dyngen.terms import tilt
+    from dyngen.terms import Tilt, tilt
 
     robot = load_robot(ROOT / "examples" / "lwr.yaml")
     p = random_parameters(7, 3, mass=(0.5, 3.0), second_moment=(0.002, 0.02))

@@ -83,7 +83,7 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
             score = float(design.weights ** 2 @ selection_mse(form_design, form_chosen))
             options.append((score, form_design, form_chosen))
         _, design, chosen = min(options, key=lambda o: o[0])
-        refused.append(refusal)
+        refused.append(Refusal(*refusal))  # what of the term is refused, its values
         return design, chosen, solve(design, chosen)
     return design, chosen, final
 

@@ -165,7 +165,7 @@ def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, 
     """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major:
     identify's default columns (terms.joint_columns), each on its own joint's rows."""
     T, n = q.shape
-    Y = RigidBody.columns(model, q, qd, qdd).reshape(T * n, -1)
+    Y = RigidBody.regressor(model, q, qd, qdd).reshape(T * n, -1)
     cols = []
     for j in range(n):
         for kind in joint_columns.DEFAULT_KINDS:
