@@ -49,8 +49,10 @@ def commands(cases: Path) -> dict:
     m = [str(REAL / f"measurement_{k}.csv") for k in (1, 2, 3)]
     out["diagnose-real-1-3"] = ["diagnose", str(LWR), "--params", paper, *model, "--data", m[0], "--test", m[2],
                                 "--out", "{out}"]
+    every = ("offset,coulomb,viscous,stribeck,direction,ripple,armature,gain,payload,tilt,gravity_scale,time_shift,"
+             "coefficients")
     out["diagnose-real-all-effects"] = ["diagnose", str(LWR), "--params", paper, *model, "--data", m[2],
-                                        "--effects", "offset,coulomb,viscous,stribeck,direction,ripple,armature,gain,payload,tilt,gravity_scale,time_shift,coefficients", "--out", "{out}"]
+                                        "--effects", every, "--out", "{out}"]
     out["identify-real-ols"] = ["identify", str(LWR), *model, "--ols", "--data", m[0], "-o", "{out}/identified.yaml"]
     out["identify-real-consistent"] = ["identify", str(LWR), *model, "--data", m[0], "--prior", paper, "--friction",
                                        "coulomb,viscous,offset,armature,ripple", "--tilt", "-o",
@@ -64,6 +66,8 @@ def commands(cases: Path) -> dict:
     out["excite-lwr"] = ["excite", str(LWR), *model, "--iterations", "8", "-q", "-o", "{out}/excitation.csv"]
     out["excite-lwr-logdet"] = ["excite", str(LWR), *model, "--iterations", "8", "--criterion", "logdet",
                                 "--harmonics", "3", "-q", "-o", "{out}/excitation.csv"]
+    out["excite-lwr-workspace"] = ["excite", str(LWR), *model, "--iterations", "4", "--harmonics", "3",
+                                   "--workspace=-0.6,0.6,-0.6,0.6,0.2,1.2", "-o", "{out}/excitation.csv"]
     return out
 
 
