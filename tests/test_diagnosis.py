@@ -415,7 +415,7 @@ def test_static_friction_is_refused_outside_what_a_joint_shows():
 
 
 def test_a_local_effects_column_on_a_joint_needs_that_joint_alone(lwr):
-    """Effect.local lets the search of a velocity scale compute one joint's column
+    """Term.local lets the search of a velocity scale compute one joint's column
     (design.columns_of with a joint): for every effect in the library that says so, its column
     on joint j from joint j's signals alone equals joint j's column from the whole arm's."""
     from dyngen.catalogue import STANDARD_FROM_DYNAMIC

@@ -141,7 +141,7 @@ def test_friction_that_sticks_claims_no_static_friction(diagnosed):
 
 
 def test_stribeck_is_static_friction_above_coulomb(folder):
-    """Stribeck's term is friction above the Coulomb level (Effect.extends): tried alone it is
+    """Stribeck's term is friction above the Coulomb level (Term.extends): tried alone it is
     never selected, whatever its gain; with Coulomb it is, on the same joint."""
     robot, model = load_robot(LWR), load(ROOT / "generated" / "lwr")
     alone = run(robot, model, *folder, "stribeck", options=Options(effects=("stribeck",)))["diagnosis"]
