@@ -2,7 +2,7 @@
 diagnosis's candidates (its "effects"), excitation's information matrix and the emitted friction
 routine.
 
-Each term (base.Term) states its fitted values and their physical ranges (base.Value), its
+Each term (term.Term) states its fitted values and their physical ranges (term.Value), its
 nonlinear settings, its regressor columns (numpy, per chunk of samples where `pointwise`), its
 documentation line, and for the friction routine its fields and its C (friction.IN_FRICTION):
 the firmware's friction is, by construction, the law that was fitted. An instance is the
@@ -22,7 +22,7 @@ fixed variants of one term (`library`), refined once the term is selected (diagn
 
 from __future__ import annotations
 
-from .base import FrictionField, Term, Value
+from .term import FrictionField, Term, Value
 from .body import FixedShapePayload, Payload, RigidBody
 from .context import Context
 from .friction import (FRICTION_FIELDS, FRICTION_NAMES, IN_FRICTION, SCALE_VARIANTS, STRIBECK_VARIANTS, Coulomb,

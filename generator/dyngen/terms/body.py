@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK
-from .base import Term, Value
+from .term import Term, Value
 
 
 class RigidBody(Term):

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import FrictionField, Term, Value, sign
+from .term import FrictionField, Term, Value, sign
 
 # The Coulomb law's velocity scale vc, by its use (one place for every default):
 SIMPLE_SCALE = 0.02  # rad/s: the simple model's fixed scale, and identify's when not searched

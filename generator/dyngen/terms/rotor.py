@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Term, Value
+from .term import Term, Value
 from .friction import POSITIVE
 
 RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many peaks of their torque: not separable

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Term, Value
+from .term import Term, Value
 
 MAX_GAIN = 0.5  # a sensor that reads 0.5 to 1.5 times the torque
 MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor's time shift

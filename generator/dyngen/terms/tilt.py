@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..description.joint_model import forward_kinematics
-from .base import Term, Value
+from .term import Term, Value
 
 MAX_TILT_DEG = 10.0  # a larger tilt is no mounting error
 MAX_GRAVITY_SCALE = 0.1  # relative: a larger change of gravity's size is no tilt's nor a model's rounding

@@ -96,7 +96,7 @@ class Term:
     @classmethod
     def c(cls, v: str, f, c) -> str:
         """C expression of the term's torque on one joint: v the velocity, f(name) its fields, c
-        the C names of sgn(v, e) (base.sign), exp, abs (|x|) and zero (attributes)."""
+        the C names of sgn(v, e) (term.sign), exp, abs (|x|) and zero (attributes)."""
         raise NotImplementedError
 
     @classmethod
