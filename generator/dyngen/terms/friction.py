@@ -44,18 +44,36 @@ def coulomb(qd, vc):
     return np.tanh(qd / vc)
 
 
-class Coulomb(Term):
-    name, doc = "coulomb", "Coulomb friction Fc tanh(qd / vc), vc fitted (real joints do not switch sharply)"
+class _AtVelocity(Term):
+    """A friction term at one velocity setting (`velocity`, its field `field`): the diagnosis's
+    variant of it, refined once selected."""
+
+    field = ""
     switching = refinable = local = True
+
+    def __init__(self, velocity: float):
+        self.velocity = float(velocity)
+        self.label = f"{self.field}={self.velocity:g}"
+
+    def fixed(self):
+        return {self.field: self.velocity}
+
+    @property
+    def setting(self):
+        return self.velocity
+
+    def at(self, setting):
+        return type(self)(setting)
+
+
+class Coulomb(_AtVelocity):
+    name, doc = "coulomb", "Coulomb friction Fc tanh(qd / vc), vc fitted (real joints do not switch sharply)"
+    field = "vc"
     values = (Value("Fc", "Nm", **POSITIVE),)
     settings = (Value("vc", "rad/s", **POSITIVE),)
     friction = (FrictionField("Fc", "value", "Coulomb friction [Nm or N]"),
                 FrictionField("vc", "velocity", "its velocity scale: tanh(qd / vc); the plain sign when <= 0 [rad/s or m/s]"))
     simulator = ("friction", "Fc")
-
-    def __init__(self, velocity: float):
-        self.velocity = float(velocity)
-        self.label = f"vc={self.velocity:g}"
 
     @staticmethod
     def regressor(qd, vc):
@@ -72,22 +90,12 @@ class Coulomb(Term):
     def columns(self, context, signals, tau_model):
         return self.regressor(signals.qd, self.velocity)
 
-    def fixed(self):
-        return {"vc": self.velocity}
-
-    @property
-    def setting(self):
-        return self.velocity
-
     def search_interval(self, values, beside=()):
         # Reaches the neighbouring variants; below a Stribeck velocity on the joint (static
         # friction breaks away within the Coulomb transition and decays after it; a Coulomb scale
         # refined freely drifts up to the Stribeck velocity until the two laws merge).
         hi = min([self.velocity * 4] + [e.velocity / STRIBECK_WIDER for e in beside if isinstance(e, Stribeck)])
         return min(self.velocity / 4, hi), hi
-
-    def at(self, setting):
-        return Coulomb(setting)
 
     @classmethod
     def friction_terms(cls, values, variant):
@@ -120,9 +128,9 @@ class Viscous(Term):
         return {"Fv": values["Fv"]}
 
 
-class Stribeck(Term):
+class Stribeck(_AtVelocity):
     name, doc = "stribeck", "Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): breakaway friction above Coulomb's"
-    switching = refinable = local = True
+    field = "vs"
     values = (Value("Fs", "Nm", **POSITIVE),)
     settings = (Value("vs", "rad/s", **POSITIVE), Value("es", "rad/s", **POSITIVE))
     friction = (FrictionField("Fs", "value", "Stribeck friction (breakaway minus Coulomb) [Nm or N]"),
@@ -133,10 +141,6 @@ class Stribeck(Term):
     # speed, which no joint has, and the viscous law would then take the Coulomb level's place
     # (extrapolating steeply beyond the fit speeds).
     extends = "coulomb"
-
-    def __init__(self, velocity: float):
-        self.velocity = float(velocity)
-        self.label = f"vs={self.velocity:g}"
 
     @staticmethod
     def regressor(qd, vs, es):
@@ -154,21 +158,11 @@ class Stribeck(Term):
     def columns(self, context, signals, tau_model):
         return self.regressor(signals.qd, self.velocity, context.sign_velocity)
 
-    def fixed(self):
-        return {"vs": self.velocity}
-
-    @property
-    def setting(self):
-        return self.velocity
-
     def search_interval(self, values, beside=()):
         # Reaches the neighbouring variants; no narrower than STRIBECK_WIDER times the joint's
         # Coulomb scale (see reshapes).
         lo = max([self.velocity / 3] + [STRIBECK_WIDER * e.velocity for e in beside if isinstance(e, Coulomb)])
         return lo, max(self.velocity * 3, lo)
-
-    def at(self, setting):
-        return Stribeck(setting)
 
     def refusal_beside(self, values, base):
         """Static friction above the Coulomb level, between STATIC_RESOLVED and STATIC_EXCESS
