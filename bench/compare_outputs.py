@@ -4,7 +4,7 @@ runs (before and after the change) can be compared with `diff -r`.
 
     python bench/compare_outputs.py cases DIR             # the synthetic cases (once, shared by both runs)
     python bench/compare_outputs.py run GENERATOR CASES OUT  # every command with GENERATOR's dyngen
-    diff -r OUT_BEFORE OUT_AFTER
+    python bench/compare_outputs.py diff OUT_BEFORE OUT_AFTER   # every file byte for byte
 
 Cases: the withheld sample (/work/shared/data/withheld-sample), the real LWR4+ runs
 (examples/lwr4-real), and synthetic LWR cases from the tests' simulation (stribeck_off_grid,
@@ -13,7 +13,9 @@ gain_tilt, payload_tilt, shift_coulomb, 200 Hz) whose effects exercise every ter
 
 from __future__ import annotations
 
+import filecmp
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -87,15 +89,38 @@ def run(generator: Path, cases: Path, out: Path, only: list) -> int:
     return failed
 
 
+def differences(before: Path, after: Path) -> list[str]:
+    """Every output file that differs or is missing (exit.txt: the exit code and messages, its
+    timings left out)."""
+    out = []
+    for folder in sorted(p for p in before.iterdir() if p.is_dir()):
+        files = sorted(p.relative_to(folder) for p in folder.rglob("*") if p.is_file())
+        for name in files:
+            a, b = folder / name, after / folder.name / name
+            if not b.is_file():
+                out.append(f"{folder.name}/{name}: missing")
+            elif name.name == "exit.txt":
+                if re.sub(r"[0-9.]+ s\)", "s)", a.read_text()) != re.sub(r"[0-9.]+ s\)", "s)", b.read_text()):
+                    out.append(f"{folder.name}/{name}: exit code or messages differ")
+            elif not filecmp.cmp(a, b, shallow=False):
+                out.append(f"{folder.name}/{name}: differs")
+    return out
+
+
 def main() -> int:
     parser = arguments(__doc__, whole=True)
-    parser.add_argument("what", choices=("cases", "run"))
+    parser.add_argument("what", choices=("cases", "run", "diff"))
     parser.add_argument("paths", nargs="+", type=Path)
     parser.add_argument("--only", default="", help="comma-separated case names")
     a = parser.parse_args()
     if a.what == "cases":
         write_synthetic(a.paths[0])
         return 0
+    if a.what == "diff":
+        found = differences(a.paths[0], a.paths[1])
+        cases = sum(p.is_dir() for p in a.paths[0].iterdir())
+        print("\n".join(found) or f"{cases} cases: every output file byte-identical (timings aside)")
+        return int(bool(found))
     return run(a.paths[0], a.paths[1], a.paths[2], [s for s in a.only.split(",") if s])
 
 
