@@ -102,6 +102,32 @@ def test_every_term_states_its_values_ranges_and_doc():
     assert not TimeShift.pointwise and C.pointwise  # a lag needs samples before a chunk
 
 
+def test_the_diagnosis_candidates_are_the_terms(model):
+    """One class per term: every candidate the diagnosis tries is an instance of a term of
+    dyngen.terms (its name, values and range the term's own), and no module outside terms/
+    defines a second class of one (no Term subclass elsewhere once every stage is imported)."""
+    import dyngen.commands.diagnose  # noqa: F401  (every stage that could define one)
+    import dyngen.excitation  # noqa: F401
+    import dyngen.identification  # noqa: F401
+    from dyngen.terms import NAMES, Term, library
+    from oracles.random_params import random_parameters
+
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    context = Context(model, robot, random_parameters(N, seed=1), None, 0.002)
+    candidates = library(context, NAMES)
+    assert {c.name for c in candidates} == set(NAMES) == {t.name for t in TERMS}
+    for c in candidates:
+        term = next(t for t in TERMS if t.name == c.name)
+        assert type(c) is term
+        assert c.parameters == tuple(v.name for v in term.values) or term.name == "coefficients"
+
+    def subclasses(cls):
+        return [s for sub in cls.__subclasses__() for s in (sub, *subclasses(sub))]
+
+    assert len(subclasses(Term)) >= len(TERMS)
+    assert all(cls.__module__.startswith("dyngen.terms.") for cls in subclasses(Term)), subclasses(Term)
+
+
 def test_one_tilt_for_identify_and_diagnose():
     """identify's rotation columns (terms.tilt.rotation_columns) and the diagnosis's Tilt are the
     same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
