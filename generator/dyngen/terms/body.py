@@ -219,7 +219,7 @@ def armature_identifiable(model, dof: int, seed: int = 0) -> list[bool]:
     rng = np.random.default_rng(seed)
     states = 40
     q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))
-    Y = model.batch("regressor", q, qd, qdd).reshape(states * dof, -1)
+    Y = RigidBody.regressor(model, q, qd, qdd).reshape(states * dof, -1)
     ok = []
     for j in range(dof):
         col = np.zeros((states, dof))
