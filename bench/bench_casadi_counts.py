@@ -10,17 +10,14 @@ callgrind counts are the speed claim.
 """
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 from pathlib import Path
 
-BENCH = Path(__file__).resolve().parent
-sys.path.insert(0, str(BENCH.parent / "tests"))
+from common import BENCH, arguments, arm_yaml, example_arms, log, on_path
 
+on_path()
 import casadi_side  # noqa: E402
 from bench_dynamics import dynamic_parameters  # noqa: E402
-from common import arm_yaml, example_arms, log  # noqa: E402
 
 CONTROLLER = {"coriolis": "coriolis_matrix", "mass_matrix_dot": "mass_matrix_derivative",
               "slotine_li": "regressor_slotine_li", "fd": "forward_dynamics", "rnea_derivatives": "rnea_derivatives",
@@ -58,7 +55,7 @@ def arm_rows(name: str) -> list:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arms", nargs="+", default=None)
     ap.add_argument("--output", default=str(BENCH / "results" / "casadi_counts.md"))
     args = ap.parse_args(argv)

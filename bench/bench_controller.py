@@ -25,7 +25,6 @@ The table goes to bench/results/controller.md.
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import os
 import shlex
@@ -37,7 +36,7 @@ from pathlib import Path
 import casadi_side
 from bench_dynamics import (BENCH, DEFAULT_FLAGS, finish_pinocchio_object, markdown, pinocchio_object,
                             pinocchio_toolchain, prepare_arm, run)
-from common import arm_yaml, compiler_version, example_arms, log, machine
+from common import arguments, arm_yaml, compiler_version, example_arms, log, machine
 
 SIDES = ("dyngen", "pinocchio", "casadi", "casadi_baked")  # the harness's order
 
@@ -138,7 +137,7 @@ def instructions(exe: Path, model: Path, states: int, fn: str, side: str, calls:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arms", nargs="+", default=None)
     ap.add_argument("--calls", type=int, default=1000)
     ap.add_argument("--states", type=int, default=100)

@@ -15,7 +15,6 @@ the compiler's helpers (__aeabi_*: on the M4F, double arithmetic is software flo
 
 from __future__ import annotations
 
-import argparse
 import json
 import re
 import subprocess
@@ -23,7 +22,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from common import ROOT, arguments
+
 CC = "arm-none-eabi-gcc"
 TARGETS = {
     "Cortex-M4F": ["-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard"],
@@ -111,7 +111,7 @@ def report(folder: Path, results: dict, compiler: str) -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = arguments(__doc__)
     parser.add_argument("--folder", type=Path, default=ROOT / "generated" / "lwr")
     parser.add_argument("--out", type=Path, default=ROOT / "bench" / "results" / "firmware.md")
     args = parser.parse_args(argv)

@@ -23,11 +23,10 @@ Part 3, `dyngen excite` for the LWR: time and condition numbers.
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
-from common import machine, on_path, table  # noqa: E402  (bench/ is sys.path[0])
+from common import arguments, machine, on_path, table  # noqa: E402  (bench/ is sys.path[0])
 
 ROOT = on_path()
 
@@ -230,7 +229,7 @@ def excite(lines):
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = arguments(__doc__, whole=True)
     ap.add_argument("--skip-real", action="store_true")
     ap.add_argument("--skip-speed", action="store_true")
     ap.add_argument("--skip-excite", action="store_true")

@@ -24,26 +24,20 @@ Pinocchio is header-only, compiled once into bench/.build/ (the model is read at
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import os
 import shlex
-import subprocess
 import sys
 import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import numpy as np
+from common import BENCH, arguments, arm_yaml, compiler_version, example_arms, log, machine, on_path
 
-BENCH = Path(__file__).resolve().parent
-ROOT = BENCH.parent
-sys.path.insert(0, str(ROOT / "tests"))
-sys.path.insert(0, str(BENCH))
+ROOT = on_path()
 from bench_dynamics import dynamic_parameters, fmt, joint_ranges, pinocchio_toolchain, run, write_model  # noqa: E402
-from common import arm_yaml, compiler_version, example_arms, log, machine  # noqa: E402
 
 PAIRS = {
     "link_poses": "framesForwardKinematics",
@@ -188,7 +182,7 @@ def markdown(arms: list, results: dict, callgrind: bool) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = arguments(__doc__)
     ap.add_argument("--arms", nargs="*", help="example names or YAML paths (default: every example arm)")
     ap.add_argument("--states", type=int, default=1000)
     ap.add_argument("--batches", type=int, default=100)

@@ -19,9 +19,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-BENCH = Path(__file__).resolve().parent
-ROOT = BENCH.parent
-from common import arguments, log  # noqa: E402  (bench/ is sys.path[0])
+from common import BENCH, arguments, log, on_path
 
 
 def arm_counts(yaml_path: Path, tmp: Path, states: int) -> dict:
@@ -45,7 +43,7 @@ def float_errors(folder: Path, manifest: dict, states: int, tmp: Path) -> dict:
     """Worst normwise relative error of the float build against the double build, per function."""
     import numpy as np
 
-    sys.path.insert(0, str(ROOT / "tests"))
+    on_path()
     from oracles.random_params import random_parameters
 
     from dyngen.runtime import load

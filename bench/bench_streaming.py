@@ -19,19 +19,15 @@ Writes bench/results/streaming.md and streaming.json.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import sys
 import tempfile
 from pathlib import Path
 
-BENCH = Path(__file__).resolve().parent
-ROOT = BENCH.parent
-sys.path.insert(0, str(BENCH))
-from common import log, machine  # noqa: E402
-from long_recordings import write  # noqa: E402
-from peak_memory import run_measured  # noqa: E402
+from common import BENCH, ROOT, arguments, log, machine
+from long_recordings import write
+from peak_memory import run_measured
 
 RESULTS = BENCH / "results"
 REAL = [ROOT / "examples" / "lwr4-real" / f"measurement_{k}.csv" for k in (1, 2, 3)]
@@ -223,7 +219,7 @@ def markdown(doc) -> list:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = arguments(__doc__)
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each worker count (the fastest is kept)")
     ap.add_argument("--parts", nargs="+", choices=("memory", "parallel"), default=["memory", "parallel"],

@@ -7,15 +7,14 @@ the numerical rank of Pinocchio's regressor.
 """
 from __future__ import annotations
 
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+from common import arguments, on_path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+ROOT = on_path()
 from cbuild import compile_folder  # noqa: E402
 from test_urdf import ARMS, DATA, configuration, numerical_rank, pinocchio_chain, rel_err  # noqa: E402
 
@@ -27,9 +26,7 @@ STATES = 1000
 
 
 def main():
-    import argparse
-
-    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
+    arguments(__doc__, whole=True).parse_args()
     lines = ["| arm | snaps | counts g/inertia/full | Pinocchio rank g/full | rnea | gravity | M |", "|---|---|---|---|---|---|---|"]
     for name, (file, tip) in sorted(ARMS.items()):
         robot = load_urdf(DATA / file, tip_link=tip)

@@ -10,9 +10,9 @@ vs tests/data/urdf/ur5_robot.urdf. Writes bench/results/urdf_vs_dh.md.
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from common import ROOT, arguments
+
 PAIRS = (("panda", ROOT / "examples/panda.yaml", ROOT / "tests/data/urdf/panda.urdf", "panda_link8"),
          ("ur5", ROOT / "examples/ur5.yaml", ROOT / "tests/data/urdf/ur5_robot.urdf", None))
 FUNCTIONS = ("rnea", "gravity", "mass_matrix")
@@ -36,9 +36,7 @@ def measure(load):
 
 
 def main():
-    import argparse
-
-    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
+    arguments(__doc__, whole=True).parse_args()
     from dyngen.description import load_description
 
     lines = ["| arm | input | counts g/inertia/full | " + " | ".join(f"{f} mul/add" for f in FUNCTIONS)

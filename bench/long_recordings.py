@@ -9,13 +9,13 @@ jumps of a few hundredths of a radian, as in a log that was cut and restarted.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
+from common import ROOT, arguments
+
 SOURCE = ROOT / "examples" / "lwr4-real" / "measurement_1.csv"
 CHUNK = 100000  # rows written at a time (the output may be larger than memory should hold)
 
@@ -68,7 +68,7 @@ def write(out: Path, minutes: float, rate: float | None = None, source: Path = S
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = arguments(__doc__)
     ap.add_argument("out", type=Path)
     ap.add_argument("--minutes", type=float, required=True)
     ap.add_argument("--rate", type=float, default=None, help="resample to this rate [Hz] (default: as recorded)")

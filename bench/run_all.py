@@ -288,9 +288,7 @@ def write_benchmarks(outcomes: dict, args, total: float) -> Path:
 
 
 def main(argv=None) -> int:
-    ap = arguments(__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog=__doc__.split("\n\n", 2)[2])
+    ap = arguments(__doc__, formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 2)[2])
     ap.add_argument("--parts", nargs="+", choices=PARTS, default=list(PARTS), help="parts to run (default: all)")
     ap.add_argument("--arms", nargs="+", help="example arms for opcounts and dynamics (default: all examples; "
                     "extraction always uses its own list of arms with bounds)")

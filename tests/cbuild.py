@@ -9,6 +9,7 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
+import shared_run
 from dyngen.runtime import Compiled, load
 
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
@@ -27,5 +28,15 @@ def compile_objects(folder: Path, build_dir: Path, extra_flags=()) -> list[Path]
 
 
 def compile_folder(folder: Path, build_dir: Path) -> Compiled:
-    compile_objects(folder, build_dir)
-    return load(folder, cache_dir=Path(build_dir))
+    """The strict compile (once per distinct set of sources in a test run), then the library,
+    built into the run's shared cache where there is one."""
+    folder = Path(folder)
+    sources = sorted(folder.glob("*.c")) + sorted(folder.glob("*.h"))
+    key = shared_run.digest(*(p.name for p in sources), *(p.read_bytes() for p in sources))
+    passed = shared_run.folder("strict")
+    with shared_run.locked(f"strict-{key}"):
+        if passed is None or not (passed / key).exists():
+            compile_objects(folder, build_dir)
+            if passed is not None:
+                (passed / key).touch()
+        return load(folder, cache_dir=shared_run.folder("libraries") or Path(build_dir))

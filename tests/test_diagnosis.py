@@ -19,7 +19,7 @@ from synthetic import fourier, noisy, rigid_torques, signals
 
 from dyngen.description import load_robot
 from dyngen.diagnosis import Options, diagnose
-from dyngen.diagnosis.effects import gravity_matrix
+from dyngen.terms import gravity_matrix
 from dyngen.runtime import load
 
 LWR = ROOT / "examples" / "lwr.yaml"
@@ -405,7 +405,7 @@ def test_static_friction_is_refused_outside_what_a_joint_shows():
     friction beside a 1-Nm Coulomb level (a spike standing in for a 3.3-Hz filter's rounding),
     0.08 Nm beside 0.9 Nm (friction that sticks, seen through the filter), and the injected
     0.8 Nm beside 0.8 Nm, which stays."""
-    from dyngen.diagnosis.effects.friction import Stribeck
+    from dyngen.terms import Stribeck
 
     law = Stribeck(0.1)
     assert "no joint's" in law.refusal_beside(np.array([9.8]), np.array([1.0]))
@@ -415,11 +415,11 @@ def test_static_friction_is_refused_outside_what_a_joint_shows():
 
 
 def test_a_local_effects_column_on_a_joint_needs_that_joint_alone(lwr):
-    """Effect.local lets the search of a velocity scale compute one joint's column
+    """Term.local lets the search of a velocity scale compute one joint's column
     (design.columns_of with a joint): for every effect in the library that says so, its column
     on joint j from joint j's signals alone equals joint j's column from the whole arm's."""
     from dyngen.catalogue import STANDARD_FROM_DYNAMIC
-    from dyngen.diagnosis.effects import Context, library
+    from dyngen.terms import Context, library
 
     model, robot, arm, p, trajectories = lwr
     t, at, q, qd, qdd, tau = trajectories["fit"]
@@ -439,7 +439,7 @@ def test_the_nearest_body_inertia_is_a_body_and_nearest():
     """Payload.simplified keeps a payload whose fitted inertia is no body's with the nearest
     body's inertia (same principal axes): checked against a brute-force search over principal
     moments that satisfy the triangle inequalities."""
-    from dyngen.diagnosis.effects.body import nearest_body_inertia
+    from dyngen.terms.body import nearest_body_inertia
 
     rng = np.random.default_rng(5)
     V = np.linalg.qr(rng.standard_normal((3, 3)))[0]
@@ -462,8 +462,8 @@ def test_a_fixed_shape_payload_exports_the_body_its_columns_describe(lwr):
     values equal Newton-Euler with the standard parameters it adds to the last link (what the
     updated model and the URDF get), and those are a body's."""
     from dyngen.catalogue import STANDARD_FROM_DYNAMIC
-    from dyngen.diagnosis.effects import Context
-    from dyngen.diagnosis.effects.body import FixedShapePayload, consistent_inertia
+    from dyngen.terms import Context
+    from dyngen.terms.body import FixedShapePayload, consistent_inertia
 
     model, robot, arm, p, trajectories = lwr
     t, at, q, qd, qdd, tau = trajectories["fit"]

@@ -16,7 +16,7 @@ import random
 
 import pytest
 import sympy as sp
-from conftest import EXAMPLES
+from conftest import EXAMPLES, derive
 
 from dyngen.derivation.inertia import motion_index, phi, stacked_regressor, stacked_row
 from dyngen.derivation.models import Derivation, Input, Model
@@ -120,10 +120,7 @@ def test_operation_count_is_the_loop_trips_times_the_body_plus_the_motions():
     sums that evaluating every filled entry with phi makes (counted by brute force here)."""
     from dyngen.emission.c_code import straight_line
     from dyngen.emission.opcount import count_all
-    from dyngen.generate import build
-
-    robot = load_robot(ARMS["lwr"])
-    bases, emitted = build(robot)
+    robot, bases, emitted = derive(ARMS["lwr"])
     motions = Derivation(robot).unit_accelerations()
     straight = straight_line(robot.name, robot.joint_models, motions, motions.outputs).ops + count_all(motions.outputs)
     n = robot.dof

@@ -15,7 +15,7 @@ import numpy as np
 
 from dyngen.data import condition, read_recording
 from dyngen.diagnosis import diagnose
-from dyngen.diagnosis.effects import base
+from dyngen.terms import context
 from dyngen.description import load_robot
 from dyngen.runtime import load
 from oracles.arm import Arm, nominal_parameters
@@ -69,7 +69,7 @@ def test_recording_within_the_bound_is_the_in_memory_diagnosis(tmp_path, monkeyp
     assert "sampled" not in doc and doc["fit"] == ["short.csv"]
     assert any(e["effect"] == "offset" and e["joints"] == [3] for e in doc["selected"])
     robot = load_robot(LWR)
-    monkeypatch.setattr(base, "MEMO_BYTES", 1 << 20)
+    monkeypatch.setattr(context, "MEMO_BYTES", 1 << 20)
     result = diagnose(robot, load(FOLDER), nominal_parameters(LWR), [condition(read_recording(path, N))])
     assert np.allclose(doc["rms_before"], result.rms_before, rtol=1e-9)
     assert np.allclose(doc["rms_after"], result.rms_after, rtol=1e-9)

@@ -15,11 +15,10 @@ import pytest
 from conftest import ROOT
 
 from dyngen.description import load_robot
-from dyngen.diagnosis.effects import Context, Coulomb, Direction, Stribeck, Viscous
-from dyngen.diagnosis.updated_model import friction_vector
 from dyngen.diagnosis.record import Finding
+from dyngen.diagnosis.updated_model import friction_vector
 from dyngen.runtime import load
-from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, friction_torque
+from dyngen.terms import FRICTION_FIELDS, IN_FRICTION, TERMS, Context, Coulomb, Direction, Stribeck, Viscous, friction_torque
 
 N = 7
 
@@ -103,14 +102,39 @@ def test_every_term_states_its_values_ranges_and_doc():
     assert not TimeShift.pointwise and C.pointwise  # a lag needs samples before a chunk
 
 
+def test_the_diagnosis_candidates_are_the_terms(model):
+    """One class per term: every candidate the diagnosis tries is an instance of a term of
+    dyngen.terms (its name, values and range the term's own), and no module outside terms/
+    defines a second class of one (no Term subclass elsewhere once every stage is imported)."""
+    import dyngen.commands.diagnose  # noqa: F401  (every stage that could define one)
+    import dyngen.excitation  # noqa: F401
+    import dyngen.identification  # noqa: F401
+    from dyngen.terms import NAMES, Term, library
+    from oracles.random_params import random_parameters
+
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    context = Context(model, robot, random_parameters(N, seed=1), None, 0.002)
+    candidates = library(context, NAMES)
+    assert {c.name for c in candidates} == set(NAMES) == {t.name for t in TERMS}
+    for c in candidates:
+        term = next(t for t in TERMS if t.name == c.name)
+        assert type(c) is term
+        assert c.parameters == tuple(v.name for v in term.values) or term.name == "coefficients"
+
+    def subclasses(cls):
+        return [s for sub in cls.__subclasses__() for s in (sub, *subclasses(sub))]
+
+    assert len(subclasses(Term)) >= len(TERMS)
+    assert all(cls.__module__.startswith("dyngen.terms.") for cls in subclasses(Term)), subclasses(Term)
+
+
 def test_one_tilt_for_identify_and_diagnose():
     """identify's rotation columns (terms.tilt.rotation_columns) and the diagnosis's Tilt are the
     same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
     gravity along -z), and the turned gravity vector keeps its size."""
     from oracles.random_params import random_parameters
 
-    from dyngen.diagnosis.effects import Tilt
-    from dyngen.terms import tilt
+    from dyngen.terms import Tilt, tilt
 
     robot = load_robot(ROOT / "examples" / "lwr.yaml")
     p = random_parameters(7, 3, mass=(0.5, 3.0), second_moment=(0.002, 0.02))

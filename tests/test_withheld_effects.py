@@ -129,7 +129,7 @@ def test_friction_that_sticks_claims_no_static_friction(diagnosed):
     Stribeck term (0.08 Nm beside joint 2's 0.9 Nm Coulomb level at 200 Hz) stood in for that.
     Static friction less than STATIC_RESOLVED of the Coulomb level is refused, saying why; the
     injected static friction of `stribeck_sticky` (as large as its Coulomb level) stays."""
-    from dyngen.diagnosis.effects.friction import STATIC_RESOLVED
+    from dyngen.terms.friction import STATIC_RESOLVED
 
     r = diagnosed("sticky")
     assert r["problems"] == [], "\n".join(r["problems"])
@@ -141,7 +141,7 @@ def test_friction_that_sticks_claims_no_static_friction(diagnosed):
 
 
 def test_stribeck_is_static_friction_above_coulomb(folder):
-    """Stribeck's term is friction above the Coulomb level (Effect.extends): tried alone it is
+    """Stribeck's term is friction above the Coulomb level (Term.extends): tried alone it is
     never selected, whatever its gain; with Coulomb it is, on the same joint."""
     robot, model = load_robot(LWR), load(ROOT / "generated" / "lwr")
     alone = run(robot, model, *folder, "stribeck", options=Options(effects=("stribeck",)))["diagnosis"]

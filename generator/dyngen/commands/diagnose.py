@@ -73,7 +73,7 @@ def main(argv, prog="dyngen diagnose") -> int:
     from ..data.split import parse_fractions
     from ..description import load_robot
     from ..diagnosis import Options, diagnose
-    from ..diagnosis.effects import check_names
+    from ..terms import check_names
     from ..diagnosis.outputs import write_outputs
     from ..diagnosis.report import summary_lines
     from ..data.parameters_file import read_link_parameters

@@ -13,14 +13,6 @@ from ..options import add_arguments, option, resolve
 from ..progress import Progress
 
 
-def forward_flange(robot):
-    """q (T, N) -> flange position (T, 3) in the base frame: the last link frame's origin (the
-    joint model's forward kinematics, description/joint_model.py)."""
-    from ..description.joint_model import forward_kinematics
-
-    return lambda q: forward_kinematics(robot.joint_models, q)[-1].origin
-
-
 def csv_text(t, q, qd, qdd) -> str:
     n = q.shape[1]
     header = ["t"] + [f"q{j}" for j in range(1, n + 1)] + [f"qd{j}" for j in range(1, n + 1)] + \
@@ -101,19 +93,18 @@ def main(argv, prog="dyngen excite") -> int:
     samples = sampling.rate * settings.period * sampling.periods
     if samples > MAX_SAMPLES:
         command_line.error(f"--rate x --period x --periods gives {samples:.3g} samples; at most {MAX_SAMPLES:g}")
+    from ..atomic import write_file
     from ..description import load_robot
-    from .recordings import compiled_model
     from ..excitation.design import check_limits, limits_of, optimise
+    from ..output_paths import check_file
+    from .recordings import compiled_model
 
     robot = load_robot(args.robot)
     progress = Progress(quiet=args.quiet)
-    from ..output_paths import check_file
-
     out = Path(args.output) if args.output else Path("out") / robot.name / "excitation.csv"
     for path in (out, out.with_suffix(".png")):  # the output path policy, before any work
         check_file(path, [args.robot, args.model])
     limits = limits_of(robot)  # missing limits fail before anything runs
-    workspace = None
     if args.workspace:
         try:
             workspace = tuple(float(x) for x in args.workspace.split(","))
@@ -126,20 +117,12 @@ def main(argv, prog="dyngen excite") -> int:
                  f"seed {settings.seed}")
     model = compiled_model(args, robot, progress)
     with progress.step("optimise the Fourier coefficients"):
-        design = optimise(robot, model, settings, forward_flange(robot) if workspace else None)
+        design = optimise(robot, model, settings)
     t = np.arange(int(round(settings.period * sampling.periods * sampling.rate)) + 1) / sampling.rate
     q, qd, qdd = design.trajectory(t)
-    problems = check_limits(robot, t, q, qd, qdd)
-    if workspace:
-        box = np.asarray(workspace).reshape(3, 2)
-        where = forward_flange(robot)(q)
-        outside = np.flatnonzero(~np.all((where >= box[:, 0]) & (where <= box[:, 1]), axis=1))
-        if outside.size:
-            problems.append(f"the flange leaves the workspace box at t = {t[outside[0]]:.4g} s")
+    problems = check_limits(robot, t, q, qd, qdd, settings.workspace)
     if problems:  # cannot happen by construction; never write a trajectory that breaks a limit
         raise InputError(args.robot, "joints[].limits", "; ".join(problems[:3]))
-    from ..atomic import write_file
-
     write_file(out, csv_text(t, q, qd, qdd))
     plot = out.with_suffix(".png")
     figure(robot, design, t, q, qd, qdd, limits, plot)

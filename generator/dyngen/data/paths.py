@@ -14,14 +14,10 @@ from ..errors import InputError, shorten
 MAX_FILES = 100000
 
 
-def is_glob(text: str) -> bool:
-    return glob.has_magic(text)
-
-
 def expand(values) -> list[str]:
     out = []
     for value in values:
-        if not is_glob(value):
+        if not glob.has_magic(value):
             out.append(value)
             continue
         found = sorted(glob.glob(value, recursive=True))

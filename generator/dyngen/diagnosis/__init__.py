@@ -8,7 +8,7 @@ The stages, in order (pipeline.py runs them):
 
     0. roles.py      recordings cut into fit, selection and test samples; the nominal residual
     1. fit.py        the moments of every candidate (moments.py) from the library of effects
-                     (effects/: each a torque term of dyngen.terms with the diagnosis's rules)
+                     (dyngen.terms.library: each a torque term with the diagnosis's rules on it)
     2. forward_selection.py  forward selection on the selection data
     3. settle.py     nonlinear settings refined (refine.py), insignificant effects pruned,
                      implausible ones refused

@@ -6,8 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..options import option
+from ..terms import DEFAULT_NAMES, NAMES
 from ..terms.friction import SIGN_SCALE
-from .effects import DEFAULT_NAMES, NAMES
 from .forward_selection import ALPHA, MIN_GAIN
 
 

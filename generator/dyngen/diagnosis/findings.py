@@ -31,7 +31,7 @@ def describe(robot, design, chosen, final, cand, min_gain) -> Finding:
 
 def with_values(described, design, chosen, final, tau_corr, robot) -> list[Finding]:
     """The findings with the final values of every chosen effect, deviations scaled for the
-    residual's correlation in time, and what follows from them (Effect.derived)."""
+    residual's correlation in time, and what follows from them (Term.derived)."""
     offset, out = 0, []
     for cand, e in zip(chosen, described):
         k = slice(offset, offset + cand.size)

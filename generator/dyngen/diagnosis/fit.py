@@ -101,7 +101,7 @@ def correlation_time(segments, weights) -> float:
 
 def ranged(context, segments, chosen):
     """The context with the positions the segments' fit samples cover (Context.q_range), if a
-    chosen effect depends on them (Effect.ranged); else the context itself (and its cache)."""
+    chosen effect depends on them (Term.ranged); else the context itself (and its cache)."""
     if not any(c.effect.ranged for c in chosen):
         return context
     q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])

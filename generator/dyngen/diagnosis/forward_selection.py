@@ -13,13 +13,13 @@ effects). A step adds the candidate with the largest selection gain if
   - its fitted values are significant on the fit data (chi-square test of x_c^T Cov_cc^-1 x_c,
     p < `alpha`), so noise alone does not qualify, and
   - they are physically plausible (friction opposes motion, a rotor inertia is positive, a
-    sensor gain lies within 50 % of one: Effect.plausible), so a column that merely happens
+    sensor gain lies within 50 % of one: Term.plausible), so a column that merely happens
     to resemble the residual is not claimed as that effect.
 
 An arm-wide effect must gain `min_gain` on at least two joints' selection data: a time shift,
 tilt or payload loads every joint, and one joint's gain is that joint's own business.
 
-An effect that only adds to another on its joint (Effect.extends: Stribeck's static friction
+An effect that only adds to another on its joint (Term.extends: Stribeck's static friction
 above the Coulomb level) is tried once that one is selected, and goes when it goes.
 
 Then prune() drops, one by one, selected effects that no longer pay their way with all the
@@ -29,7 +29,7 @@ scaled for the correlation in time of the residual they leave.
 
 Among candidates within 10 % of the best gain, the one with fewest values wins (a payload is
 preferred to the 43 coefficient errors that could also express it), and a secondary effect
-(Effect.secondary: direction-dependent Coulomb, which on a joint that never stops is a
+(Term.secondary: direction-dependent Coulomb, which on a joint that never stops is a
 sensor offset; the gravity scale, a symptom) only if no plainer one is near. Selection stops when no
 candidate qualifies: with data that hold no unmodelled effect, nothing is selected.
 """
@@ -66,7 +66,7 @@ class Selection:
     chosen: list  # Candidate, in the order selected
     steps: list = field(default_factory=list)  # per step: {"candidate", "gain", "score"}
     first_gains: dict = field(default_factory=dict)  # candidate key -> gain when tried alone
-    # (an extension, Effect.extends: when first tried, beside its base effect)
+    # (an extension, Term.extends: when first tried, beside its base effect)
 
 
 def solve(design, chosen, block: slice | None = None, covariance: bool = True) -> Fit:
@@ -249,7 +249,7 @@ def relative_change(before: np.ndarray, after: np.ndarray) -> np.ndarray:
 
 
 def bases(candidate, chosen) -> list:
-    """The chosen effects on the candidate's joint that it extends (Effect.extends)."""
+    """The chosen effects on the candidate's joint that it extends (Term.extends)."""
     name = candidate.effect.extends
     return [c for c in chosen if name and c.effect.name == name and c.joint == candidate.joint]
 
@@ -260,7 +260,7 @@ def _based(candidate, chosen) -> bool:
 
 
 def without(chosen, cand) -> tuple[list, list]:
-    """(chosen less cand and the effects that extend it on its joint (Effect.extends), the
+    """(chosen less cand and the effects that extend it on its joint (Term.extends), the
     candidates removed: cand first)."""
     kept = [c for c in chosen if c is not cand]
     gone = [c for c in kept if not _based(c, kept)]

@@ -22,7 +22,7 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Candidate:
-    effect: object  # effects.Effect
+    effect: object  # terms.Term
     joint: int | None  # 0-based joint for scope "joint"; None for arm-wide effects
     start: int  # first slot in the global parameter vector
     size: int
@@ -84,18 +84,18 @@ def effect_columns(effects, context, segment) -> dict:
 def columns_of(effect, context, segment, joint=None) -> np.ndarray:
     """An effect's columns on one segment, computed once per segment and effect setting (the
     selection and the pruning ask again). Laws that switch with the sign of the velocity
-    (Effect.switching: Coulomb, Stribeck, direction) are passed through the recording's filter,
+    (Term.switching: Coulomb, Stribeck, direction) are passed through the recording's filter,
     like the torque they explain: a filtered friction step is then compared with a filtered
     step, not a sharp one. Smooth functions of the filtered motion are filtered already.
 
-    joint: of a local effect (Effect.local), only that joint's columns are computed, the
+    joint: of a local effect (Term.local), only that joint's columns are computed, the
     others left zero (the search of a velocity scale asks for one joint's column dozens of times).
 
     The arm and its torque sensor as the chosen effects have them (as_chosen): with a time shift
     (Context.delay), every other effect's columns are taken that much earlier, as a late sensor
     measures friction or a payload as late as the arm's own torque; with a sensor gain
     (Context.scale), the arm's effects (not the sensor's) are scaled by it on its joint; a
-    tilt turns a payload's gravity with the arm's (Context.load, Effect.reads)."""
+    tilt turns a payload's gravity with the arm's (Context.load, Term.reads)."""
     part = joint is not None and effect.local
     delay = 0.0 if effect.delays else context.delay
     scale = None if effect.sensor else context.scale
@@ -127,8 +127,8 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
 
 def world(context, chosen) -> dict:
     """The Context fields the chosen candidates set, each at its setting: the lag of a time
-    shift (delay; Effect.delays), each joint's 1 + sensor gain (scale; Effect.scales) and a
-    payload (load; Effect.load); none without them."""
+    shift (delay; Term.delays), each joint's 1 + sensor gain (scale; Term.scales) and a
+    payload (load; Term.load); none without them."""
     delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
     scale = None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import roles
-from .effects import effect_class
+from ..terms import effect_class
 
 EXTRAPOLATION = 1.2  # warn when test speeds exceed the fit data's by this factor
 DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of a joint's residual variance

@@ -27,10 +27,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
-from ..terms import simple_model
+from ..terms import Context, library, simple_model
 from . import choose, findings_check, fit, joints, reidentify, roles, trust
 from .diagnose_options import Options
-from .effects import Context, library
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
 from .judge import judge, simple_mse

@@ -18,13 +18,13 @@ def entry(finding) -> dict:
 @dataclass(frozen=True)
 class Finding:
     """One selected effect: what it does on the selection data and the values the fit gave."""
-    effect: str  # Effect.name
+    effect: str  # Term.name
     joints: tuple  # 1-based joints it helps (its own joint for a per-joint effect)
-    variant: dict  # settings not fitted (Effect.fixed: e.g. a velocity scale)
+    variant: dict  # settings not fitted (Term.fixed: e.g. a velocity scale)
     values: dict  # parameter -> fitted value, None where the data do not determine it
     std: dict  # parameter -> standard deviation (scaled for the residual's correlation), or None
     units: dict  # parameter -> unit
-    derived: dict  # what follows from the values (Effect.derived: tilt angles, payload mass, ...)
+    derived: dict  # what follows from the values (Term.derived: tilt angles, payload mass, ...)
     selection_gain: float  # relative decrease of the selection data's mean square residual
     rms_before: list  # per joint, selection data, the other selected effects without it
     rms_after: list  # per joint, selection data, with it

@@ -7,12 +7,12 @@ derivative of tau_model), which is wrong wherever tau_model jumps (acceleration 
 rest-to-rest trajectories). Once such an effect is selected, its setting is refined on the
 fit samples, every other selected effect refitted each time (selection and test data stay unused):
 
-  - a setting the fitted values imply (Effect.implied_setting: the time shift, whose exact
+  - a setting the fitted values imply (Term.implied_setting: the time shift, whose exact
     column at dt0 gives the fitted value dt = dt0 when the model holds; the tilt, whose
     second-order change along gravity follows from the angles) by fixed-point
     iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE (a
     scalar setting whose iteration fails: the secant method on implied(s) - s);
-  - a setting independent of the values (Effect.search_interval: the Stribeck velocity) by a
+  - a setting independent of the values (Term.search_interval: the Stribeck velocity) by a
     bounded scalar search for the smallest weighted fit residual.
 
     design, chosen = refine(context, segments, design, chosen)

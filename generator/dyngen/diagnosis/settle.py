@@ -65,7 +65,7 @@ def _plausible(design, chosen):
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):
-    """An effect whose fitted values are possible only in part (Effect.simplified: a payload
+    """An effect whose fitted values are possible only in part (Term.simplified: a payload
     whose inertia is no body's) is replaced by the simpler form that does best on the
     selection data (weighted as the fit), and everything refitted."""
     offset = 0
@@ -83,13 +83,13 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
             score = float(design.weights ** 2 @ selection_mse(form_design, form_chosen))
             options.append((score, form_design, form_chosen))
         _, design, chosen = min(options, key=lambda o: o[0])
-        refused.append(refusal)
+        refused.append(Refusal(*refusal))  # what of the term is refused, its values
         return design, chosen, solve(design, chosen)
     return design, chosen, final
 
 
 def _narrow_stribeck(chosen) -> list:
-    """Per-joint effects that only reshape another on their joint (Effect.reshapes: a Stribeck
+    """Per-joint effects that only reshape another on their joint (Term.reshapes: a Stribeck
     term no wider than the Coulomb transition)."""
     return [c for c in chosen if c.joint is not None
             and any(o.joint == c.joint and c.effect.reshapes(o.effect) for o in chosen)]

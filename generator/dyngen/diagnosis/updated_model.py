@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..parameters import PER_LINK, dynamic_from_standard, standard_from_dynamic
+from ..terms import effect_class
 from ..terms.friction import FRICTION_NAMES
-from .effects import effect_class
 from .joints import COMPLETED, SIMPLE, TIED
 
 FRICTION_FIELDS = FRICTION_NAMES  # the emitted <robot>_friction's vector, per joint

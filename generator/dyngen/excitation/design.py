@@ -25,11 +25,13 @@ L-BFGS-B (finite differences) from the best of `candidates` random starts; all d
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize
 
+from ..description.joint_model import forward_kinematics
 from ..errors import InputError
 from ..options import option
 from ..terms import RigidBody, joint_columns
@@ -103,6 +105,12 @@ class _Shape:
         self.grid = np.arange(GRID_PER_HARMONIC * self.L) / (GRID_PER_HARMONIC * self.L * self.base_hz)
         self.size = self.n + 2 * self.n * (self.L - 1)
 
+    def random(self, rng) -> np.ndarray:
+        """A random x: centres within 20 % of the range about the middle, coefficients falling
+        as 1 / harmonic."""
+        decay = np.tile(np.repeat(1.0 / np.arange(2, self.L + 1)[None, :], 2, axis=0).ravel(), self.n)
+        return np.concatenate([rng.uniform(-0.2, 0.2, self.n), rng.standard_normal(self.size - self.n) * decay])
+
     def coefficients(self, x):
         free = x[self.n:].reshape(self.n, 2, self.L - 1)
         harmonic = np.arange(2, self.L + 1)
@@ -161,11 +169,17 @@ def _inside(points, box) -> np.ndarray:
     return np.all((points >= box[:, 0]) & (points <= box[:, 1]), axis=1)
 
 
+def flange_of(robot):
+    """q (T, N) -> flange position (T, 3) in the base frame: the last link frame's origin (the
+    joint model's forward kinematics)."""
+    return lambda q: forward_kinematics(robot.joint_models, q)[-1].origin
+
+
 def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, armature=None) -> np.ndarray:
     """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major:
     identify's default columns (terms.joint_columns), each on its own joint's rows."""
     T, n = q.shape
-    Y = RigidBody.columns(model, q, qd, qdd).reshape(T * n, -1)
+    Y = RigidBody.regressor(model, q, qd, qdd).reshape(T * n, -1)
     cols = []
     for j in range(n):
         for kind in joint_columns.DEFAULT_KINDS:
@@ -177,17 +191,20 @@ def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, 
     return np.hstack([Y, np.column_stack(cols)])
 
 
+def _unit_columns(A) -> np.ndarray:
+    norms = np.linalg.norm(A, axis=0)
+    return A / np.where(norms > 0, norms, 1.0)
+
+
 def _conditions(A) -> tuple[float, float]:
     sv = np.linalg.svd(A, compute_uv=False)
-    norms = np.linalg.norm(A, axis=0)
-    svs = np.linalg.svd(A / np.where(norms > 0, norms, 1.0), compute_uv=False)
+    svs = np.linalg.svd(_unit_columns(A), compute_uv=False)
     return (float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf, float(svs[0] / svs[-1]) if svs[-1] > 0 else np.inf)
 
 
-def optimise(robot, model, settings: Settings | None = None, flange=None) -> Design:
-    """The optimised excitation for `robot` (its YAML limits) with the compiled `model`."""
-    import time
-
+def optimise(robot, model, settings: Settings | None = None) -> Design:
+    """The optimised excitation for `robot` (its YAML limits; the flange within
+    settings.workspace if given) with the compiled `model`."""
     settings = settings or Settings()
     if settings.harmonics < 2:
         raise InputError("--harmonics", "", f"{settings.harmonics}: at least 2 (one is used to start at rest)")
@@ -195,7 +212,7 @@ def optimise(robot, model, settings: Settings | None = None, flange=None) -> Des
         raise InputError("--criterion", "", f'expected "cond" or "logdet", got "{settings.criterion}"')
     start = time.perf_counter()
     limits = limits_of(robot)
-    shape = _Shape(limits, settings, flange)
+    shape = _Shape(limits, settings, flange_of(robot) if settings.workspace is not None else None)
     armature = armature_identifiable(model, robot.dof)
     times = np.arange(settings.points) * settings.period / settings.points
     evaluations = 0
@@ -209,18 +226,13 @@ def optimise(robot, model, settings: Settings | None = None, flange=None) -> Des
         evaluations += 1
         A = matrix(x)
         if settings.criterion == "logdet":
-            norms = np.linalg.norm(A, axis=0)
-            sign, logdet = np.linalg.slogdet((A / np.where(norms > 0, norms, 1)).T @ (A / np.where(norms > 0, norms, 1)))
+            sign, logdet = np.linalg.slogdet(_unit_columns(A).T @ _unit_columns(A))  # two operands: GEMM, not SYRK
             return -logdet if sign > 0 else 1e6
         ev = np.linalg.eigvalsh(A.T @ A)  # the Gram matrix's eigenvalues: 10 times faster than the SVD
         return float(0.5 * (np.log(max(ev[-1], 1e-300)) - np.log(max(ev[0], 1e-300))))
 
     rng = np.random.default_rng(settings.seed)
-    decay = np.tile(np.repeat(1.0 / np.arange(2, settings.harmonics + 1)[None, :], 2, axis=0).ravel(), robot.dof)
-    starts = []
-    for _ in range(settings.candidates):
-        u = rng.uniform(-0.2, 0.2, robot.dof)
-        starts.append(np.concatenate([u, rng.standard_normal(shape.size - robot.dof) * decay]))
+    starts = [shape.random(rng) for _ in range(settings.candidates)]
     values = [criterion(x) for x in starts]
     random_index = int(np.argsort(values)[len(values) // 2])  # the median random trajectory
     best = starts[int(np.argmin(values))]
@@ -238,14 +250,12 @@ def optimise(robot, model, settings: Settings | None = None, flange=None) -> Des
 def random_design(robot, settings: Settings, seed: int) -> FourierTrajectory:
     """A random trajectory of the same family and limits (the comparison for a design)."""
     shape = _Shape(limits_of(robot), settings)
-    rng = np.random.default_rng(seed)
-    decay = np.tile(np.repeat(1.0 / np.arange(2, settings.harmonics + 1)[None, :], 2, axis=0).ravel(), robot.dof)
-    x = np.concatenate([rng.uniform(-0.2, 0.2, robot.dof), rng.standard_normal(shape.size - robot.dof) * decay])
-    return shape.trajectory(x)
+    return shape.trajectory(shape.random(np.random.default_rng(seed)))
 
 
-def check_limits(robot, t, q, qd, qdd, tolerance: float = 1e-9) -> list[str]:
-    """Every violated limit on the given samples (empty: all respected)."""
+def check_limits(robot, t, q, qd, qdd, workspace=None, tolerance: float = 1e-9) -> list[str]:
+    """Every violated limit on the given samples, the flange's workspace box included (empty:
+    all respected)."""
     lim = limits_of(robot)
     problems = []
     for name, bad in (("lower", q < lim.lower - tolerance), ("upper", q > lim.upper + tolerance),
@@ -253,4 +263,8 @@ def check_limits(robot, t, q, qd, qdd, tolerance: float = 1e-9) -> list[str]:
                       ("acceleration", np.abs(qdd) > lim.acceleration + tolerance)):
         for j in np.flatnonzero(bad.any(axis=0)):
             problems.append(f"joint {j + 1}: {name} limit exceeded at t = {t[np.argmax(bad[:, j])]:.4g} s")
+    if workspace is not None:
+        outside = np.flatnonzero(~_inside(flange_of(robot)(q), np.asarray(workspace).reshape(3, 2)))
+        if outside.size:
+            problems.append(f"the flange leaves the workspace box at t = {t[outside[0]]:.4g} s")
     return problems

@@ -17,11 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..terms.simple_model import VELOCITY  # rad/s: the simple model's tanh scale
 from . import engine
 from .step import _local, _model
 from ..identification.triangular import fold
-
-VELOCITY = 0.02  # rad/s, diagnosis.baseline.VELOCITY: the simple model's tanh scale
 
 
 @dataclass(frozen=True)

@@ -1,31 +1,70 @@
 """The torque terms: one definition of each, drawn on by identification's columns, the
-diagnosis's candidates, excitation's information matrix and the emitted friction routine.
+diagnosis's candidates (its "effects"), excitation's information matrix and the emitted friction
+routine.
 
-Each term (base.Term) states its fitted values and their physical ranges (base.Value), its
+Each term (term.Term) states its fitted values and their physical ranges (term.Value), its
 nonlinear settings, its regressor columns (numpy, per chunk of samples where `pointwise`), its
 documentation line, and for the friction routine its fields and its C (friction.IN_FRICTION):
-the firmware's friction is, by construction, the law that was fitted.
+the firmware's friction is, by construction, the law that was fitted. An instance is the
+diagnosis's candidate at its settings, its columns of a recording computed in a context
+(context.py): a residual r = tau_measured - tau_model ~= sum over terms of columns @ values.
 
-    rigid_body, payload        body.py     the base regressor; a body on the last link
-    coulomb, viscous, stribeck,
-    direction, ripple, armature friction.py  per joint, of its own motion
     offset, gain, time_shift   sensor.py   errors of the measurement
+    coulomb, viscous, stribeck,
+    direction                  friction.py per joint, of its own motion
+    ripple, armature           rotor.py    the gear's harmonics, the rotor's inertia
+    payload, coefficients      body.py     a body on the last link; the base regressor
     tilt, gravity_scale        tilt.py     gravity turned or scaled (from the joint model)
+
+A nonlinear setting (the Stribeck velocity, the time shift of the exact form) is tried as a few
+fixed variants of one term (`library`), refined once the term is selected (diagnosis/refine.py).
 """
 
 from __future__ import annotations
 
-from .base import FrictionField, Term, Value
-from .body import Payload, RigidBody
-from .friction import (FRICTION_FIELDS, FRICTION_NAMES, IN_FRICTION, Armature, Coulomb, Direction, Ripple, Stribeck,
-                       Viscous, friction_torque)
+from .term import FrictionField, Term, Value
+from .body import FixedShapePayload, Payload, RigidBody
+from .context import Context
+from .friction import (FRICTION_FIELDS, FRICTION_NAMES, IN_FRICTION, SCALE_VARIANTS, STRIBECK_VARIANTS, Coulomb,
+                       Direction, Stribeck, Viscous, friction_torque)
+from .rotor import Armature, Ripple
 from .sensor import Gain, Offset, TimeShift
-from .tilt import GravityScale, Tilt
+from .tilt import GravityScale, Tilt, gravity_matrix
 
-TERMS = (RigidBody, Offset, Coulomb, Viscous, Stribeck, Direction, Ripple, Armature, Payload, Tilt, GravityScale,
-         TimeShift, Gain)
-BY_NAME = {term.name: term for term in TERMS}
+TIME_SHIFTS = (0.001, 0.004, 0.016, 0.064)  # s: the variants tried (factors of 4; refined once selected)
+TERMS = (Offset, Coulomb, Viscous, Stribeck, Direction, Ripple, Armature, Gain, Payload, Tilt, GravityScale,
+         TimeShift, RigidBody)  # every term, in the diagnosis library's order
+NAMES = tuple(term.name for term in TERMS)
+# Errors in every base coefficient: dozens of values that fit anything a little, and over-fit
+# real data (a repeated trajectory selects 43 of them). Tried only when asked for by name.
+NOT_BY_DEFAULT = ("coefficients",)
+DEFAULT_NAMES = tuple(name for name in NAMES if name not in NOT_BY_DEFAULT)
 
-__all__ = ["Armature", "BY_NAME", "Coulomb", "Direction", "FRICTION_FIELDS", "FRICTION_NAMES", "FrictionField", "Gain",
-           "GravityScale", "IN_FRICTION", "Offset", "Payload", "RigidBody", "Ripple", "Stribeck", "TERMS", "Term",
-           "Tilt", "TimeShift", "Value", "Viscous", "friction_torque"]
+
+def check_names(names) -> None:
+    """ValueError naming the unknown effect names, if any."""
+    unknown = sorted(set(names) - set(NAMES))
+    if unknown:
+        raise ValueError(f"unknown effect(s) {', '.join(unknown)}; known: {', '.join(sorted(NAMES))}")
+
+
+def effect_class(name: str) -> type:
+    """The term a report entry names (FixedShapePayload reports as "payload")."""
+    return next(term for term in TERMS if term.name == name)
+
+
+def library(context: Context, names=None) -> list[Term]:
+    """Every candidate tried by default (or those whose name is in `names`), for the diagnosis of
+    one robot and its link parameters (context)."""
+    names = DEFAULT_NAMES if names is None else names
+    check_names(names)
+    candidates = [Offset(), *[Coulomb(v) for v in SCALE_VARIANTS], Viscous(), *[Stribeck(v) for v in STRIBECK_VARIANTS],
+                  Direction(), Ripple(), Armature(), Gain(), Payload.of(context), Tilt.of(context),
+                  GravityScale.of(context), *[TimeShift(dt) for dt in TIME_SHIFTS], RigidBody.of(context)]
+    return [c for c in candidates if c.name in names]
+
+
+__all__ = ["Armature", "Context", "Coulomb", "DEFAULT_NAMES", "Direction", "FRICTION_FIELDS", "FRICTION_NAMES",
+           "FixedShapePayload", "FrictionField", "Gain", "GravityScale", "IN_FRICTION", "NAMES", "Offset", "Payload",
+           "RigidBody", "Ripple", "Stribeck", "TERMS", "TIME_SHIFTS", "Term", "Tilt", "TimeShift", "Value", "Viscous",
+           "check_names", "effect_class", "friction_torque", "gravity_matrix", "library"]

@@ -1,22 +1,41 @@
-"""The rigid body: the base regressor Y(q, qd, qdd) of the full dynamics, and a payload on the
-last link (the Newton-Euler torques of its 10 standard parameters, m, mx, my, mz, XX, XY, XZ,
-YY, YZ, ZZ in the last link's frame, docs/conventions.md)."""
+"""The rigid body and errors in it: the base regressor Y(q, qd, qdd) of the full dynamics (as a
+diagnosis's candidate "coefficients": errors in every base coefficient), and a payload on the
+last link.
+
+payload: the 10 standard parameters (m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ, frame of the last
+  link, docs/conventions.md) of a body fixed to the last link. Newton-Euler is linear in the
+  standard parameters, so its torque columns are rnea(q, qd, qdd, e_k) with e_k the unit vector
+  of the last link's k-th parameter.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK
-from .base import Term, Value
+from .term import Term, Value
 
 
 class RigidBody(Term):
-    name, scope, doc = "rigid_body", "arm", "the rigid body's base coefficients: Y(q, qd, qdd) pi"
+    """The full dynamics' base coefficients pi; as a diagnosis's candidate, errors in every one."""
+
+    name, scope, doc = "coefficients", "arm", "the rigid body's base coefficients: Y(q, qd, qdd) pi"
+
+    def __init__(self, parameters=()):
+        self.parameters = tuple(parameters)  # the standard names of the full model's base coefficients
+        self.units = ("SI",) * len(self.parameters)
 
     @staticmethod
-    def columns(model, q, qd, qdd):
+    def regressor(model, q, qd, qdd):
         """(T, N, r): the compiled model's base regressor."""
         return model.batch("regressor", q, qd, qdd)
+
+    @classmethod
+    def of(cls, context):
+        return cls(e["standard"] for e in context.model.manifest["coefficients"]["full"]["expressions"])
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(context.model, signals.q, signals.qd, signals.qdd)
 
 
 class Payload(Term):
@@ -27,6 +46,13 @@ class Payload(Term):
     values = tuple(Value(n, u) for n, u in zip(STANDARD_NAMES_PER_LINK, (
         "kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")))
     REACH = 1.0  # m: the centre of mass at most this far from the flange frame
+    # Its setting (m, mx, my, mz, refined to the fitted values) is the body whose gravity a tilt
+    # turns with the arm's (Context.load): the product of the two enters the tilt's columns.
+    refinable = shapes_others = True
+
+    def __init__(self, max_mass: float, weight=None):
+        self.max_mass = float(max_mass)  # kg: the arm's own mass; a heavier "payload" is refused
+        self.weight = None if weight is None else tuple(float(x) for x in weight)  # (m, mx, my, mz) setting
 
     @classmethod
     def inside(cls, values, scales=None):
@@ -34,7 +60,7 @@ class Payload(Term):
         return bool(0 < m < scales["arm mass"] and np.linalg.norm(values[1:4]) < cls.REACH * m)
 
     @staticmethod
-    def columns(model, q, qd, qdd, units) -> np.ndarray:
+    def regressor(model, q, qd, qdd, units) -> np.ndarray:
         """(T, N, k): Newton-Euler torques of the last link's standard parameters units[k]."""
         n = q.shape[1]
         out = np.empty(q.shape + (len(units),))
@@ -44,6 +70,148 @@ class Payload(Term):
             out[:, :, k] = model.batch("rnea", q, qd, qdd, s)
         return out
 
+    @classmethod
+    def of(cls, context):
+        return cls(float(np.sum(np.asarray(context.p, dtype=float).reshape(-1, PER_LINK)[:, 0])))
+
+    @property
+    def setting(self):
+        return np.zeros(4) if self.weight is None else np.array(self.weight)
+
+    def implied_setting(self, values):
+        return np.array(values[:4], dtype=float)
+
+    def at(self, setting):
+        return Payload(self.max_mass, setting)
+
+    @property
+    def load(self):
+        return self.weight
+
+    def range_scales(self):
+        return {"arm mass": self.max_mass}
+
+    def simplified(self, values):
+        """A fitted inertia that is no body's (about its centre of mass: a negative principal
+        moment, or one larger than the other two together): at the fitted centre, either the
+        nearest body's inertia per kg of the fitted mass or none (a point mass), as fixed shapes
+        (FixedShapePayload). The data determine m and m c far better than that inertia, and an
+        impossible one mispredicts other motions; which of the two predicts better depends on
+        how far off the fitted one is (at 1 kHz the nearest body's, at 100 Hz from a 17-bit
+        encoder none), so the selection data choose."""
+        if consistent_inertia(values):
+            return None
+        refusal = ("the payload's inertia about its centre of mass (not a body's; the payload keeps its fitted "
+                   "centre, with the nearest body's inertia per kg or none, whichever does better on selection "
+                   "data)", values[4:].tolist())
+        m, c = values[0], values[1:4] / values[0]
+        nearest = nearest_body_inertia(_matrix(values[4:10]) - m * _point(c))
+        return refusal, [FixedShapePayload(c, J, self.max_mass, values[:4]) for J in (nearest / m, np.zeros((3, 3)))]
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(context.model, signals.q, signals.qd, signals.qdd, np.eye(PER_LINK))
+
+    def derived(self, robot, values, std, torque_rms):
+        m = values.get("m")
+        if m in (None, 0.0):
+            return {}
+        return {"mass_kg": m,
+                "com_m": [values[k] / m if values.get(k) is not None else None for k in ("mx", "my", "mz")]}
+
+    @classmethod
+    def last_link(cls, values, variant=None):
+        return None if None in values.values() else standard_of_payload(values, variant)
+
+
+class FixedShapePayload(Payload):
+    """A payload of a fixed shape: centre c0 and inertia J0 about it per kg (those of a fitted
+    Payload whose own inertia came out no body's: Payload.simplified), its mass fitted. Values m
+    and m c; the inertia about the frame origin is m (J0 + |c0|^2 1 - c0 c0^T), a body's for any
+    positive m."""
+
+    values = Payload.values[:4]
+
+    def __init__(self, centre, per_kg, max_mass: float, weight=None):
+        super().__init__(max_mass, weight)
+        self.centre = np.asarray(centre, dtype=float)
+        self.per_kg = np.asarray(per_kg, dtype=float)  # (3, 3) J0
+        centre = "c0=(" + ",".join(f"{x:.4g}" for x in self.centre) + ")"
+        self.label = (f"point mass at {centre}" if not self.per_kg.any() else
+                      f"fixed shape at {centre}, J0=(" + ",".join(f"{self.per_kg[i, k]:.4g}" for i, k in _UPPER) + ")")
+
+    def fixed(self):
+        J = self.per_kg
+        return {"centre_m": [float(x) for x in self.centre],
+                "inertia_per_kg": [float(J[i, k]) for i, k in _UPPER]}  # XX, XY, XZ, YY, YZ, ZZ about the centre
+
+    def at(self, setting):
+        return FixedShapePayload(self.centre, self.per_kg, self.max_mass, setting)
+
+    def simplified(self, values):
+        return None  # always a body
+
+    def columns(self, context, signals, tau_model):
+        I = self.per_kg + _point(self.centre)  # per kg, about the frame origin
+        units = [np.array([1.0, 0, 0, 0, *(I[i, k] for i, k in _UPPER)]), *np.eye(PER_LINK)[1:4]]
+        return self.regressor(context.model, signals.q, signals.qd, signals.qdd, np.array(units))
+
+    @classmethod
+    def last_link(cls, values, variant=None):
+        if None in values.values():
+            return None
+        m = values["m"]
+        c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
+        J = _matrix((variant or {}).get("inertia_per_kg", [0.0] * 6))
+        I = m * (J + _point(c))
+        return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
+
+
+_UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))  # XX, XY, XZ, YY, YZ, ZZ
+
+
+def _matrix(six) -> np.ndarray:
+    XX, XY, XZ, YY, YZ, ZZ = six
+    return np.array([[XX, XY, XZ], [XY, YY, YZ], [XZ, YZ, ZZ]], dtype=float)
+
+
+def _point(c) -> np.ndarray:
+    """Inertia of a unit point mass at c about the origin."""
+    c = np.asarray(c, dtype=float)
+    return c @ c * np.eye(3) - np.outer(c, c)
+
+
+def nearest_body_inertia(I) -> np.ndarray:
+    """The inertia nearest to the symmetric I (in principal moments, same axes) that a body can
+    have: principal moments non-negative, none larger than the other two together. The set is a
+    cone with six faces; the nearest point lies on some of them, so it is the nearest of the
+    projections onto each set of faces that satisfies all six."""
+    e, V = np.linalg.eigh(I)
+    faces = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], dtype=float)
+    best, distance = np.zeros(3), np.inf
+    for subset in range(64):
+        A = faces[[k for k in range(6) if subset >> k & 1]]
+        x = e - A.T @ np.linalg.lstsq(A @ A.T, A @ e, rcond=None)[0] if len(A) else e  # onto A x = 0
+        if np.all(faces @ x >= -1e-15 * max(np.abs(e).max(), 1e-300)) and np.linalg.norm(x - e) < distance:
+            best, distance = x, np.linalg.norm(x - e)
+    return V @ np.diag(np.maximum(best, 0.0)) @ V.T
+
+
+def consistent_inertia(values, tolerance: float = 0.0) -> bool:
+    """Whether a fitted payload's 10 standard values (m, m c, inertia about the frame origin)
+    describe a body: inertia about its centre of mass with non-negative principal moments that
+    satisfy the triangle inequalities."""
+    m, c = values[0], np.asarray(values[1:4]) / values[0]
+    e = np.linalg.eigvalsh(_matrix(values[4:10]) - m * _point(c))
+    return bool(e[0] >= -tolerance and e[0] + e[1] >= e[2] - tolerance)
+
+
+def standard_of_payload(values: dict, variant=None) -> np.ndarray:
+    """The 10 standard parameters of a selected payload (its 10 values, or a fixed shape's 4
+    with the variant's inertia per kg)."""
+    if "XX" in values:
+        return np.array(list(values.values()), dtype=float)
+    return FixedShapePayload.last_link(values, variant)
+
 
 def armature_identifiable(model, dof: int, seed: int = 0) -> list[bool]:
     """Per joint, whether its rotor inertia Ia_j qdd_j (terms.Armature) is independent of the rigid
@@ -51,7 +219,7 @@ def armature_identifiable(model, dof: int, seed: int = 0) -> list[bool]:
     rng = np.random.default_rng(seed)
     states = 40
     q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))
-    Y = model.batch("regressor", q, qd, qdd).reshape(states * dof, -1)
+    Y = RigidBody.regressor(model, q, qd, qdd).reshape(states * dof, -1)
     ok = []
     for j in range(dof):
         col = np.zeros((states, dof))

@@ -1,23 +1,28 @@
-"""Joint friction and rotor inertia: per joint, each acting on its own joint
-and depending on its own motion alone (columns (T, N, k): entry [:, j] acts on joint j).
+"""Joint friction: per joint, each acting on its own joint and depending on its own motion
+alone (columns (T, N, k): entry [:, j] acts on joint j; the gear's ripple and the rotor's
+inertia: rotor.py).
 
     coulomb    Fc tanh(qd / vc)                     [Nm]        vc: the law's velocity scale
     viscous    Fv qd                                [Nm s/rad]
     stribeck   Fs tanh(qd / es) exp(-(qd / vs)^2)   [Nm]        static friction above the Coulomb level
     direction  dFc |tanh(qd / ed)|                  [Nm]        Coulomb levels Fc + dFc forwards, Fc - dFc backwards
-    ripple     sum_k a_k cos(k q) + b_k sin(k q)    [Nm]        gear and cogging harmonics of the joint's position
-    armature   Ia qdd                               [kg m^2]    reflected rotor inertia
 
 Every velocity scale belongs to its own term (vc, es, ed are three numbers, each the one its
 term was fitted with): the emitted friction vector carries each (FRICTION_FIELDS), so the
-firmware's friction is the law that was measured. (Units for a prismatic joint: N, N s/m, kg.)
+firmware's friction is the law that was measured. (Units for a prismatic joint: N, N s/m.)
+
+As the diagnosis's candidates: Coulomb at a few velocity scales vc and Stribeck at a few
+velocities vs, refined once selected (refine.py). vc is fitted because real joints do not
+switch sharply: in stick phases and reversals friction takes any value in [-Fc, Fc], which a
+smooth law with a wider vc follows better than a sharp sign. The Stribeck and direction terms' signs are smoothed by the
+diagnosis's sign velocity (Context.sign_velocity) so that standstill noise does not flip them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .base import FrictionField, Term, Value, sign
+from .term import FrictionField, Term, Value, sign
 
 # The Coulomb law's velocity scale vc, by its use (one place for every default):
 SIMPLE_SCALE = 0.02  # rad/s: the simple model's fixed scale, and identify's when not searched
@@ -26,7 +31,12 @@ SCALE_GRID = (1e-5, 1e-4, 0.0005, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)  # identi
 EXCITATION_SCALE = 0.01  # the excitation's information matrix (a sharper law excites no differently)
 SIGN_SCALE = 0.002  # the Stribeck and direction terms' sign smoothing (diagnose --sign-velocity)
 STRIBECK_VARIANTS = (0.03, 0.1, 0.3)  # rad/s: the diagnosis's Stribeck velocities (well above SIGN_SCALE)
-POSITIVE = dict(low=0.0)  # friction opposes motion, a rotor inertia is positive
+POSITIVE = dict(low=0.0)  # friction opposes motion (a rotor inertia is positive)
+# A Stribeck velocity below this many Coulomb velocity scales only reshapes the Coulomb law:
+# tanh(3) = 0.995, so beyond it the Coulomb law has switched before static friction decays.
+STRIBECK_WIDER = 3.0
+STATIC_EXCESS = 3.0  # Stribeck's static friction above the Coulomb level at most this times that level
+STATIC_RESOLVED = 0.25  # ... and at least this share of it (see Stribeck.refusal_beside)
 
 
 def coulomb(qd, vc):
@@ -34,26 +44,39 @@ def coulomb(qd, vc):
     return np.tanh(qd / vc)
 
 
-def stribeck(qd, vs, es):
-    """tanh(qd / es) exp(-(qd / vs)^2): static friction decaying with speed."""
-    return np.tanh(qd / es) * np.exp(-(qd / vs) ** 2)
+class _AtVelocity(Term):
+    """A friction term at one velocity setting (`velocity`, its field `field`): the diagnosis's
+    variant of it, refined once selected."""
+
+    field = ""
+    switching = refinable = local = True
+
+    def __init__(self, velocity: float):
+        self.velocity = float(velocity)
+        self.label = f"{self.field}={self.velocity:g}"
+
+    def fixed(self):
+        return {self.field: self.velocity}
+
+    @property
+    def setting(self):
+        return self.velocity
+
+    def at(self, setting):
+        return type(self)(setting)
 
 
-def direction(qd, ed):
-    """|tanh(qd / ed)|: the same sign of torque both ways."""
-    return np.abs(np.tanh(qd / ed))
-
-
-class Coulomb(Term):
+class Coulomb(_AtVelocity):
     name, doc = "coulomb", "Coulomb friction Fc tanh(qd / vc), vc fitted (real joints do not switch sharply)"
-    switching = True
+    field = "vc"
     values = (Value("Fc", "Nm", **POSITIVE),)
     settings = (Value("vc", "rad/s", **POSITIVE),)
     friction = (FrictionField("Fc", "value", "Coulomb friction [Nm or N]"),
                 FrictionField("vc", "velocity", "its velocity scale: tanh(qd / vc); the plain sign when <= 0 [rad/s or m/s]"))
+    simulator = ("friction", "Fc")
 
     @staticmethod
-    def columns(qd, vc):
+    def regressor(qd, vc):
         return coulomb(qd, vc)[..., None]
 
     @classmethod
@@ -64,14 +87,29 @@ class Coulomb(Term):
     def torque(cls, m, v, f):
         return f["Fc"] * sign(m, v, f["vc"])
 
+    def columns(self, context, signals, tau_model):
+        return self.regressor(signals.qd, self.velocity)
+
+    def search_interval(self, values, beside=()):
+        # Reaches the neighbouring variants; below a Stribeck velocity on the joint (static
+        # friction breaks away within the Coulomb transition and decays after it; a Coulomb scale
+        # refined freely drifts up to the Stribeck velocity until the two laws merge).
+        hi = min([self.velocity * 4] + [e.velocity / STRIBECK_WIDER for e in beside if isinstance(e, Stribeck)])
+        return min(self.velocity / 4, hi), hi
+
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"Fc": values["Fc"], "vc": variant["vc"]}  # the fitted velocity scale
+
 
 class Viscous(Term):
     name, doc = "viscous", "viscous friction Fv qd"
     values = (Value("Fv", "Nm s/rad", **POSITIVE),)
     friction = (FrictionField("Fv", "value", "viscous friction [Nm s/rad or N s/m]"),)
+    local, simple_term, simulator = True, "Fv", ("damping", "Fv")
 
     @staticmethod
-    def columns(qd):
+    def regressor(qd):
         return qd[..., None]
 
     @classmethod
@@ -82,20 +120,31 @@ class Viscous(Term):
     def torque(cls, m, v, f):
         return f["Fv"] * v
 
+    def columns(self, context, signals, tau_model):
+        return self.regressor(signals.qd)
 
-class Stribeck(Term):
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"Fv": values["Fv"]}
+
+
+class Stribeck(_AtVelocity):
     name, doc = "stribeck", "Stribeck friction Fs tanh(qd / es) exp(-(qd / vs)^2): breakaway friction above Coulomb's"
-    switching = True
+    field = "vs"
     values = (Value("Fs", "Nm", **POSITIVE),)
     settings = (Value("vs", "rad/s", **POSITIVE), Value("es", "rad/s", **POSITIVE))
     friction = (FrictionField("Fs", "value", "Stribeck friction (breakaway minus Coulomb) [Nm or N]"),
                 FrictionField("vs", "velocity", "Stribeck velocity; no Stribeck term when <= 0 [rad/s or m/s]"),
                 FrictionField("es", "velocity", "its sign's smoothing: tanh(qd / es); the plain sign when <= 0 "
                                                 "[rad/s or m/s]"))
+    # Static friction above the Coulomb level. Alone, it would be friction that vanishes at
+    # speed, which no joint has, and the viscous law would then take the Coulomb level's place
+    # (extrapolating steeply beyond the fit speeds).
+    extends = "coulomb"
 
     @staticmethod
-    def columns(qd, vs, es):
-        return stribeck(qd, vs, es)[..., None]
+    def regressor(qd, vs, es):
+        return (np.tanh(qd / es) * np.exp(-(qd / vs) ** 2))[..., None]
 
     @classmethod
     def c(cls, v, f, c):
@@ -106,10 +155,45 @@ class Stribeck(Term):
     def torque(cls, m, v, f):
         return f["Fs"] * sign(m, v, f["es"]) * m.exp(-(v / f["vs"]) ** 2) if f["vs"] > 0 else 0 * v
 
+    def columns(self, context, signals, tau_model):
+        return self.regressor(signals.qd, self.velocity, context.sign_velocity)
+
+    def search_interval(self, values, beside=()):
+        # Reaches the neighbouring variants; no narrower than STRIBECK_WIDER times the joint's
+        # Coulomb scale (see reshapes).
+        lo = max([self.velocity / 3] + [STRIBECK_WIDER * e.velocity for e in beside if isinstance(e, Coulomb)])
+        return lo, max(self.velocity * 3, lo)
+
+    def refusal_beside(self, values, base):
+        """Static friction above the Coulomb level, between STATIC_RESOLVED and STATIC_EXCESS
+        times that level. A breakaway torque of ten Coulomb levels at a reversal is no joint's:
+        it is a spike standing in for a conditioning artefact (at 100 Hz, 17-bit positions: Fs
+        10.5 Nm beside Fc 1.0). A small excess is what a low-pass filter makes of the reversals
+        of friction that sticks, where the torque takes any value within the Coulomb levels
+        while the filtered velocity passes through zero smoothly (withheld benchmark, `sticky`,
+        no static friction injected: 0.04-0.13 Nm beside 0.4-0.9 Nm; injected static friction
+        came out at 0.9-1.6 Coulomb levels)."""
+        if np.any(values > STATIC_EXCESS * base):
+            return f"static friction above {STATIC_EXCESS:g} Coulomb levels is no joint's"
+        if np.any(values < STATIC_RESOLVED * base):
+            return (f"static friction less than {STATIC_RESOLVED:g} of the Coulomb level above it is not told apart "
+                    "from a filter's rounding of reversals where friction sticks")
+        return ""
+
+    def reshapes(self, other):
+        """No wider than STRIBECK_WIDER times the joint's Coulomb velocity scale (up to the
+        search's 1 % tolerance: refined onto that bound): there the two laws trade shape with
+        each other, and no static friction is shown."""
+        return isinstance(other, Coulomb) and self.velocity < 1.02 * STRIBECK_WIDER * other.velocity
+
+    @classmethod
+    def friction_terms(cls, values, variant):
+        return {"Fs": values["Fs"], "vs": variant["vs"]}  # its sign's smoothing: the context's (friction_vector)
+
 
 class Direction(Term):
     name, doc = "direction", "direction-dependent Coulomb friction dFc |tanh(qd / ed)| (Fc + dFc forwards, Fc - dFc back)"
-    switching = True
+    switching = secondary = local = True
     values = (Value("dFc", "Nm"),)
     settings = (Value("ed", "rad/s", **POSITIVE),)
     friction = (FrictionField("dFc", "value", "Coulomb level's excess moving forwards over moving backwards, halved "
@@ -117,8 +201,8 @@ class Direction(Term):
                 FrictionField("ed", "velocity", "its sign's smoothing: |tanh(qd / ed)|; |sign| when <= 0 [rad/s or m/s]"))
 
     @staticmethod
-    def columns(qd, ed):
-        return direction(qd, ed)[..., None]
+    def regressor(qd, ed):
+        return np.abs(np.tanh(qd / ed))[..., None]
 
     @classmethod
     def c(cls, v, f, c):
@@ -128,37 +212,12 @@ class Direction(Term):
     def torque(cls, m, v, f):
         return f["dFc"] * abs(sign(m, v, f["ed"]))
 
-
-class Ripple(Term):
-    """Known only where the data went: the diagnosis clips q to the fit data's range (harmonics
-    extrapolated beyond it are guesses); a prismatic joint has none (harmonics of metres)."""
-
-    HARMONICS = (1, 2, 3)
-    name, doc = "ripple", "position ripple sum_k a_k cos(k q) + b_k sin(k q) (gear and cogging harmonics)"
-    values = tuple(Value(f"{ab}{k}", "Nm") for k in HARMONICS for ab in ("a", "b"))
-
-    @staticmethod
-    def harmonic(q, k: int, kind: str):
-        """cos(k q) or sin(k q) (one column, e.g. identify's first harmonic)."""
-        x = q if k == 1 else k * q
-        return np.cos(x) if kind == "cos" else np.sin(x)
+    def columns(self, context, signals, tau_model):
+        return self.regressor(signals.qd, context.sign_velocity)
 
     @classmethod
-    def columns(cls, q, revolute, q_range=None, harmonics=HARMONICS):
-        if q_range is not None:
-            q = np.clip(q, *q_range)
-        out = np.stack([f(k * q) for k in harmonics for f in (np.cos, np.sin)], axis=-1)
-        out[..., ~np.asarray(revolute, dtype=bool), :] = 0.0
-        return out
-
-
-class Armature(Term):
-    name, doc = "armature", "rotor inertia Ia qdd (reflected through the gear)"
-    values = (Value("Ia", "kg m^2", **POSITIVE),)
-
-    @staticmethod
-    def columns(qdd):
-        return qdd[..., None]
+    def friction_terms(cls, values, variant):
+        return {"dFc": values["dFc"]}  # its sign's smoothing: the context's (friction_vector)
 
 
 IN_FRICTION = (Coulomb, Viscous, Stribeck, Direction)  # the terms of the emitted friction routine, in its order

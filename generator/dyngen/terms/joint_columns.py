@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .friction import Armature, Coulomb, Ripple, Viscous
+from .friction import Coulomb, Viscous
+from .rotor import Armature, Ripple
 from .sensor import Offset
 
 DEFAULT_KINDS = ("coulomb", "viscous", "offset", "armature")  # identify's per-joint columns always in
@@ -21,13 +22,13 @@ def column(kind: str, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, vc: float 
     """(T,): the column of `kind` in its joint's rows (coulomb: at velocity scale vc, unfiltered;
     ripple_cos, ripple_sin: the first harmonic of the position)."""
     if kind == "coulomb":
-        return Coulomb.columns(qd, vc)[:, 0]
+        return Coulomb.regressor(qd, vc)[:, 0]
     if kind == "viscous":
-        return Viscous.columns(qd)[:, 0]
+        return Viscous.regressor(qd)[:, 0]
     if kind == "offset":
-        return Offset.columns(qd.shape)[:, 0]
+        return Offset.regressor(qd.shape)[:, 0]
     if kind == "armature":
-        return Armature.columns(qdd)[:, 0]
+        return Armature.regressor(qdd)[:, 0]
     if kind in ("ripple_cos", "ripple_sin"):
         return Ripple.harmonic(q, 1, kind[-3:])
     raise ValueError(kind)

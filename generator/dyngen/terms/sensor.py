@@ -3,15 +3,22 @@
     offset      b                                  per joint [Nm]: the torque sensor's zero
     gain        (k - 1) tau_model                  per joint [1]: the sensor reads k times the torque
     time_shift  (tau(t - dt0) - tau(t)) / dt0      whole arm [s]: torques lag the positions by dt
-                                                   (the exact form at a shift dt0, fitted dt; its
-                                                   columns need dt0 of samples before a chunk)
+
+The time shift is linear in dt only to first order, -dt * d tau_model / dt, which fails wherever
+tau_model jumps (an acceleration step): the measured torque keeps the value before the jump for
+dt, while the sampled derivative puts a spike of jump * dt / (2 h) on the two samples around it
+(h the sample period; 5 times the jump for 10 ms at 1 kHz). So its column is the exact form at a
+shift dt0 (tau_model interpolated linearly in time; its columns need dt0 of samples before a
+chunk), whose fitted value dt equals dt0 when the model holds. The diagnosis tries a few variants
+of dt0 (TIME_SHIFTS, terms/__init__.py); once selected, dt0 is refined by fixed-point iteration
+dt0 <- dt (refine.py), which also reaches negative shifts (torques leading the positions).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .base import Term, Value
+from .term import Term, Value
 
 MAX_GAIN = 0.5  # a sensor that reads 0.5 to 1.5 times the torque
 MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor's time shift
@@ -20,19 +27,50 @@ MAX_SHIFT = 0.1  # s: a longer lag between positions and torques is not a sensor
 class Offset(Term):
     name, doc = "offset", "torque-sensor zero offset b"
     values = (Value("b", "Nm"),)
+    simple_term = "b"
+    local = sensor = True
 
     @staticmethod
-    def columns(shape):
+    def regressor(shape):
         return np.ones(tuple(shape) + (1,))
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(signals.q.shape)
 
 
 class Gain(Term):
+    """measured = (1 + k-1) * torque: the model's torque (its column) and every other term's
+    torque on the arm alike, friction and payload included. Its setting g0 is the gain those are
+    scaled by (Context.scale), refined to the fitted value once selected (0 while selecting)."""
+
     name, doc = "gain", "torque-sensor gain: the measured torque is (1 + (k - 1)) times the arm's"
     values = (Value("k-1", "1", -MAX_GAIN, MAX_GAIN),)
+    refinable = sensor = scales = shapes_others = True
+    tolerance = 1e-4  # of the torque: far below any gain a diagnosis reports
+
+    def __init__(self, gain: float = 0.0):
+        self.gain = float(gain)
+        self.label = f"g0={self.gain:.6g}" if self.gain else ""
 
     @staticmethod
-    def columns(tau_model):
+    def regressor(tau_model):
         return tau_model[:, :, None]
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(tau_model)
+
+    @property
+    def setting(self):
+        return self.gain
+
+    def implied_setting(self, values):
+        return float(values[0])
+
+    def at(self, setting):
+        return Gain(setting)
+
+    def derived(self, robot, values, std, torque_rms):
+        return {"factor": 1.0 + values["k-1"]}
 
 
 class TimeShift(Term):
@@ -40,9 +78,33 @@ class TimeShift(Term):
     values = (Value("dt", "s", -MAX_SHIFT, MAX_SHIFT),)
     settings = (Value("dt0", "s"),)
     pointwise = False
+    refinable = sensor = delays = shapes_others = True
+
+    def __init__(self, shift: float):
+        self.shift = float(shift)  # dt0 [s], not 0
+        self.label = f"dt0={self.shift:.6g}"
 
     @staticmethod
-    def columns(t, tau_model, dt0: float):
+    def regressor(t, tau_model, dt0: float):
         # Before the first sample the torque is held at its first value (np.interp's ends).
         shifted = np.column_stack([np.interp(t - dt0, t, tau) for tau in tau_model.T])
         return ((shifted - tau_model) / dt0)[:, :, None]
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(signals.t, tau_model, self.shift)
+
+    def fixed(self):
+        return {"dt0": self.shift}
+
+    @property
+    def setting(self):
+        return self.shift
+
+    def implied_setting(self, values):
+        return float(values[0]) or None
+
+    def at(self, setting):
+        return TimeShift(setting)
+
+    def derived(self, robot, values, std, torque_rms):
+        return {"dt_ms": 1e3 * values["dt"], "dt_std_ms": 1e3 * std["dt"]}

@@ -14,10 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .friction import SIMPLE_SCALE, coulomb
+from .friction import SIMPLE_SCALE, Coulomb, Viscous, coulomb
+from .sensor import Offset
 
 VELOCITY = SIMPLE_SCALE  # rad/s: the simple model's tanh scale (fixed, not fitted)
-NAMES = ("b", "Fc", "Fv")
+NAMES = Offset.parameters + Coulomb.parameters + Viscous.parameters  # b, Fc, Fv: its columns' order
 
 
 @dataclass

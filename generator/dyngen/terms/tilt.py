@@ -12,8 +12,9 @@ tilt: a rotation of the base turns gvec by d gvec = dg1 u1 + dg2 u2 across gravi
   u2 = base -y), and shortens it along n by what keeps |gvec|: -(dg1^2 + dg2^2) / (2 |g|) to
   second order. Its column k is G u_k - G n dg_k0 / (2 |g|), linearised at an estimate dg_k0 and
   refitted there, so a tilt cannot change gravity's size. Beyond MAX_TILT_DEG it is no mounting
-  error.
-gravity_scale: G n dg: every link's gravity torque scaled alike (no tilt does this).
+  error (the diagnosis refuses it).
+gravity_scale: G n dg: every link's gravity torque scaled alike (no tilt does this: the
+  diagnosis reports it as suspect, a symptom, not a cause).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..description.joint_model import forward_kinematics
-from .base import Term, Value
+from .term import Term, Value
 
 MAX_TILT_DEG = 10.0  # a larger tilt is no mounting error
 MAX_GRAVITY_SCALE = 0.1  # relative: a larger change of gravity's size is no tilt's nor a model's rounding
@@ -127,34 +128,112 @@ def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
 
 
 class Tilt(Term):
+    """As the diagnosis's candidate the second-order term is linearised at the current estimate,
+    refined by fixed-point iteration once the tilt is selected (refine.py); its angles are named
+    by the base axes it turns gravity towards (tilt_axes)."""
+
     name, scope, doc = "tilt", "arm", "a tilted base: gravity turned by dg1 u1 + dg2 u2, its size kept"
     values = (Value("dg1", "m/s^2"), Value("dg2", "m/s^2"))
+    refinable = True
+
+    def __init__(self, g: float, directions, estimate=(0.0, 0.0)):
+        self.g = float(g)  # |gravity| of the robot's model
+        self.directions = directions  # (u1, u2): tilt_directions of the robot
+        self.estimate = tuple(float(x) for x in estimate)  # dg1, dg2 of the second-order term
+        self.label = "" if not any(self.estimate) else f"dg0=({self.estimate[0]:.6g},{self.estimate[1]:.6g})"
 
     @classmethod
     def inside(cls, values, scales=None):
         return bool(np.hypot(*values[:2]) < scales["g"] * np.sin(np.radians(MAX_TILT_DEG)))
 
     @staticmethod
-    def columns(G, u1, u2, g: float, estimate=(0.0, 0.0)):
+    def regressor(G, u1, u2, g: float, estimate=(0.0, 0.0)):
         """(T, N, 2) from G (T, N, 3), linearised at the estimate (dg1, dg2)."""
         along = G @ np.cross(u1, u2)
         return np.stack([G @ u1 - along * estimate[0] / (2 * g), G @ u2 - along * estimate[1] / (2 * g)], axis=-1)
+
+    @classmethod
+    def of(cls, context):
+        return cls(gravity_norm(context.robot), tilt_directions(context.robot))
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(recording_gravity(context, signals), *self.directions, self.g, self.estimate)
+
+    def reads(self, context):
+        return (context.load,)
+
+    def range_scales(self):
+        return {"g": self.g}
+
+    @property
+    def setting(self):
+        return np.array(self.estimate)
+
+    def implied_setting(self, values):
+        return np.array(values[:2], dtype=float) if np.any(values[:2]) else None
+
+    def at(self, setting):
+        return Tilt(self.g, self.directions, setting)
+
+    def derived(self, robot, values, std, torque_rms):
+        if None in values.values():
+            return {}
+        a1, a2 = tilt_angles_deg(robot, [values["dg1"], values["dg2"]])
+        s1, s2 = tilt_angles_deg(robot, [std["dg1"], std["dg2"]])
+        return {"tilt_deg": [a1, a2], "tilt_std_deg": [abs(s1), abs(s2)], "tilt_towards": list(tilt_axes(robot)),
+                "tilt_total_deg": float(np.hypot(a1, a2))}
 
 
 class GravityScale(Term):
     name, scope, doc = "gravity_scale", "arm", "gravity's size changed by dg: every link's gravity torque scaled alike"
     values = (Value("dg", "m/s^2", -MAX_GRAVITY_SCALE, MAX_GRAVITY_SCALE, per="g"),)
+    suspect = ("no tilt changes gravity's size; every link's gravity torque scaled alike points at masses and "
+               "centres of mass wrong by one factor, or at a torque-sensor gain")
+    secondary = True
+
+    def __init__(self, g: float):
+        self.g = float(g)  # |gravity| of the robot's model
 
     @staticmethod
-    def columns(G, u1, u2):
+    def regressor(G, u1, u2):
         return (G @ np.cross(u1, u2))[:, :, None]
+
+    @classmethod
+    def of(cls, context):
+        return cls(gravity_norm(context.robot))
+
+    def columns(self, context, signals, tau_model):
+        return self.regressor(recording_gravity(context, signals), *tilt_directions(context.robot))
+
+    def reads(self, context):
+        return (context.load,)
+
+    def range_scales(self):
+        return {"g": self.g}
+
+    def derived(self, robot, values, std, torque_rms):
+        return {} if values.get("dg") is None else {"relative": values["dg"] / self.g}
+
+
+def recording_gravity(context, signals) -> np.ndarray:
+    """G(q) of a recording (memoised in the context: the tilt's and the gravity scale's), with a
+    chosen payload (Context.load) on the last link: a tilt turns its gravity too (B of
+    body_gravity_matrix times its (m, mx, my, mz))."""
+    def poses():
+        return context.memo(("poses", id(signals)), lambda: forward_kinematics(context.robot.joint_models, signals.q))
+
+    G = context.memo(("gravity_matrix", id(signals)), lambda: gravity_matrix(context.robot, context.p, signals.q, poses()))
+    if context.load is None:
+        return G
+    B = context.memo(("body_gravity", id(signals)), lambda: body_gravity_matrix(context.robot, signals.q, poses()))
+    return G + B @ np.asarray(context.load)
 
 
 def rotation_columns(robot, p, q, g, a0=(0.0, 0.0)) -> np.ndarray:
     """(T, N, 2): the tilt's columns at positions q for link parameters p and gravity g,
     linearised at a0 (identify's rotation; the diagnosis's Tilt is the same term)."""
     D = directions(g)
-    return Tilt.columns(gravity_matrix(robot, p, q), D[0], D[1], float(np.linalg.norm(g)), a0)
+    return Tilt.regressor(gravity_matrix(robot, p, q), D[0], D[1], float(np.linalg.norm(g)), a0)
 
 
 def torque(robot, p, q, g, a) -> np.ndarray:
