@@ -214,7 +214,7 @@ def tilt_columns(g_vec, a=(0.0, 0.0)):
     if g_vec is None:
         return None
     D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))
-    return lambda G: tilt.Tilt.columns(G, D[0], D[1], size, a)
+    return lambda G: tilt.Tilt.regressor(G, D[0], D[1], size, a)
 
 
 def velocity_limits(robot, sources) -> np.ndarray:
