@@ -21,7 +21,7 @@ from conftest import ROOT
 from dyngen.runtime import library_sources
 
 FOLDER = ROOT / "generated" / "lwr"
-LIBM = {"sin", "cos", "sinf", "cosf", "sincos", "sincosf", "sqrt", "sqrtf",  # sqrt: the sincos macro's cosine (libm only on its errno path)
+LIBM = {"sin", "cos", "sinf", "cosf", "sincos", "sincosf", "sqrt",  # the double sincos macro's cosine (libm only on its errno path)
         "exp", "expf", "tanh", "tanhf"}  # exp and tanh: the optional friction routine (Stribeck term, smooth sign)
 COMPILER_SUPPORT = {"memset", "memcpy", "memmove"}  # GCC's freestanding requirements (gcc docs, "Standards")
 HELPER = re.compile(r"__aeabi_\w+")
