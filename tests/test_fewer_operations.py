@@ -1,6 +1,6 @@
-"""Issue 24's emitter changes: the header's sincos macro (cos from sqrt(1 - sin^2) in double) and
-the statement scheduler (emission/schedule.py), each against an oracle of its own: numpy's sin
-and cos at the same angles, and a count of live values done here by hand."""
+"""Issue 24's emitter: the header's sincos macro (the bound it states) and the statement
+scheduler (emission/schedule.py), each against an oracle of its own: numpy's sin and cos at the
+same angles, and a count of live values done here by hand."""
 
 from __future__ import annotations
 

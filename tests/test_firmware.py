@@ -2,7 +2,7 @@
 
 Cross-compiled with Debian's arm-none-eabi-gcc (scripts/setup.sh installs it) for a Cortex-M4F
 in float and a Cortex-M7 in double, -ffreestanding, warnings as errors; the objects' undefined
-symbols may only be libm's sin/cos/sqrt (and GCC's sincos fusion of them) and the compiler's own
+symbols may only be libm's sin/cos (and GCC's sincos fusion of them) and the compiler's own
 helpers (__aeabi_* on ARM; memset/memcpy, which GCC may emit even when freestanding). No heap,
 no stdio, no globals (.data and .bss empty). The host build is checked the same way.
 bench/bench_firmware.py measures sizes and stack use for all eight configurations.
@@ -21,7 +21,7 @@ from conftest import ROOT
 from dyngen.runtime import library_sources
 
 FOLDER = ROOT / "generated" / "lwr"
-LIBM = {"sin", "cos", "sinf", "cosf", "sincos", "sincosf", "sqrt",  # the double sincos macro's cosine (libm only on its errno path)
+LIBM = {"sin", "cos", "sinf", "cosf", "sincos", "sincosf",
         "exp", "expf", "tanh", "tanhf"}  # exp and tanh: the optional friction routine (Stribeck term, smooth sign)
 COMPILER_SUPPORT = {"memset", "memcpy", "memmove"}  # GCC's freestanding requirements (gcc docs, "Standards")
 HELPER = re.compile(r"__aeabi_\w+")
