@@ -42,7 +42,7 @@ class Model:
         return self.program.pruned(self.outputs)
 
 
-GROUPING_LIMIT = 10  # largest |K| entry for which rnea, gravity and M run over the base coefficients
+GROUPING_LIMIT = 10  # largest |K| entry of a standard parameter that rnea, gravity and M group into the base coefficients
 
 
 class Derivation:
@@ -93,9 +93,11 @@ class Derivation:
         program, sym, chain = self._start()
         exact = [sp.Rational(repr(float(v))) for v in p_values]
         s = [x for i in range(self.n) for x in standard_from_dynamic_link(exact[PER_LINK * i: PER_LINK * (i + 1)])]
-        params = s  # where K has a large entry, the grouped form cancels in float (_grouped)
-        if not any(abs(k) > GROUPING_LIMIT for row in base.K for k in row):
-            params = self._placed(base, [sp.Add(*(k * v for k, v in zip(row, s) if k != 0)) for row in base.K])
+        kept = _ungroupable(base)  # their large factors would cancel in float (_grouped)
+        params = self._placed(base, [sp.Add(*(k * v for j, (k, v) in enumerate(zip(row, s)) if k != 0 and j not in kept))
+                                     for row in base.K])
+        for j in kept:
+            params[j] = s[j]
         tau = self._interleaved(program, chain, sym.qd, sym.qdd, params)
         return Model("rnea_nominal", self._joint_inputs(sym, "q", "qd", "qdd") + self._gravity_inputs(),
                      tau, (self.n,), "inverse dynamics at fixed parameters (Newton-Euler)", program, sym.trig)
@@ -124,16 +126,24 @@ class Derivation:
                      (self.n, self.n), "inertia matrix M(q), row-major", program, sym.trig)
 
     def _grouped(self, program, base) -> list:
-        """The parameters the recursion reads: s itself, or s* from pi = K s (see above). Only
-        where no entry of K exceeds GROUPING_LIMIT in size: an entry like 1/0.0203 (a regrouping
-        that divides by a short length, PUMA 560) makes pi and the products with it cancel in
-        float (2e-4 of the torques instead of 2e-6); there the standard parameters stay. The
-        other example arms' largest entries (1/0.4 on the LWR, 6.5 on the UR5) cost nothing in
-        float (bench/bench_opcounts.py)."""
-        if base is None or any(abs(k) > GROUPING_LIMIT for row in base.K for k in row):
+        """The parameters the recursion reads: s itself, or s* from pi = K s (see above), grouped
+        column by column. A standard parameter whose column of K has an entry above
+        GROUPING_LIMIT in size (a regrouping that divides by a short length, 1/0.0203 on the
+        PUMA 560) is not grouped: such a factor makes pi and the products with it cancel in float
+        (2e-4 of the torques instead of 2e-6). It keeps its own place in the recursion and the
+        coefficients leave it out. Exact either way: column j of Y is Y_b times column j of K, so
+        Y s = Y_b (K' s) + sum over the kept j of Y_j s_j, with K' = K without the kept columns.
+        The other example arms' largest entries (1/0.4 on the LWR, 6.5 on the UR5) cost nothing
+        in float (bench/bench_opcounts.py), so all their parameters are grouped."""
+        if base is None:
             return self.s
         program.section = f"base coefficients pi_{base.kind} = K s"
-        return self._placed(base, [_linear_form(program, row, self.s) for row in base.K])
+        kept = _ungroupable(base)
+        params = self._placed(base, [_linear_form(program, [0 if j in kept else k for j, k in enumerate(row)], self.s)
+                                     for row in base.K])
+        for j in kept:
+            params[j] = self.s[j]
+        return params
 
     def _placed(self, base, pi) -> list:
         params = [sp.Integer(0)] * len(self.s)
@@ -202,6 +212,11 @@ class Derivation:
             out += program.let_vector(standard_from_dynamic_link(self.p[PER_LINK * i: PER_LINK * (i + 1)]))
         return Model("standard_from_dynamic", [Input("p", self.p, ARGUMENTS["p"].meaning)], out,
                      (PER_LINK * self.n,), "standard parameters s from dynamic parameters p", program)
+
+
+def _ungroupable(base) -> set:
+    """Standard parameters (non-base columns) whose column of K has an entry above GROUPING_LIMIT."""
+    return {j for row in base.K for j, k in enumerate(row) if abs(k) > GROUPING_LIMIT}
 
 
 def _linear_form(program: Program, row, s) -> sp.Expr:

@@ -13,6 +13,7 @@ from sympy.printing.c import C99CodePrinter
 
 from .factoring import factored
 from .opcount import OpCount, count_all
+from .schedule import scheduled
 
 
 @dataclass
@@ -123,7 +124,8 @@ class StraightLine:
 
 def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     """Declarations of everything `outputs` (expressions of the model's program) need."""
-    pruned = model.program.pruned(outputs)
+    outputs_free = set().union(*(sp.sympify(o).free_symbols for o in outputs))
+    pruned = scheduled(model.program.pruned(outputs), outputs_free, model.trig)
     names = input_names(model)
     names.update({a.symbol: f"x{k}" for k, a in enumerate(pruned)})  # dense numbering: stable diffs
     printer = Printer(prefix, names)
@@ -143,12 +145,12 @@ def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     for k, a in enumerate(pruned):
         for s in a.expr.free_symbols & set(trig_used):
             first_use.setdefault(model.trig[s][0], k)
-    section = None
+    seen = set()
     written = [factored(a.expr) for a in pruned]
     for k, (a, expr) in enumerate(zip(pruned, written)):
-        if a.section != section:
-            section = a.section
-            body.append(f"/* {section} */")
+        if a.section not in seen:  # statements are scheduled (schedule.py): a section's comment marks its start
+            seen.add(a.section)
+            body.append(f"/* {a.section} */")
         for joint in sorted(j for j, first in first_use.items() if first == k):
             body += angles[joint]
         body.append(f"const {real} {names[a.symbol]} = {printer.doprint(expr)};")

@@ -1,0 +1,68 @@
+"""Statement order for the register allocator: fewer values live at once, fewer spills.
+
+gcc -O2 on x86-64 keeps the order of a basic block's statements (no pre-allocation
+scheduling) and has 16 floating-point registers; a value computed long before its last use
+is stored to the stack and loaded again. A straight-line program's statements may come in
+any order that respects their dependencies, so this greedy list scheduler picks, among the
+statements whose operands exist, the one that ends the most live values and starts the
+fewest (a sine/cosine pair counts as two values, started by its first reader), then the
+earliest in the original order (so ties keep the per-link reading order). Preferring the
+statement that reads the latest value (depth first) was tried: more values live, more
+instructions (Panda rnea 1731 Ir per call against 1721 unscheduled and 1675 with this rule). Same statements, same operations, same
+results to the bit: only the order of independent statements changes.
+"""
+
+from __future__ import annotations
+
+LARGEST = 4000  # statements; above it the quadratic search costs more generation time than it saves
+
+
+def scheduled(assignments: list, outputs_free: set, trig: dict) -> list:
+    """assignments reordered (a topological order of their dependencies). outputs_free: the
+    symbols the outputs read (they stay live to the end); trig: symbol -> (joint, fn)."""
+    n = len(assignments)
+    if n > LARGEST or n < 3:
+        return assignments
+    index = {a.symbol: k for k, a in enumerate(assignments)}
+    reads = [sorted(index[s] for s in a.expr.free_symbols if s in index) for a in assignments]
+    angles = [sorted({trig[s][0] for s in a.expr.free_symbols if s in trig}) for a in assignments]
+    users = [0] * n
+    for deps in reads:
+        for d in deps:
+            users[d] += 1
+    for s in outputs_free:
+        if s in index:
+            users[index[s]] += 1  # kept to the end
+    angle_users: dict = {}
+    for joints in angles:
+        for j in joints:
+            angle_users[j] = angle_users.get(j, 0) + 1
+    waiting = [len(deps) for deps in reads]
+    readers = [[] for _ in range(n)]
+    for k, deps in enumerate(reads):
+        for d in deps:
+            readers[d].append(k)
+    ready = {k for k in range(n) if not reads[k]}
+    order = []
+
+    def score(k):
+        ended = sum(1 for d in reads[k] if users[d] == 1)
+        ended += sum(2 for j in angles[k] if angle_users[j] == 1)
+        started = (1 if users[k] else 0) + sum(2 for j in angles[k] if opened.get(j) is None)
+        return (ended - started, -k)
+
+    opened: dict = {}
+    while ready:
+        k = max(ready, key=score)
+        ready.discard(k)
+        order.append(assignments[k])
+        for d in reads[k]:
+            users[d] -= 1
+        for j in angles[k]:
+            opened[j] = True
+            angle_users[j] -= 1
+        for r in readers[k]:
+            waiting[r] -= 1
+            if waiting[r] == 0:
+                ready.add(r)
+    return order
