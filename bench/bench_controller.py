@@ -85,19 +85,20 @@ def casadi_wrappers(a: dict) -> list:
     return lines
 
 
-def casadi_controller(a: dict, yaml_path: Path) -> dict:
+def casadi_controller(a: dict, yaml_path: Path, cc: str, flags: list) -> dict:
     """CasADi's C of the controller functions for the arm's Pinocchio model, beside its dynamics' C."""
     from oracles import pinocchio_arm
     from oracles.arm import Arm
 
     model, _ = pinocchio_arm.build(Arm.from_yaml(yaml_path), a["p"])
-    return casadi_side.generate_controller(model, a["name"], a["folder"] / "casadi")
+    return casadi_side.generate_controller(model, a["name"], a["folder"] / "casadi", cc, flags)
 
 
 def arm_inc(a: dict) -> str:
     name, n = a["name"], a["n"]
     numbers = lambda xs: ", ".join(repr(float(x)) for x in xs)  # noqa: E731
-    return "\n".join([f'#include "{name}.h"', f'#include "{name}_casadi_controller.h"',
+    headers = [f'#include "{info["header"].name}"' for info in a["casadi_controller"].values()]
+    return "\n".join([f'#include "{name}.h"', *headers,
                       f"#define ARM(fn) {name}_##fn", f"#define N {n}",
                       f"#define N_PI_FULL {a['shapes']['pi_full'][0]}",
                       f"static const double P[{10 * n}] = {{{numbers(a['p'])}}};",
@@ -115,9 +116,8 @@ def build(a: dict, work: Path, cc: str, cxx: str, flags: list, pin_objs: list) -
         obj = out / (src.stem + ".o")
         run([cc, "-std=c99", *flags, "-c", str(src), "-o", str(obj)])
         objs.append(obj)
-    cas = folder / "casadi" / f"{a['name']}_casadi_controller.c"
-    objs.append(out / "casadi_controller.o")
-    run([cc, "-std=c99", *flags, "-c", str(cas), "-o", str(objs[-1])])
+    objs += [info["object"] for info in a["casadi_controller"].values()]  # compiled and cached before
+    cas = folder / "casadi"
     (out / "arm.inc").write_text(arm_inc(a))
     harness = out / "controller_harness.o"
     run([cxx, "-std=c++17", *flags, f"-I{out}", f"-I{BENCH}", f"-I{folder}", f"-I{cas.parent}", "-c",
@@ -166,7 +166,7 @@ def main(argv=None) -> int:
             (work / "gen").mkdir(exist_ok=True)
             (work / "models").mkdir(exist_ok=True)
             a = prepare_arm(arm_yaml(name), work / "gen", work / "models")
-            a["casadi_controller"] = casadi_controller(a, arm_yaml(name))
+            a["casadi_controller"] = casadi_controller(a, arm_yaml(name), cc, flags)
             exe = build(a, work, cc, cxx, flags, pin_objs)
             model = work / "models" / f"{a['name']}.model"
             verified = run([str(exe), "verify", str(model), str(args.states)]).stdout

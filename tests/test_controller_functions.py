@@ -2,12 +2,15 @@
 forward dynamics, derivatives), compiled with cffi, on every example arm: against the numpy
 Lagrangian oracle (Christoffel symbols from dM/dq by complex step), against Pinocchio
 (computeCoriolisMatrix, aba, computeRNEADerivatives, computeABADerivatives) and against the
-identities they must satisfy, at random states and random consistent parameters, 1e-9 relative."""
+identities they must satisfy, at random states and random consistent parameters, 1e-9 relative.
+At 1000 states the Lagrangian is the vectorised one (oracles/lagrangian_batch.py: dM/dq and
+dg/dq by complex step over every state at once), itself checked against lagrangian.py."""
 
 from __future__ import annotations
 
 import numpy as np
 from oracles import lagrangian as lag
+from oracles.lagrangian_batch import Lagrangian
 from oracles import pinocchio_control as pin_control
 from oracles.random_params import random_parameters
 from test_generated_c import random_state, rel_err
@@ -172,3 +175,43 @@ def test_slotine_li_identity_at_1000_states(built):
     want = (np.einsum("tij,tj->ti", batch("mass_matrix", Q, s), QRDD)
             + np.einsum("tij,tj->ti", batch("coriolis_matrix", Q, QD, s), QRD) + batch("gravity", Q, s))
     assert per_state_rel_err(batch("regressor_slotine_li", Q, QD, QRD, QRDD) @ pi, want) < TOL
+
+
+def test_at_1000_states_against_the_lagrangian(built):
+    """Every controller function against the vectorised Lagrangian oracle (no Newton-Euler, no
+    Pinocchio): C = Gamma qd, M_dot = dM/dq qd, FD = M^-1 (tau - c - g), Slotine-Li = M qr_dd +
+    C qr_d + g, d tau / d qd = 2 C (c is quadratic in qd: d(qd^T Gamma_i qd) / d qd = 2 Gamma_i qd;
+    rnea has no friction), d tau / d q at qd = 0 = dM/dq qdd + dg/dq, and the FD derivatives =
+    -M^-1 [d tau / d q | d tau / d qd]."""
+    n = built.robot.dof
+    p = random_parameters(n, seed=25)
+    s, pi = built.c("standard_from_dynamic", p), built.c("pi_full", p)
+    Q, QD, QDD = many_states(built, 26)
+    rng = np.random.default_rng(27)
+    QRD, QRDD = rng.uniform(-2, 2, Q.shape), rng.uniform(-3, 3, Q.shape)
+    L = Lagrangian(built.arm, p)
+    M, g, dM = L.mass_matrix(Q), L.gravity(Q), L.mass_matrix_derivatives(Q)
+    C = L.coriolis_matrix(Q, QD)
+    mv = lambda A, x: np.einsum("tij,tj->ti", A, x)  # noqa: E731  (per-state matrix times vector)
+    batch = built.c.batch
+    tau = batch("rnea", Q, QD, QDD, s)
+    D = batch("rnea_derivatives", Q, QD, QDD, s)
+    D_rest = batch("rnea_derivatives", Q, np.zeros_like(QD), QDD, s)
+    checks = {
+        "batch oracle = lagrangian.py (3 states)": (
+            np.array([np.einsum("ijk,k->ij", lag.christoffel(built.arm, Q[t], p), QD[t]) for t in range(3)]), C[:3]),
+        "rnea = M qdd + c + g": (tau, mv(M, QDD) + mv(C, QD) + g),
+        "coriolis_matrix = Gamma qd": (batch("coriolis_matrix", Q, QD, s), C),
+        "mass_matrix_derivative = dM/dq qd": (batch("mass_matrix_derivative", Q, QD, s), np.einsum("tkij,tk->tij", dM, QD)),
+        "forward_dynamics = M^-1 (tau - c - g)": (batch("forward_dynamics", Q, QD, tau, s),
+                                                  np.linalg.solve(M, (tau - mv(C, QD) - g)[..., None])[..., 0]),
+        "Slotine-Li Y pi = M qr_dd + C qr_d + g": (batch("regressor_slotine_li", Q, QD, QRD, QRDD) @ pi,
+                                                   mv(M, QRDD) + mv(C, QRD) + g),
+        "d tau / d qd = 2 C": (D[:, :, n:], 2 * C),
+        "d tau / d q at qd = 0 = dM/dq qdd + dg/dq": (D_rest[:, :, :n],
+                                                     np.einsum("tkij,tj->tik", dM, QDD) + L.gravity_derivatives(Q)),
+        "forward_dynamics_derivatives = -M^-1 D": (batch("forward_dynamics_derivatives", Q, QD, tau, s),
+                                                   -np.linalg.solve(M, D)),
+    }
+    worst = {name: per_state_rel_err(got, want) for name, (got, want) in checks.items()}
+    assert all(err < TOL for err in worst.values()), worst
