@@ -31,11 +31,12 @@ def test_coriolis_matrix_is_the_christoffel_one(built):
     worst = {}
     for p, s, q, qd, _ in states(built, 1):
         C = built.c("coriolis_matrix", q, qd, s)
-        christoffel = np.einsum("ijk,k->ij", lag.christoffel(built.arm, q, p), qd)
-        M_dot = np.einsum("kij,k->ij", lag.mass_matrix_derivatives(built.arm, q, p), qd)
+        L = Lagrangian(built.arm, p)  # on one state; checked against lagrangian.py in the 1000-state test
+        christoffel = L.coriolis_matrix(q[None], qd[None])[0]
+        M_dot = np.einsum("kij,k->ij", L.mass_matrix_derivatives(q[None])[0], qd)
         checks = {"C = sum_k Gamma_ijk qd_k": (C, christoffel),
                   "Pinocchio computeCoriolisMatrix": (C, pin_control.coriolis_matrix(built.arm, p, q, qd)),
-                  "C qd = c": (C @ qd, lag.coriolis(built.arm, q, qd, p)),
+                  "C qd = c": (C @ qd, L.coriolis(q[None], qd[None])[0]),
                   "M_dot": (built.c("mass_matrix_derivative", q, qd, s), M_dot),
                   "M_dot - 2C skew": ((M_dot - 2 * C) + (M_dot - 2 * C).T, np.zeros_like(C))}
         for name, (got, want) in checks.items():
@@ -51,8 +52,8 @@ def test_slotine_li_regressor(built):
         pi = built.c("pi_full", p)
         qr_d, qr_dd = rng.uniform(-2, 2, n), rng.uniform(-3, 3, n)
         Y = built.c("regressor_slotine_li", q, qd, qr_d, qr_dd)
-        christoffel = np.einsum("ijk,k->ij", lag.christoffel(built.arm, q, p), qd)
-        want = lag.mass_matrix(built.arm, q, p) @ qr_dd + christoffel @ qr_d + lag.gravity(built.arm, q, p)
+        L = Lagrangian(built.arm, p)
+        want = L.mass_matrix(q[None])[0] @ qr_dd + L.coriolis_matrix(q[None], qd[None])[0] @ qr_d + L.gravity(q[None])[0]
         checks = {"Y pi = M qr_dd + C qr_d + g": (Y @ pi, want),
                   "Y(q, qd, qd, qdd) pi = rnea": (built.c("regressor_slotine_li", q, qd, qd, qdd) @ pi,
                                                   built.c("rnea", q, qd, qdd, s)),
@@ -67,8 +68,9 @@ def test_forward_dynamics(built):
     worst = {}
     for p, s, q, qd, qdd in states(built, 4):
         tau = built.c("rnea", q, qd, qdd, s)
-        M = lag.mass_matrix(built.arm, q, p)
-        bias = lag.coriolis(built.arm, q, qd, p) + lag.gravity(built.arm, q, p)
+        L = Lagrangian(built.arm, p)
+        M = L.mass_matrix(q[None])[0]
+        bias = L.coriolis(q[None], qd[None])[0] + L.gravity(q[None])[0]
         checks = {"FD(ID(qdd)) = qdd": (built.c("forward_dynamics", q, qd, tau, s), qdd),
                   "Lagrangian M^-1 (tau - c - g)": (built.c("forward_dynamics", q, qd, tau, s),
                                                     np.linalg.solve(M, tau - bias)),
