@@ -137,6 +137,22 @@ def instructions(exe: Path, model: Path, states: int, fn: str, side: str, calls:
     raise SystemExit(f"no instruction total in {out}")
 
 
+def write_table(args, rows: list, verify_lines: list, cc: str, cxx: str, tool: dict) -> str:
+    """The table so far, written to args.output (if any) with how it was measured; returns it."""
+    text = markdown(rows)
+    if args.output:
+        info = [f"- machine: {machine()}", f"- compilers: `{cc}` ({compiler_version(cc)}) and `{cxx}`, flags `{args.flags}`",
+                f"- Pinocchio {tool['version']} (header-only, same flags); {args.calls} calls per function and side, "
+                f"{args.states} random states, instructions = (run with CALLS calls - run with 0) / CALLS",
+                f"- CasADi {casadi_side.ca.__version__}: bench/casadi_side.py (controller_functions), cse=True, one C file "
+                "per function (bench/casadi_objects.py), the same flags; \"vs\" columns: the other side's Ir / dyngen's "
+                "(> 1: dyngen fewer)", "- agreement with Pinocchio, "
+                "max relative error (dyngen, CasADi, CasADi baked): " + "; ".join(verify_lines)]
+        Path(args.output).write_text("# Controller functions: dyngen vs Pinocchio and CasADi\n\n" + "\n".join(info) + "\n\n"
+                                     + text + "\n")
+    return text
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--arms", nargs="+", default=None)
@@ -194,19 +210,10 @@ def main(argv=None) -> int:
                 if args.time:
                     row += [f"{x:.0f}" for x in times[f]]
                 rows.append(row)
+            write_table(args, rows, verify_lines, cc, cxx, tool)  # after every arm: a long run keeps what it measured
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    text = markdown(rows)
-    print(text)
-    if args.output:
-        info = [f"- machine: {machine()}", f"- compilers: `{cc}` ({compiler_version(cc)}) and `{cxx}`, flags `{args.flags}`",
-                f"- Pinocchio {tool['version']} (header-only, same flags); {args.calls} calls per function and side, "
-                f"{args.states} random states, instructions = (run with CALLS calls - run with 0) / CALLS",
-                f"- CasADi {casadi_side.ca.__version__}: bench/casadi_side.py (controller_functions), cse=True, the same flags; "
-                "\"vs\" columns: the other side's Ir / dyngen's (> 1: dyngen fewer)", "- agreement with Pinocchio, "
-                "max relative error (dyngen, CasADi, CasADi baked): " + "; ".join(verify_lines)]
-        Path(args.output).write_text("# Controller functions: dyngen vs Pinocchio and CasADi\n\n" + "\n".join(info) + "\n\n"
-                                     + text + "\n")
+    print(write_table(args, rows, verify_lines, cc, cxx, tool))
     return 0
 
 
