@@ -13,6 +13,7 @@ predictable, and a planted object would be linked into the benchmark and run.
 """
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import os
 import shlex
@@ -40,14 +41,16 @@ def _cached_object(src: Path, cc: str, flags: list, version: str) -> Path:
     cmd = [cc, "-std=c99", *flags, "-c"]
     key = hashlib.sha256("\0".join([src.read_text(), version, shlex.join(cmd)]).encode()).hexdigest()[:20]
     target = cache.folder("bench-casadi") / f"{src.stem}-{key}.o"
-    if cache.verified(target):
-        return target
-    log(f"CasADi: compiling {src.name} ({src.stat().st_size // 1024} kB) ...")
-    built = target.with_name(f"{target.name}.{os.getpid()}.tmp.o")
-    res = subprocess.run(["nice", "-n", "10", *cmd, str(src), "-o", str(built)], capture_output=True, text=True)
-    if res.returncode != 0:
-        raise SystemExit(f"compiling {src} failed:\n{res.stderr}")
-    return cache.install(built, target)
+    with open(target.with_name(target.name + ".lock"), "w") as lock:  # two runs wanting it: one compiles, one waits
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if cache.verified(target):
+            return target
+        log(f"CasADi: compiling {src.name} ({src.stat().st_size // 1024} kB) ...")
+        built = target.with_name(f"{target.name}.{os.getpid()}.tmp.o")
+        res = subprocess.run(["nice", "-n", "10", *cmd, str(src), "-o", str(built)], capture_output=True, text=True)
+        if res.returncode != 0:
+            raise SystemExit(f"compiling {src} failed:\n{res.stderr}")
+        return cache.install(built, target)
 
 
 def compile_functions(fns: list, folder: Path, cc: str, flags: list, jobs: int = 2) -> dict:
