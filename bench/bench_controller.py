@@ -120,7 +120,7 @@ def build(a: dict, work: Path, cc: str, cxx: str, flags: list, pin_objs: list) -
     cas = folder / "casadi"
     (out / "arm.inc").write_text(arm_inc(a))
     harness = out / "controller_harness.o"
-    run([cxx, "-std=c++17", *flags, f"-I{out}", f"-I{BENCH}", f"-I{folder}", f"-I{cas.parent}", "-c",
+    run([cxx, "-std=c++17", *flags, f"-I{out}", f"-I{BENCH}", f"-I{folder}", f"-I{cas}", "-c",
          str(BENCH / "controller_harness.cpp"), "-o", str(harness)])
     exe = out / "controller_bench"
     run([cxx, *flags, str(harness), *map(str, pin_objs), *map(str, objs), "-o", str(exe), "-lm"])

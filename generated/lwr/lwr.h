@@ -41,7 +41,7 @@
  *   lwr_jacobian_dot_qd          149 mul, 93 add, 0 div, 6 sin/cos
  *   lwr_control                  586 mul, 511 add, 0 div, 6 sin/cos
  *   lwr_control_with_jacobian    757 mul, 626 add, 0 div, 7 sin/cos
- *   lwr_coriolis_matrix          1442 mul, 1342 add, 0 div, 6 sin/cos
+ *   lwr_coriolis_matrix          1467 mul, 1401 add, 0 div, 6 sin/cos
  *   lwr_mass_matrix_derivative   670 mul, 436 add, 0 div, 6 sin/cos
  *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 6 sin/cos
  *   lwr_forward_dynamics         1003 mul, 803 add, 7 div, 6 sin/cos
@@ -309,7 +309,7 @@ void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_
  *   qd       [7]  joint velocities
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   C        [7 x 7]  row-major (written)
- * 1442 mul, 1342 add, 0 div, 6 sin/cos
+ * 1467 mul, 1401 add, 0 div, 6 sin/cos
  */
 void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *C);
 

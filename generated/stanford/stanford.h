@@ -41,7 +41,7 @@
  *   stanford_jacobian_dot_qd     128 mul, 85 add, 0 div, 4 sin/cos
  *   stanford_control             416 mul, 370 add, 0 div, 4 sin/cos
  *   stanford_control_with_jacobian 566 mul, 485 add, 0 div, 5 sin/cos
- *   stanford_coriolis_matrix     869 mul, 761 add, 0 div, 4 sin/cos
+ *   stanford_coriolis_matrix     878 mul, 793 add, 0 div, 4 sin/cos
  *   stanford_mass_matrix_derivative 397 mul, 263 add, 0 div, 4 sin/cos
  *   stanford_regressor_slotine_li 456 mul, 290 add, 0 div, 4 sin/cos
  *   stanford_forward_dynamics    822 mul, 675 add, 6 div, 4 sin/cos
@@ -309,7 +309,7 @@ void stanford_control_with_jacobian(const stanford_real *q, const stanford_real 
  *   qd       [6]  joint velocities
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   C        [6 x 6]  row-major (written)
- * 869 mul, 761 add, 0 div, 4 sin/cos
+ * 878 mul, 793 add, 0 div, 4 sin/cos
  */
 void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *C);
 

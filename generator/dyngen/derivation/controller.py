@@ -7,10 +7,8 @@ from .models import Derivation
 
 
 def controller_models(derivation: Derivation, operations) -> dict:
-    """operations: model -> its operation count, by which forward_dynamics and the Coriolis
-    matrix pick their method (the bilinear recursion on a tie)."""
-    candidates = [coriolis.coriolis_matrix(derivation), derivatives.coriolis_by_forward_mode(derivation)]
-    return {"coriolis_matrix": min(candidates, key=operations),
+    """operations: model -> its operation count, by which forward_dynamics picks its method."""
+    return {"coriolis_matrix": coriolis.coriolis_matrix(derivation),
             "mass_matrix_derivative": derivatives.mass_matrix_derivative(derivation),
             "regressor_slotine_li": coriolis.slotine_li_regressor(derivation),
             "forward_dynamics": forward_dynamics.forward_dynamics(derivation, operations),

@@ -98,22 +98,6 @@ def forward_dynamics_derivatives(derivation: Derivation) -> Model:
                  "[d qdd / d q | d qdd / d qd], row-major", program, sym.trig)
 
 
-def coriolis_by_forward_mode(derivation: Derivation) -> Model:
-    """C(q, qd) = 1/2 d c / d qd: c(q, qd) = rnea(q, qd, 0) without gravity is the quadratic form
-    qd^T Gamma_i qd whose Christoffel symbols are symmetric in their last two indices, so its
-    gradient is 2 Gamma_i qd = 2 C row i. Column k is the tangent along qd_k / 2 (ForwardMode);
-    coriolis.coriolis_matrix (the bilinear recursion) is the other candidate."""
-    program, sym, chain = start(derivation)
-    n = derivation.n
-    c = joint_forces(derivation, chain, chain.forward(sym.qd, [sp.Integer(0)] * n, [sp.Integer(0)] * 3))
-    forward_mode, columns = ForwardMode(program, c), []
-    for k in range(n):
-        program.section = f"C column {k + 1} = 1/2 d c / d qd{k + 1}"
-        columns.append(forward_mode.tangents({sym.qd[k]: sp.Rational(1, 2)}))
-    return Model("coriolis_matrix", model_inputs(derivation, sym, qd=True), [columns[j][i] for i in range(n) for j in range(n)],
-                 (n, n), "Christoffel Coriolis matrix C(q, qd), row-major", program, sym.trig)
-
-
 def mass_matrix_derivative(derivation: Derivation) -> Model:
     """M_dot = sum_k dM/dq_k qd_k: one forward-mode direction (along qd) over M's composite-body
     program (ForwardMode above), about half the operations of C + C^T (which equals it)."""
