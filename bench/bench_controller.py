@@ -5,7 +5,8 @@ Per arm (examples/*.yaml, or --arms): generate the C, build the same arm as a Pi
 (bench_dynamics.prepare_arm) and as CasADi-generated C (casadi_side.generate_controller: a
 plain rnea over casadi.SX, C by Christoffel symbols of casadi.jacobian(M), M_dot by jtimes, FD
 by casadi.solve, the derivatives by casadi.jacobian; parameters as input and baked), compile
-ONE executable (generated C + CasADi's C + bench/controller_harness.cpp + bench/pinocchio_side.cpp
+ONE executable (generated C + CasADi's C, one file per function compiled once into a private
+cache by bench/casadi_objects.py, + bench/controller_harness.cpp + bench/pinocchio_side.cpp
 + bench/pinocchio_controller.cpp, header-only Pinocchio, the same compiler and flags), check
 that every side agrees with Pinocchio on every state (relative 1e-9), then count instructions
 per call with valgrind (CALLS calls minus a 0-call run, / CALLS) and, with --time, the median

@@ -18,7 +18,8 @@ and flags), check agreement on every state (1e-9), then time and count instructi
 
 The five kinematics functions have a third side in the same binary: CasADi's C of SX forward
 kinematics of the same Pinocchio model (bench/casadi_side.py, kinematics_functions; the
-Jacobian's linear rows by casadi.jacobian, Jdot qd by casadi.jtimes), cse=True, same flags.
+Jacobian's linear rows by casadi.jacobian, Jdot qd by casadi.jtimes), cse=True, same flags,
+one file per function compiled once into a private cache (bench/casadi_objects.py).
 
 Pinocchio is header-only, compiled once into bench/.build/ (the model is read at run time).
 """
