@@ -5,7 +5,8 @@ Per arm (examples/*.yaml, or --arms): generate the C, build the same arm as a Pi
 (bench_dynamics.prepare_arm) and as CasADi-generated C (casadi_side.generate_controller: a
 plain rnea over casadi.SX, C by Christoffel symbols of casadi.jacobian(M), M_dot by jtimes, FD
 by casadi.solve, the derivatives by casadi.jacobian; parameters as input and baked), compile
-ONE executable (generated C + CasADi's C + bench/controller_harness.cpp + bench/pinocchio_side.cpp
+ONE executable (generated C + CasADi's C, one file per function compiled once into a private
+cache by bench/casadi_objects.py, + bench/controller_harness.cpp + bench/pinocchio_side.cpp
 + bench/pinocchio_controller.cpp, header-only Pinocchio, the same compiler and flags), check
 that every side agrees with Pinocchio on every state (relative 1e-9), then count instructions
 per call with valgrind (CALLS calls minus a 0-call run, / CALLS) and, with --time, the median
@@ -84,19 +85,20 @@ def casadi_wrappers(a: dict) -> list:
     return lines
 
 
-def casadi_controller(a: dict, yaml_path: Path) -> dict:
+def casadi_controller(a: dict, yaml_path: Path, cc: str, flags: list) -> dict:
     """CasADi's C of the controller functions for the arm's Pinocchio model, beside its dynamics' C."""
     from oracles import pinocchio_arm
     from oracles.arm import Arm
 
     model, _ = pinocchio_arm.build(Arm.from_yaml(yaml_path), a["p"])
-    return casadi_side.generate_controller(model, a["name"], a["folder"] / "casadi")
+    return casadi_side.generate_controller(model, a["name"], a["folder"] / "casadi", cc, flags)
 
 
 def arm_inc(a: dict) -> str:
     name, n = a["name"], a["n"]
     numbers = lambda xs: ", ".join(repr(float(x)) for x in xs)  # noqa: E731
-    return "\n".join([f'#include "{name}.h"', f'#include "{name}_casadi_controller.h"',
+    headers = [f'#include "{info["header"].name}"' for info in a["casadi_controller"].values()]
+    return "\n".join([f'#include "{name}.h"', *headers,
                       f"#define ARM(fn) {name}_##fn", f"#define N {n}",
                       f"#define N_PI_FULL {a['shapes']['pi_full'][0]}",
                       f"static const double P[{10 * n}] = {{{numbers(a['p'])}}};",
@@ -114,12 +116,11 @@ def build(a: dict, work: Path, cc: str, cxx: str, flags: list, pin_objs: list) -
         obj = out / (src.stem + ".o")
         run([cc, "-std=c99", *flags, "-c", str(src), "-o", str(obj)])
         objs.append(obj)
-    cas = folder / "casadi" / f"{a['name']}_casadi_controller.c"
-    objs.append(out / "casadi_controller.o")
-    run([cc, "-std=c99", *flags, "-c", str(cas), "-o", str(objs[-1])])
+    objs += [info["object"] for info in a["casadi_controller"].values()]  # compiled and cached before
+    cas = folder / "casadi"
     (out / "arm.inc").write_text(arm_inc(a))
     harness = out / "controller_harness.o"
-    run([cxx, "-std=c++17", *flags, f"-I{out}", f"-I{BENCH}", f"-I{folder}", f"-I{cas.parent}", "-c",
+    run([cxx, "-std=c++17", *flags, f"-I{out}", f"-I{BENCH}", f"-I{folder}", f"-I{cas}", "-c",
          str(BENCH / "controller_harness.cpp"), "-o", str(harness)])
     exe = out / "controller_bench"
     run([cxx, *flags, str(harness), *map(str, pin_objs), *map(str, objs), "-o", str(exe), "-lm"])
@@ -134,6 +135,22 @@ def instructions(exe: Path, model: Path, states: int, fn: str, side: str, calls:
         if line.startswith(("summary:", "totals:")):
             return int(line.split()[1])
     raise SystemExit(f"no instruction total in {out}")
+
+
+def write_table(args, rows: list, verify_lines: list, cc: str, cxx: str, tool: dict) -> str:
+    """The table so far, written to args.output (if any) with how it was measured; returns it."""
+    text = markdown(rows)
+    if args.output:
+        info = [f"- machine: {machine()}", f"- compilers: `{cc}` ({compiler_version(cc)}) and `{cxx}`, flags `{args.flags}`",
+                f"- Pinocchio {tool['version']} (header-only, same flags); {args.calls} calls per function and side, "
+                f"{args.states} random states, instructions = (run with CALLS calls - run with 0) / CALLS",
+                f"- CasADi {casadi_side.ca.__version__}: bench/casadi_side.py (controller_functions), cse=True, one C file "
+                "per function (bench/casadi_objects.py), the same flags; \"vs\" columns: the other side's Ir / dyngen's "
+                "(> 1: dyngen fewer)", "- agreement with Pinocchio, "
+                "max relative error (dyngen, CasADi, CasADi baked): " + "; ".join(verify_lines)]
+        Path(args.output).write_text("# Controller functions: dyngen vs Pinocchio and CasADi\n\n" + "\n".join(info) + "\n\n"
+                                     + text + "\n")
+    return text
 
 
 def main(argv=None) -> int:
@@ -165,7 +182,7 @@ def main(argv=None) -> int:
             (work / "gen").mkdir(exist_ok=True)
             (work / "models").mkdir(exist_ok=True)
             a = prepare_arm(arm_yaml(name), work / "gen", work / "models")
-            a["casadi_controller"] = casadi_controller(a, arm_yaml(name))
+            a["casadi_controller"] = casadi_controller(a, arm_yaml(name), cc, flags)
             exe = build(a, work, cc, cxx, flags, pin_objs)
             model = work / "models" / f"{a['name']}.model"
             verified = run([str(exe), "verify", str(model), str(args.states)]).stdout
@@ -193,19 +210,10 @@ def main(argv=None) -> int:
                 if args.time:
                     row += [f"{x:.0f}" for x in times[f]]
                 rows.append(row)
+            write_table(args, rows, verify_lines, cc, cxx, tool)  # after every arm: a long run keeps what it measured
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    text = markdown(rows)
-    print(text)
-    if args.output:
-        info = [f"- machine: {machine()}", f"- compilers: `{cc}` ({compiler_version(cc)}) and `{cxx}`, flags `{args.flags}`",
-                f"- Pinocchio {tool['version']} (header-only, same flags); {args.calls} calls per function and side, "
-                f"{args.states} random states, instructions = (run with CALLS calls - run with 0) / CALLS",
-                f"- CasADi {casadi_side.ca.__version__}: bench/casadi_side.py (controller_functions), cse=True, the same flags; "
-                "\"vs\" columns: the other side's Ir / dyngen's (> 1: dyngen fewer)", "- agreement with Pinocchio, "
-                "max relative error (dyngen, CasADi, CasADi baked): " + "; ".join(verify_lines)]
-        Path(args.output).write_text("# Controller functions: dyngen vs Pinocchio and CasADi\n\n" + "\n".join(info) + "\n\n"
-                                     + text + "\n")
+    print(write_table(args, rows, verify_lines, cc, cxx, tool))
     return 0
 
 

@@ -18,7 +18,8 @@ and flags), check agreement on every state (1e-9), then time and count instructi
 
 The five kinematics functions have a third side in the same binary: CasADi's C of SX forward
 kinematics of the same Pinocchio model (bench/casadi_side.py, kinematics_functions; the
-Jacobian's linear rows by casadi.jacobian, Jdot qd by casadi.jtimes), cse=True, same flags.
+Jacobian's linear rows by casadi.jacobian, Jdot qd by casadi.jtimes), cse=True, same flags,
+one file per function compiled once into a private cache (bench/casadi_objects.py).
 
 Pinocchio is header-only, compiled once into bench/.build/ (the model is read at run time).
 """
@@ -97,7 +98,7 @@ def prepare(name: str, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path
     build.mkdir()
     import casadi_side
 
-    cas_info = casadi_side.generate_kinematics(model, robot, posts, tool, build / "casadi")
+    cas_info = casadi_side.generate_kinematics(model, robot, posts, tool, build / "casadi", cc, flags)
     wrappers = []
     for fn, ins in casadi_side.KINEMATICS_FUNCTIONS.items():
         info = cas_info[f"{robot}_casb_{fn}"]
@@ -110,14 +111,13 @@ def prepare(name: str, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path
         f"static const double ARM_P[{10 * n}] = {{{', '.join(map(repr, map(float, p)))}}};",
         f"static const double ARM_QLO[{n}] = {{{', '.join(map(repr, map(float, lo)))}}};",
         f"static const double ARM_QHI[{n}] = {{{', '.join(map(repr, map(float, hi)))}}};",
-        f'#include "{robot}_casadi_kinematics.h"', *wrappers, ""]))
+        *(f'#include "{info["header"].name}"' for info in cas_info.values()), *wrappers, ""]))
     objects = []
     for src in manifest["files"]["library"]:
         obj = build / (Path(src).stem + ".o")
         run([cc, "-std=c99", *flags, "-c", str(folder / src), "-o", str(obj)])
         objects.append(obj)
-    objects.append(build / "casadi_kinematics.o")
-    run([cc, "-std=c99", *flags, "-c", str(build / "casadi" / f"{robot}_casadi_kinematics.c"), "-o", str(objects[-1])])
+    objects += [info["object"] for info in cas_info.values()]  # compiled and cached before
     harness = build / "harness.o"
     run([cxx, "-std=c++17", *flags, f"-I{build}", f"-I{BENCH}", f"-I{folder}", f"-I{build / 'casadi'}", "-c",
          str(BENCH / "kinematics_harness.cpp"), "-o", str(harness)])

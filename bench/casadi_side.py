@@ -198,16 +198,14 @@ def controller_functions(model, name: str) -> list:
     return out
 
 
-def generate_controller(model, name: str, folder: Path) -> dict:
-    """Writes <name>_casadi_controller.c and .h into folder; returns {function name: {iw, w, n_instructions}}."""
+def generate_controller(model, name: str, folder: Path, cc: str, flags: list) -> dict:
+    """One C file per controller function in folder, each compiled (or found in the private
+    cache: casadi_objects.py); returns {function name: {iw, w, n_instructions, header, object}}."""
+    import casadi_objects
+
     fns = controller_functions(model, name)
-    cg = ca.CodeGenerator(f"{name}_casadi_controller.c", {"with_header": True, "casadi_real": "double"})
-    for f in fns:
-        cg.add(f)
-    folder.mkdir(parents=True, exist_ok=True)
-    cg.generate(str(folder) + "/")
-    return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
-            for f in fns}
+    built = casadi_objects.compile_functions(fns, folder, cc, flags)
+    return {k: {**v, "header": built[k][0], "object": built[k][1]} for k, v in casadi_objects.info(fns).items()}
 
 
 # --- the kinematics functions (bench_kinematics.py) ---------------------------------------------
@@ -260,13 +258,11 @@ def kinematics_functions(model, name: str, posts, tool) -> list:
             for fn, value in outputs.items()]
 
 
-def generate_kinematics(model, name: str, posts, tool, folder: Path) -> dict:
-    """Writes <name>_casadi_kinematics.c and .h into folder; returns {function name: {iw, w, n_instructions}}."""
+def generate_kinematics(model, name: str, posts, tool, folder: Path, cc: str, flags: list) -> dict:
+    """One C file per kinematics function in folder, each compiled (or found in the private
+    cache); returns {function name: {iw, w, n_instructions, header, object}}."""
+    import casadi_objects
+
     fns = kinematics_functions(model, name, posts, tool)
-    cg = ca.CodeGenerator(f"{name}_casadi_kinematics.c", {"with_header": True, "casadi_real": "double"})
-    for f in fns:
-        cg.add(f)
-    folder.mkdir(parents=True, exist_ok=True)
-    cg.generate(str(folder) + "/")
-    return {f.name(): {"iw": int(f.sz_iw()), "w": int(f.sz_w()), "n_instructions": int(f.n_instructions())}
-            for f in fns}
+    built = casadi_objects.compile_functions(fns, folder, cc, flags)
+    return {k: {**v, "header": built[k][0], "object": built[k][1]} for k, v in casadi_objects.info(fns).items()}

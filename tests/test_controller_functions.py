@@ -2,12 +2,15 @@
 forward dynamics, derivatives), compiled with cffi, on every example arm: against the numpy
 Lagrangian oracle (Christoffel symbols from dM/dq by complex step), against Pinocchio
 (computeCoriolisMatrix, aba, computeRNEADerivatives, computeABADerivatives) and against the
-identities they must satisfy, at random states and random consistent parameters, 1e-9 relative."""
+identities they must satisfy, at random states and random consistent parameters, 1e-9 relative.
+At 1000 states the Lagrangian is the vectorised one (oracles/lagrangian_batch.py: dM/dq and
+dg/dq by complex step over every state at once), itself checked against lagrangian.py."""
 
 from __future__ import annotations
 
 import numpy as np
 from oracles import lagrangian as lag
+from oracles.lagrangian_batch import Lagrangian
 from oracles import pinocchio_control as pin_control
 from oracles.random_params import random_parameters
 from test_generated_c import random_state, rel_err
@@ -28,11 +31,12 @@ def test_coriolis_matrix_is_the_christoffel_one(built):
     worst = {}
     for p, s, q, qd, _ in states(built, 1):
         C = built.c("coriolis_matrix", q, qd, s)
-        christoffel = np.einsum("ijk,k->ij", lag.christoffel(built.arm, q, p), qd)
-        M_dot = np.einsum("kij,k->ij", lag.mass_matrix_derivatives(built.arm, q, p), qd)
+        L = Lagrangian(built.arm, p)  # on one state; checked against lagrangian.py in the 1000-state test
+        christoffel = L.coriolis_matrix(q[None], qd[None])[0]
+        M_dot = np.einsum("kij,k->ij", L.mass_matrix_derivatives(q[None])[0], qd)
         checks = {"C = sum_k Gamma_ijk qd_k": (C, christoffel),
                   "Pinocchio computeCoriolisMatrix": (C, pin_control.coriolis_matrix(built.arm, p, q, qd)),
-                  "C qd = c": (C @ qd, lag.coriolis(built.arm, q, qd, p)),
+                  "C qd = c": (C @ qd, L.coriolis(q[None], qd[None])[0]),
                   "M_dot": (built.c("mass_matrix_derivative", q, qd, s), M_dot),
                   "M_dot - 2C skew": ((M_dot - 2 * C) + (M_dot - 2 * C).T, np.zeros_like(C))}
         for name, (got, want) in checks.items():
@@ -48,8 +52,8 @@ def test_slotine_li_regressor(built):
         pi = built.c("pi_full", p)
         qr_d, qr_dd = rng.uniform(-2, 2, n), rng.uniform(-3, 3, n)
         Y = built.c("regressor_slotine_li", q, qd, qr_d, qr_dd)
-        christoffel = np.einsum("ijk,k->ij", lag.christoffel(built.arm, q, p), qd)
-        want = lag.mass_matrix(built.arm, q, p) @ qr_dd + christoffel @ qr_d + lag.gravity(built.arm, q, p)
+        L = Lagrangian(built.arm, p)
+        want = L.mass_matrix(q[None])[0] @ qr_dd + L.coriolis_matrix(q[None], qd[None])[0] @ qr_d + L.gravity(q[None])[0]
         checks = {"Y pi = M qr_dd + C qr_d + g": (Y @ pi, want),
                   "Y(q, qd, qd, qdd) pi = rnea": (built.c("regressor_slotine_li", q, qd, qd, qdd) @ pi,
                                                   built.c("rnea", q, qd, qdd, s)),
@@ -64,8 +68,9 @@ def test_forward_dynamics(built):
     worst = {}
     for p, s, q, qd, qdd in states(built, 4):
         tau = built.c("rnea", q, qd, qdd, s)
-        M = lag.mass_matrix(built.arm, q, p)
-        bias = lag.coriolis(built.arm, q, qd, p) + lag.gravity(built.arm, q, p)
+        L = Lagrangian(built.arm, p)
+        M = L.mass_matrix(q[None])[0]
+        bias = L.coriolis(q[None], qd[None])[0] + L.gravity(q[None])[0]
         checks = {"FD(ID(qdd)) = qdd": (built.c("forward_dynamics", q, qd, tau, s), qdd),
                   "Lagrangian M^-1 (tau - c - g)": (built.c("forward_dynamics", q, qd, tau, s),
                                                     np.linalg.solve(M, tau - bias)),
@@ -172,3 +177,43 @@ def test_slotine_li_identity_at_1000_states(built):
     want = (np.einsum("tij,tj->ti", batch("mass_matrix", Q, s), QRDD)
             + np.einsum("tij,tj->ti", batch("coriolis_matrix", Q, QD, s), QRD) + batch("gravity", Q, s))
     assert per_state_rel_err(batch("regressor_slotine_li", Q, QD, QRD, QRDD) @ pi, want) < TOL
+
+
+def test_at_1000_states_against_the_lagrangian(built):
+    """Every controller function against the vectorised Lagrangian oracle (no Newton-Euler, no
+    Pinocchio): C = Gamma qd, M_dot = dM/dq qd, FD = M^-1 (tau - c - g), Slotine-Li = M qr_dd +
+    C qr_d + g, d tau / d qd = 2 C (c is quadratic in qd: d(qd^T Gamma_i qd) / d qd = 2 Gamma_i qd;
+    rnea has no friction), d tau / d q at qd = 0 = dM/dq qdd + dg/dq, and the FD derivatives =
+    -M^-1 [d tau / d q | d tau / d qd]."""
+    n = built.robot.dof
+    p = random_parameters(n, seed=25)
+    s, pi = built.c("standard_from_dynamic", p), built.c("pi_full", p)
+    Q, QD, QDD = many_states(built, 26)
+    rng = np.random.default_rng(27)
+    QRD, QRDD = rng.uniform(-2, 2, Q.shape), rng.uniform(-3, 3, Q.shape)
+    L = Lagrangian(built.arm, p)
+    M, g, dM = L.mass_matrix(Q), L.gravity(Q), L.mass_matrix_derivatives(Q)
+    C = L.coriolis_matrix(Q, QD)
+    mv = lambda A, x: np.einsum("tij,tj->ti", A, x)  # noqa: E731  (per-state matrix times vector)
+    batch = built.c.batch
+    tau = batch("rnea", Q, QD, QDD, s)
+    D = batch("rnea_derivatives", Q, QD, QDD, s)
+    D_rest = batch("rnea_derivatives", Q, np.zeros_like(QD), QDD, s)
+    checks = {
+        "batch oracle = lagrangian.py (3 states)": (
+            np.array([np.einsum("ijk,k->ij", lag.christoffel(built.arm, Q[t], p), QD[t]) for t in range(3)]), C[:3]),
+        "rnea = M qdd + c + g": (tau, mv(M, QDD) + mv(C, QD) + g),
+        "coriolis_matrix = Gamma qd": (batch("coriolis_matrix", Q, QD, s), C),
+        "mass_matrix_derivative = dM/dq qd": (batch("mass_matrix_derivative", Q, QD, s), np.einsum("tkij,tk->tij", dM, QD)),
+        "forward_dynamics = M^-1 (tau - c - g)": (batch("forward_dynamics", Q, QD, tau, s),
+                                                  np.linalg.solve(M, (tau - mv(C, QD) - g)[..., None])[..., 0]),
+        "Slotine-Li Y pi = M qr_dd + C qr_d + g": (batch("regressor_slotine_li", Q, QD, QRD, QRDD) @ pi,
+                                                   mv(M, QRDD) + mv(C, QRD) + g),
+        "d tau / d qd = 2 C": (D[:, :, n:], 2 * C),
+        "d tau / d q at qd = 0 = dM/dq qdd + dg/dq": (D_rest[:, :, :n],
+                                                     np.einsum("tkij,tj->tik", dM, QDD) + L.gravity_derivatives(Q)),
+        "forward_dynamics_derivatives = -M^-1 D": (batch("forward_dynamics_derivatives", Q, QD, tau, s),
+                                                   -np.linalg.solve(M, D)),
+    }
+    worst = {name: per_state_rel_err(got, want) for name, (got, want) in checks.items()}
+    assert all(err < TOL for err in worst.values()), worst
