@@ -283,7 +283,7 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
     tilt_at = [i for i, k in enumerate(active) if labels[k][0] == "tilt"]
     if tilt_at:
         a = x[r + np.asarray(tilt_at)]
-        # the estimate's columns from here on (the statistics' passes read them): algebra on the hidden column
+        # the estimate's columns from here on (the statistics' pass reads them): algebra on the hidden column
         normal = normal.rotated([active[i] for i in tilt_at], a / (2 * float(np.linalg.norm(g_vec))))
         blocks.tilt = tilt_columns(g_vec, a)
         x, rounds, result = fit_with(active)
