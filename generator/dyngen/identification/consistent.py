@@ -91,7 +91,8 @@ def _coulomb(blocks, normal, fit, options, dof, swaps=None):
         blocks.smoothing = smoothing
     if options.friction_lag:
         make = _at(dof, lambda v: smoothing, lambda v: v)
-        trials = normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID])
+        zero = LAG_GRID[0] == 0.0  # the trial of no lag is the normal equations at hand: no variant for it
+        trials = [normal] * zero + normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID[zero:]])
         lags, normal = _coulomb_search(normal, trials, fit, LAG_GRID, 1e-3)
         blocks.lags = lags
     return smoothing, lags, normal
