@@ -156,9 +156,10 @@ class Blocks:
     settings (smoothing, lags: per joint; tilt(G) -> (T, N, 2) of gravity(q) -> G (T, N, 3)):
     iterated once per pass."""
 
-    def __init__(self, model, sources, parts, labels, smoothing, lags, gravity=None, tilt=None):
+    def __init__(self, model, sources, parts, labels, smoothing, lags, gravity=None, g_vec=None):
         self.model, self.sources, self.parts, self.labels = model, sources, parts, labels
-        self.smoothing, self.lags, self.gravity, self.tilt = smoothing, lags, gravity, tilt
+        self.smoothing, self.lags, self.gravity, self.tilt = smoothing, lags, gravity, tilt_columns(g_vec)
+        self.along = None if g_vec is None else tilt_along(g_vec)
         self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
 
     def __iter__(self):
@@ -200,6 +201,7 @@ class Blocks:
         if any(k == "tilt" for k, _ in self.labels):
             p.gravity = source.gravity(f"{self.token}-{number}", lambda: self.gravity(block.q))
             tilted = self.tilt(p.gravity)
+            p.along = p.gravity @ self.along  # the hidden column of the tilt's rotation (normal.py: rotated)
         p.columns = {lab: p.column(lab, coulomb, tilted) for lab in self.labels}
         return p
 
@@ -215,6 +217,13 @@ def tilt_columns(g_vec, a=(0.0, 0.0)):
         return None
     D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))
     return lambda G: tilt.Tilt.regressor(G, D[0], D[1], size, a)
+
+
+def tilt_along(g_vec) -> np.ndarray:
+    """(3,): u1 x u2, G @ it the gravity torques along the axis; the tilt's columns at (a1, a2)
+    are those at (0, 0) less a_d / (2 |g|) times them (terms/tilt.py Tilt.regressor)."""
+    D = tilt.directions(g_vec)
+    return np.cross(D[0], D[1])
 
 
 def velocity_limits(robot, sources) -> np.ndarray:

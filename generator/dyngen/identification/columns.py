@@ -109,10 +109,3 @@ class Piece:
         if kind == "tilt":
             return tilt[..., j]
         return joint_column(self.signals, kind, j, coulomb_full)[self.keep]
-
-    def cached(self, key, make):
-        """make(self), computed once per piece (a column that several labels read)."""
-        memo = self.__dict__.setdefault("memo", {})
-        if key not in memo:
-            memo[key] = make(self)
-        return memo[key]

@@ -91,7 +91,8 @@ def _coulomb(blocks, normal, fit, options, dof, swaps=None):
         blocks.smoothing = smoothing
     if options.friction_lag:
         make = _at(dof, lambda v: smoothing, lambda v: v)
-        trials = normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID])
+        zero = LAG_GRID[0] == 0.0  # the trial of no lag is the normal equations at hand: no variant for it
+        trials = [normal] * zero + normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID[zero:]])
         lags, normal = _coulomb_search(normal, trials, fit, LAG_GRID, 1e-3)
         blocks.lags = lags
     return smoothing, lags, normal
@@ -168,13 +169,13 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     fit = list(range(folds))
     smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
-                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), tilt_columns(g_vec))
+                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), g_vec)
     ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
     swaps = None  # 2. the Coulomb term's smoothing: every value of its grid summed in the same pass
     if ks and options.smoothing is None:
         make = _at(dof, lambda v: v, lambda v: 0.0)
-        swaps = Swaps(labels, r, parts, dof, ks, [lambda p, v=v: make(p, v) for v in SMOOTHING_GRID])
-    normal = Normal.build(blocks, labels, r, parts, dof, swaps.add if swaps else None)
+        swaps = Swaps(labels, r, parts, dof, ks, [lambda p, v=v: make(p, v) for v in SMOOTHING_GRID], int(with_tilt))
+    normal = Normal.build(blocks, labels, r, parts, dof, swaps.add if swaps else None, int(with_tilt))
     smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof, swaps)
 
     # 3. noise per joint, weights; columns the data cannot separate
@@ -283,10 +284,9 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
     tilt_at = [i for i, k in enumerate(active) if labels[k][0] == "tilt"]
     if tilt_at:
         a = x[r + np.asarray(tilt_at)]
-        rotation = tilt_columns(g_vec, a)  # the estimate's columns from here on (the statistics' pass reads them)
-        normal, = normal.replaced(blocks, {k: (lambda p, d=d: p.cached("rotation", lambda p: rotation(p.gravity))[..., d])
-                                           for k, d in zip([active[i] for i in tilt_at], range(2))})
-        blocks.tilt = rotation
+        # the estimate's columns from here on (the statistics' pass reads them): algebra on the hidden column
+        normal = normal.rotated([active[i] for i in tilt_at], a / (2 * float(np.linalg.norm(g_vec))))
+        blocks.tilt = tilt_columns(g_vec, a)
         x, rounds, result = fit_with(active)
         a = x[r + np.asarray(tilt_at)]
         if tilt.angle_deg(g_vec, a) > tilt.MAX_TILT_DEG:

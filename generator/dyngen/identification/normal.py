@@ -46,25 +46,29 @@ def joint_design(piece, labels, j: int, ks) -> np.ndarray:
 
 
 class Normal:
-    def __init__(self, r: int, labels: list, parts: int, dof: int):
-        self.r, self.labels, self.dof = r, list(labels), dof
-        c = r + len(labels)
+    def __init__(self, r: int, labels: list, parts: int, dof: int, hidden: int = 0):
+        """hidden: the trailing columns that are no label (the tilt's gravity along its axis,
+        piece.along: the tilt's rotation is then algebra on them, rotated())."""
+        self.r, self.labels, self.dof, self.hidden = r, list(labels), dof, hidden
+        c = r + len(labels) + hidden
         self.G = np.zeros((parts, dof, c, c))
         self.g = np.zeros((parts, dof, c))
         self.bb = np.zeros((parts, dof))
         self.n = np.zeros((parts, dof))
 
     @classmethod
-    def build(cls, pieces, labels, r: int, parts: int, dof: int, each=None) -> "Normal":
+    def build(cls, pieces, labels, r: int, parts: int, dof: int, each=None, hidden: int = 0) -> "Normal":
         """each(piece): also called on every piece (another sum of the same pass)."""
-        out = cls(r, labels, parts, dof)
+        out = cls(r, labels, parts, dof, hidden)
         for piece in pieces:
             if each is not None:
                 each(piece)
             for j in range(dof):
                 ks = local_labels(labels, j)
-                idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int)]
+                idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int), r + len(labels) + np.arange(hidden)]
                 A = joint_design(piece, labels, j, ks)
+                if hidden:
+                    A = np.hstack([A, piece.along[:, j:j + 1]])
                 b = piece.tau[:, j]
                 for p, sl in segments(piece.part):
                     Am, bm = A[sl], b[sl]
@@ -74,34 +78,9 @@ class Normal:
                     out.n[p, j] += bm.size
         return out
 
-    def replaced(self, pieces, *variants: dict) -> list["Normal"]:
-        """Copies, one per variant, in which label k's column is values(piece) ((T,) or (T, N),
-        as piece.columns) for every k: values of the variant; all of them in one pass over the
-        pieces (blocks.py: a pass reads the recordings again)."""
-        outs = []
-        for changes in variants:
-            out = Normal.__new__(Normal)
-            out.r, out.labels, out.dof = self.r, self.labels, self.dof
-            out.G, out.g, out.bb, out.n = self.G.copy(), self.g.copy(), self.bb, self.n
-            for k in changes:
-                i = self.r + k
-                out.G[:, :, i, :] = out.G[:, :, :, i] = 0.0
-                out.g[:, :, i] = 0.0
-            outs.append(out)
-        for piece in pieces:
-            columns = piece.columns
-            for out, changes in zip(outs, variants):
-                piece.columns = dict(columns)
-                piece.columns.update({self.labels[k]: values(piece) for k, values in changes.items()})
-                for at, k in enumerate(changes):  # a cross term of two changed labels: added by the first
-                    label = self.labels[k]
-                    for j in (range(self.dof) if label[0] == "tilt" else [label[1]]):
-                        out._row(piece, j, k, set(list(changes)[:at]))
-        return outs
-
     def swapped(self, pieces, ks, makes) -> list["Normal"]:
-        """replaced() for the Coulomb searches (Swaps), in one pass over the pieces."""
-        swaps = Swaps(self.labels, self.r, self.G.shape[0], self.dof, ks, makes)
+        """Per variant, self with the Coulomb columns ks those of makes[v] (Swaps), in one pass over the pieces."""
+        swaps = Swaps(self.labels, self.r, self.G.shape[0], self.dof, ks, makes, self.hidden)
         for piece in pieces:
             swaps.add(piece)
         return swaps.normals(self)
@@ -111,35 +90,31 @@ class Normal:
         """Joint j's blocks from normals[j] (each differs from the others in joint columns only)."""
         out = Normal.__new__(Normal)
         first = normals[0]
-        out.r, out.labels, out.dof, out.bb, out.n = first.r, first.labels, first.dof, first.bb, first.n
+        out.r, out.labels, out.dof, out.hidden, out.bb, out.n = first.r, first.labels, first.dof, first.hidden, first.bb, first.n
         out.G = np.stack([m.G[:, j] for j, m in enumerate(normals)], axis=1)
         out.g = np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1)
         return out
 
-    def _row(self, piece, j: int, k: int, done=()) -> None:
-        """Adds label k's row and column of joint j's blocks (zero before) from the piece, but
-        the cross terms with the labels `done` (added already)."""
-        i = self.r + k
-        ks = local_labels(self.labels, j)
-        idx = self.r + np.asarray(ks, dtype=int)
-        others = [_in_rows(piece.columns[self.labels[kk]], j) for kk in ks]
-        c = others[ks.index(k)]
-        for p, sl in segments(piece.part):
-            cs = c[sl]
-            cross_y = piece.Yj[j][sl].T @ cs
-            cross_f = np.array([0.0 if kk in done else o[sl] @ cs for kk, o in zip(ks, others)])
-            for G in (self.G[p, j][:, i], self.G[p, j][i, :]):
-                G[:self.r] += cross_y
-                G[idx] += cross_f
-            self.G[p, j][i, i] -= cs @ cs  # added twice above
-            self.g[p, j][i] += cs @ piece.tau[sl, j]
+    def rotated(self, ks, betas) -> "Normal":
+        """A copy in which label ks[d]'s column c_d is c_d - betas[d] * w, w the first hidden
+        column: the normal equations of A M (M the identity but M[w, c_d] = -betas[d]), so
+        M^T G M and M^T g, without reading the rows again."""
+        M = np.eye(self.G.shape[-1])
+        for k, beta in zip(ks, betas):
+            M[self.r + len(self.labels), self.r + k] = -beta
+        out = Normal.__new__(Normal)
+        out.r, out.labels, out.dof, out.hidden, out.bb, out.n = self.r, self.labels, self.dof, self.hidden, self.bb, self.n
+        out.G = np.einsum("ai,pjab,bk->pjik", M, self.G, M)
+        out.g = np.einsum("ai,pja->pji", M, self.g)
+        return out
 
     def total(self, parts, weights=None, keep=None) -> tuple[np.ndarray, np.ndarray]:
         """(A^T W A, A^T W b) over the given parts, joint j's rows weighted by weights[j]^2,
         restricted to the columns `keep` (indices, default all)."""
         w2 = np.ones(self.dof) if weights is None else np.asarray(weights, dtype=float) ** 2
-        G = np.einsum("pjab,j->ab", self.G[parts], w2)
-        g = np.einsum("pja,j->a", self.g[parts], w2)
+        c = self.r + len(self.labels)  # the hidden columns are no unknowns
+        G = np.einsum("pjab,j->ab", self.G[parts][:, :, :c, :c], w2)
+        g = np.einsum("pja,j->a", self.g[parts][:, :, :c], w2)
         if keep is not None:
             G, g = G[np.ix_(keep, keep)], g[keep]
         return G, g
@@ -147,10 +122,11 @@ class Normal:
     def sse(self, x, parts, keep=None) -> np.ndarray:
         """(len(parts), N): sum of squared residuals of x (over the columns keep) per part and joint."""
         if keep is not None:
-            full = np.zeros(self.G.shape[-1])
+            full = np.zeros(self.r + len(self.labels))
             full[keep] = x
             x = full
-        G, g, bb = self.G[parts], self.g[parts], self.bb[parts]
+        c = self.r + len(self.labels)
+        G, g, bb = self.G[parts][:, :, :c, :c], self.g[parts][:, :, :c], self.bb[parts]
         return np.maximum(bb - 2 * np.einsum("pja,a->pj", g, x) + np.einsum("pjab,a,b->pj", G, x, x), 0.0)
 
 
@@ -158,11 +134,11 @@ class Swaps:
     """The Coulomb searches' variants: one label per joint (ks, each its joint's own), variant
     v's columns those of makes[v](piece) (T, N), summed piece by piece (each joint's variants in
     one matrix product per block, the other columns as they are); normals(base): per variant,
-    base with those labels' rows and columns replaced (what replaced() would give)."""
+    base with those labels' rows and columns replaced."""
 
-    def __init__(self, labels, r: int, parts: int, dof: int, ks, makes):
-        self.labels, self.r, self.ks, self.makes = labels, r, ks, makes
-        self.rows = np.zeros((len(makes), parts, dof, r + len(labels)))
+    def __init__(self, labels, r: int, parts: int, dof: int, ks, makes, hidden: int = 0):
+        self.labels, self.r, self.ks, self.makes, self.hidden = labels, r, ks, makes, hidden
+        self.rows = np.zeros((len(makes), parts, dof, r + len(labels) + hidden))
         self.g = np.zeros((len(makes), parts, dof))
 
     def add(self, piece) -> None:
@@ -170,8 +146,9 @@ class Swaps:
         for k in self.ks:
             j = self.labels[k][1]
             local = local_labels(self.labels, j)
-            idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int)]
-            F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local])
+            idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int), self.r + len(self.labels) + np.arange(self.hidden)]
+            F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local]
+                                + ([piece.along[:, j]] if self.hidden else []))
             C = np.column_stack([v[:, j] for v in values])
             for p, sl in segments(piece.part):
                 cross = np.vstack([piece.Yj[j][sl].T @ C[sl], F[sl].T @ C[sl]])  # (columns, variants)
@@ -183,7 +160,7 @@ class Swaps:
         outs = []
         for v in range(len(self.makes)):
             out = Normal.__new__(Normal)
-            out.r, out.labels, out.dof = base.r, base.labels, base.dof
+            out.r, out.labels, out.dof, out.hidden = base.r, base.labels, base.dof, base.hidden
             out.G, out.g, out.bb, out.n = base.G.copy(), base.g.copy(), base.bb, base.n
             for k in self.ks:
                 j, i = self.labels[k][1], self.r + k

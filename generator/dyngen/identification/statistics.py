@@ -25,6 +25,9 @@ textbook deviation.
 
 from __future__ import annotations
 
+import os
+import tempfile
+
 import numpy as np
 from scipy import signal
 
@@ -96,27 +99,26 @@ def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
     return np.hstack([np.einsum("jtr,tj->tr", piece.Yj, we), np.einsum("tjk,tj->tk", _label_matrix(piece, labels, dof), we)])
 
 
-def _score_blocks(blocks, parts, labels, r, x, keep, weights, length: int, dof: int):
-    """(sum over blocks of s s^T, count): s the scores (columns keep) of a contiguous block of
-    `length` samples of a recording, counted from its first data sample (a last, shorter
-    block is left out)."""
-    S, count = np.zeros((len(keep), len(keep))), 0
+def _score_blocks(spilled, length: int):
+    """(sum over blocks of s s^T, count): s the scores of a contiguous block of `length` samples
+    of a recording, counted from its first data sample (a last, shorter block is left out);
+    spilled: per piece (its source, its first sample, the file of its score rows)."""
+    S, count = 0.0, 0
     current, index, open_sum = None, -1, None
 
     def close():
         nonlocal S, count
         if open_sum is not None and (index + 1) * length <= current.rows:
-            s = open_sum[keep]
-            S, count = S + np.outer(s, s), count + 1
+            S, count = S + np.outer(open_sum, open_sum), count + 1
 
-    for piece in blocks.fit_only(parts):
-        if piece.source is not current:
+    for source, start, path in spilled:
+        if source is not current:
             close()
-            current, index, open_sum = piece.source, -1, None
-        e = residuals([piece], labels, r, x, keep, dof)[0]
-        at = (piece.start + np.arange(e.shape[0])) // length
+            current, index, open_sum = source, -1, None
+        rows = np.load(path)
+        at = (start + np.arange(rows.shape[0])) // length
         starts = np.r_[0, np.flatnonzero(np.diff(at)) + 1]
-        for number, part in zip(at[starts], np.add.reduceat(_score_rows(piece, labels, r, weights, e, dof), starts)):
+        for number, part in zip(at[starts], np.add.reduceat(rows, starts)):
             if number == index:
                 open_sum = open_sum + part
             else:
@@ -129,7 +131,9 @@ def _score_blocks(blocks, parts, labels, r, x, keep, weights, length: int, dof: 
 def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     """The weighted unconstrained fit of the columns keep (indices into coefficients, then
     labels) on the given parts, with standard deviations as above; two passes over the fit
-    recordings' blocks (blocks.py): the residuals' size and correlation time, then the scores."""
+    recordings' blocks (blocks.py): the residuals' size and correlation time, and their scores
+    per sample, kept in a temporary folder until the correlation time gives the blocks' length
+    (reading them back costs less than a second pass: the regressor again)."""
     G, g = normal.total(parts, weights, keep)
     cols = len(keep)
     norms = np.sqrt(np.maximum(np.diag(G), 0.0))
@@ -142,17 +146,21 @@ def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     x = inverse @ g
     rows = int(normal.n[parts].sum())
     labels, r = normal.labels, normal.r
-    sse, correlation = 0.0, {}
+    sse, correlation, spilled = 0.0, {}, []
+    folder = tempfile.TemporaryDirectory(prefix="dyngen-scores-")
     for piece in blocks.fit_only(parts):
         e = residuals([piece], labels, r, x, keep, dof)[0]
         sse += float(((e * weights) ** 2).sum())
         for j in range(dof):
             correlation.setdefault((id(piece.source), j), _Correlation()).add(e[:, j])
+        spilled.append((piece.source, piece.start, os.path.join(folder.name, f"{len(spilled)}.npy")))
+        np.save(spilled[-1][2], _score_rows(piece, labels, r, weights, e, dof)[:, keep])
     sigma2 = sse / max(rows - int(strong.sum()), 1)
     textbook = np.sqrt(np.maximum(sigma2 * np.diag(inverse), 0.0))
     times = [c.time() for c in correlation.values() if c.n > 8]
     tau = max(times) if times else 1.0
-    S, count = _score_blocks(blocks, parts, labels, r, x, keep, weights, int(np.ceil(BLOCK_TIMES * tau)), dof)
+    with folder:
+        S, count = _score_blocks(spilled, int(np.ceil(BLOCK_TIMES * tau)))
     if count >= MIN_BLOCKS:
         std = np.maximum(np.sqrt(np.maximum(np.diag(inverse @ S @ inverse), 0.0)), textbook)
     else:
