@@ -28,14 +28,14 @@ import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import simple_model
-from . import choose, findings_check, fit, joints, reidentify, roles, trust
+from . import choose, findings_check, fit, joints, reidentify, roles, stable, trust
 from .diagnose_options import Options
 from .effects import Context, library
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
 from .judge import judge, simple_mse
 from .notes import notes
-from .record import CandidateGain, Diagnosis, RecordingNote
+from .record import CandidateGain, Diagnosis, RecordingNote, Unstable
 from .refine import restricted
 from .settle import settle
 
@@ -114,7 +114,7 @@ class Choice:
     reidentified: object  # identification.consistent.Consistent where it won a joint, else None
     consistent: list | None  # per segment its corrections (T, N), with reidentified
     links_hint: list  # 0-based joints where the rigid body's columns explain what the effects leave
-    excitation: float | None  # condition number of the link parameters' scaled columns, where it decided
+    excitation: tuple | None  # (condition number, bound), reidentify.excitation, where it decided
     described: list  # record.Finding per chosen effect, values not yet filled in
     selection_mse: dict  # "before", "effects", "simple": per joint, on the selection samples
 
@@ -141,7 +141,7 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
     run_reid = options.reidentify
     if run_reid is None and design.select.count:  # by default where the fit data excite the link parameters
         excitation = reidentify.excitation(model, selecting)
-        run_reid = excitation <= reidentify.EXCITED
+        run_reid = excitation[0] <= excitation[1]
     if not run_reid and design.select.count:
         links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                      options.min_gain)
@@ -194,7 +194,11 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     (notes.py's are added by diagnose)."""
     n, modes = robot.dof, choice.modes
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
-    selected, superseded = reported(final.chosen, final.findings, replaced)
+    flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
+                              final.correlation_samples)
+    claimed = [i for i, c in enumerate(final.chosen) if i not in flagged or c.joint in replaced]
+    selected, superseded = reported([final.chosen[i] for i in claimed], [final.findings[i] for i in claimed], replaced)
+    unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed))]
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
     fit_signals = roles_of[0][1]
     selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
@@ -203,9 +207,10 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)"
-                     + ("" if choice.excitation is None else f"; not tried by default: the fit data excite the link "
-                        f"parameters weakly (condition number {choice.excitation:.3g} of their scaled columns, above "
-                        f"{reidentify.EXCITED:g})"))
+                     + ("" if choice.excitation is None else "; not tried by default: the fit data excite the link "
+                        "parameters too weakly for what the effects leave (condition number {:.3g} of their scaled "
+                        "columns, above the largest ratio {:.3g} of a joint's nominal residual to what the effects leave "
+                        "there)".format(*choice.excitation)))
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}
     reid = final.reidentified
@@ -217,7 +222,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=final.simple.values.tolist(),
         peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
         candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
-        steps=selection.steps, dropped=settled.dropped, refused=settled.refused, superseded=superseded,
+        steps=selection.steps, dropped=settled.dropped, refused=settled.refused, superseded=superseded, unstable=unstable,
         correlation_samples=final.correlation_samples, segments=judged_segments, joint_models=modes,
         within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(

@@ -8,13 +8,17 @@ friction that opposes motion, a tilted base, regularised toward the diagnosed pa
 the alternative, with the three roles of data kept:
 
   excited by default (Options.reidentify None) all of this runs only where the fit samples
-          excite the link parameters: the condition number of the rigid body's base columns
-          (each scaled to unit norm, at GATE_RATE) at most EXCITED. On the real LWR4+ (42 for
-          each of its three recordings, from recorded velocities or positions alone) the
-          re-identification, chosen on selection blocks of one recording, took joint 2 of m3
-          from 0.446 to 0.633 Nm from positions alone (the simple model: 0.449), where the
-          effects predict; on the simulated Fourier excitations and Table V (9-25) it names
-          wrong links and predicts another trajectory at the noise;
+          determine the link parameters well enough for what the effects leave: a residual
+          the re-identification cannot express (RMS s_j on joint j) can, aligned with the
+          weakest direction of the rigid body's base columns (each scaled to unit norm, at
+          GATE_RATE), move their torque on a trajectory that excites every direction alike
+          by up to kappa s_j (kappa: the columns' condition number), and the most it can gain
+          on joint j is the nominal residual r_j: it runs where kappa <= max_j r_j / s_j. The
+          real LWR4+ (kappa 53-78, ratios 14-21) stays as it was (the re-identification,
+          forced there, took joint 2 of m3 from 0.446 to 0.633 Nm from positions alone, where
+          the effects predict); the simulated Fourier excitations and Table V (kappa 10-28,
+          ratios 53-670 where an effect or wrong links are in the data) run it; a residual at
+          the noise (ratio 1) does not;
   gate    cheap: the residual the selected effects leave on the fit samples, regressed on the
           rigid body's base columns (unconstrained, at GATE_RATE); the joints where that gains
           `min_gain` of the mean square on the selection samples are those whose residual the
@@ -53,7 +57,6 @@ GRID = (0.0, 0.1, 0.3, 3.0)
 REFIT_WORSE = 1.25  # the refit must fit its (larger) data about as well as the first fit did
 RESTARTS = 2  # of the final solve (the held-out choice of the regularisation uses one)
 FRICTION = ("coulomb", "viscous", "offset", "armature", "ripple")
-EXCITED = 30.0  # the largest condition number of the scaled base columns at which it runs by default
 JOINT_VALUES = 7  # per joint: Fc, Fv, offset, Ia, two ripple values, and one for the shared link parameters
 
 
@@ -81,21 +84,25 @@ def _gate_columns(model, seg, k):
     return model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
 
 
-def excitation(model, segments) -> float:
-    """The condition number of the rigid body's base columns on the fit samples (at GATE_RATE),
-    each column scaled to unit norm."""
-    G = None
+def excitation(model, segments) -> tuple[float, float]:
+    """(kappa, bound): the condition number of the rigid body's base columns on the fit samples
+    (at GATE_RATE, each column scaled to unit norm), and the largest ratio over joints of the
+    nominal residual's RMS to that of what the effects leave (Segment.correction) there."""
+    G, nominal, left = None, 0.0, 0.0
     for seg in segments:
         k = np.flatnonzero(seg.fit)[::max(1, int(round(seg.signals.rate / GATE_RATE)))]
         if k.size:
             A = _gate_columns(model, seg, k)
             A = A.reshape(-1, A.shape[2])
             G = A.T @ A if G is None else G + A.T @ A
+            nominal = nominal + np.sum(seg.residual[seg.fit] ** 2, axis=0)
+            left = left + np.sum((seg.residual - seg.correction)[seg.fit] ** 2, axis=0)
     if G is None:
-        return float("inf")
+        return float("inf"), 0.0
     scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
     ev = np.linalg.eigvalsh(G / np.outer(scale, scale))
-    return float(np.sqrt(ev[-1] / max(ev[0], 1e-300 * ev[-1])))
+    bound = float(np.max(np.sqrt(nominal / np.maximum(left, 1e-300 * np.max(nominal)))))
+    return float(np.sqrt(ev[-1] / max(ev[0], 1e-300 * ev[-1]))), bound
 
 
 def gate(model, segments, remaining, min_gain: float) -> list[int]:

@@ -1,0 +1,84 @@
+"""A finding is stable across the data, or it is not claimed: every chosen effect's values are
+fitted again on each stretch of the fit samples on its own (STRETCHES contiguous stretches of
+every fit recording, all chosen effects together, as the final fit; with several recordings
+this also compares the recordings), and set beside the values from every fit sample.
+
+An effect is "unstable across blocks" where some stretch's values
+  - differ from the whole fit's beyond their uncertainty (chi-square of the difference with the
+    stretch's covariance, scaled for the residual's correlation, above its 1 - ALPHA quantile),
+  - and either move the effect's torque by more than MOVES of that torque (the weighted norm of
+    the fit data: a sign change moves it by more than 1), or are outside the effect's
+    physical range (Effect.plausible).
+Values a stretch does not determine (a Coulomb term on a joint that does not reverse there) are
+not compared. An effect present in one third of a recording only fits about 1/3 of its value on
+the whole, and 0 or all of it on the stretches: flagged. The effect stays in the model (the
+figures do not change); it is reported as record.Unstable instead of a finding.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.stats import chi2
+
+from .findings import identifiable
+from .forward_selection import solve
+from .refine import restricted
+
+STRETCHES = 3
+ALPHA = 1e-3
+MOVES = 0.5
+
+
+def _stretched(segments):
+    """The segments with Segment.groups as every fit recording's STRETCHES contiguous stretches of
+    fit samples (equal counts), one group per stretch over all segments."""
+    fitting = [i for i, seg in enumerate(segments) if seg.fit.any()]
+    total, out = STRETCHES * len(fitting), []
+    for i, seg in enumerate(segments):
+        groups = [np.zeros(seg.fit.size, dtype=bool) for _ in range(total)]
+        if i in fitting:
+            first = STRETCHES * fitting.index(i)
+            for b, idx in enumerate(np.array_split(np.flatnonzero(seg.fit), STRETCHES)):
+                groups[first + b][idx] = True
+        out.append(replace(seg, groups=groups))
+    return out, total
+
+
+def unstable(context, segments, design, chosen, x, tau_corr) -> dict:
+    """chosen index -> (values per stretch, each a list or None where undetermined, reason) for
+    the effects that are unstable across the stretches."""
+    if not chosen:
+        return {}
+    cut, total = _stretched(segments)
+    whole, renumbered = restricted(context, cut, replace(design, groups=[None] * total), chosen)
+    overall = identifiable(whole, renumbered)
+    fits = []
+    for m in whole.groups:
+        part = type(whole)(renumbered, m, m, m, whole.weights)
+        fits.append((solve(part, renumbered), identifiable(part, renumbered)) if m.count else (None, None))
+    out = {}
+    for i, c in enumerate(renumbered):
+        k = c.slots
+        values, why = [], []
+        for b, (f, ok) in enumerate(fits):
+            use = k[overall[k] & ok[k]] if f is not None else k[:0]
+            values.append([float(v) if u else None for v, u in zip(f.x[k], overall[k] & ok[k])] if f else None)
+            if not use.size:
+                continue
+            diff = f.x[use] - x[use]
+            cov = f.covariance[np.ix_(use, use)] * tau_corr
+            score = float(diff @ np.linalg.pinv(cov) @ diff)
+            if score <= chi2.ppf(1 - ALPHA, use.size):
+                continue
+            H = whole.H[np.ix_(use, use)]
+            moved = np.sqrt(diff @ H @ diff / max(x[use] @ H @ x[use], 1e-300))
+            inside = c.effect.plausible(np.where(overall[k] & ok[k], f.x[k], x[k]))
+            if moved > MOVES or not inside:
+                why.append(f"stretch {b + 1}: " + ("outside its physical range" if not inside else
+                                                   f"its torque {moved:.0%} off the whole fit's"))
+        if why:
+            out[i] = (values, f"values on {STRETCHES} stretches of each fit recording fitted on their own differ from "
+                              f"the whole fit's beyond their uncertainty ({'; '.join(why)})")
+    return out
