@@ -13,7 +13,7 @@ the alternative, with the three roles of data kept:
           MOVED of the residual's), and every one of them is determined to PRECISION of its
           value (its standard deviation from the residual the fit leaves, scaled for that
           residual's correlation in time): two deviations from zero. (Numbers:
-          docs/measured-data.md, "A finding is physical, stable, or flagged".)
+          docs/measured-data.md, "runs by default where the fit data determine".)
   gate    cheap: the residual the selected effects leave on the fit samples, regressed on the
           rigid body's base columns (unconstrained, at GATE_RATE); the joints where that gains
           `min_gain` of the mean square on the selection samples are those whose residual the

@@ -1,18 +1,12 @@
-"""A finding is stable across the data, or it is not claimed: every chosen effect's values are
-fitted again on each stretch of the fit samples on its own (STRETCHES contiguous stretches of
-every fit recording, all chosen effects together, as the final fit; with several recordings
-this also compares the recordings), and set beside the values from every fit sample.
-
-An effect is "unstable across blocks" where some stretch's values
-  - differ from the whole fit's beyond their uncertainty (chi-square of the difference with the
-    stretch's covariance, scaled for the residual's correlation, above its 1 - ALPHA quantile),
-  - and either move the effect's torque by more than MOVES of that torque (the weighted norm of
-    the fit data: a sign change moves it by more than 1), or are outside the effect's
-    physical range (Effect.plausible).
-Values a stretch does not determine (a Coulomb term on a joint that does not reverse there) are
-not compared. An effect present in one third of a recording only fits about 1/3 of its value on
-the whole, and 0 or all of it on the stretches: flagged. The effect stays in the model (the
-figures do not change); it is reported as record.Unstable instead of a finding.
+"""A finding is stable across the fit data, or it is not claimed: each chosen effect's values,
+fitted again (all effects together) on each of STRETCHES contiguous stretches of every fit
+recording, against the values from every fit sample. It is "unstable across blocks" where a
+stretch's values differ beyond their uncertainty (chi-square with the stretch's covariance,
+scaled for the residual's correlation, above its 1 - ALPHA quantile) and move the effect's
+torque by more than MOVES of it (weighted norm over the fit data: a sign change moves it by
+more than 1) or leave its physical range. Values a stretch does not determine are not compared.
+The effect stays in the model; it is reported as record.Unstable instead of a finding
+(docs/measured-data.md, "A finding is stable across the fit data").
 """
 
 from __future__ import annotations
