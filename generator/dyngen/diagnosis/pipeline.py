@@ -114,7 +114,7 @@ class Choice:
     reidentified: object  # identification.consistent.Consistent where it won a joint, else None
     consistent: list | None  # per segment its corrections (T, N), with reidentified
     links_hint: list  # 0-based joints where the rigid body's columns explain what the effects leave
-    excitation: float | None  # reidentify.gate's precision where it left the re-identification off by default
+    precision: float | None  # reidentify.gate's precision where it left the re-identification off by default
     described: list  # record.Finding per chosen effect, values not yet filled in
     selection_mse: dict  # "before", "effects", "simple": per joint, on the selection samples
 
@@ -134,7 +134,7 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
         modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
         modes = choose.on_folds(context, selecting, design, chosen, final, options)
-    reid, consistent, links_hint, excitation = None, None, [], None
+    reid, consistent, links_hint, off_by_default = None, None, [], None
     if design.select.count:  # the gate: where the rigid body's columns explain what the effects leave
         flagged, precision = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
                                              options.min_gain)
@@ -143,9 +143,9 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
             reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
                                                           modes, options.min_gain, flagged)
         else:  # the link parameters may be off there
-            links_hint, excitation = flagged, (None if options.reidentify is False else precision)
+            links_hint, off_by_default = flagged, (None if options.reidentify is False else precision)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
-    return Choice(selecting, simple, modes, reid, consistent, links_hint, excitation, described, mse)
+    return Choice(selecting, simple, modes, reid, consistent, links_hint, off_by_default, described, mse)
 
 
 @dataclass(frozen=True)
@@ -215,8 +215,8 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)"
-                     + ("" if choice.excitation is None else f"; not tried by default: the fit data do not determine the base "
-                        f"coefficients it would move (relative standard deviation up to {choice.excitation:.3g}, above "
+                     + ("" if choice.precision is None else f"; not tried by default: the fit data do not determine the base "
+                        f"coefficients it would move (relative standard deviation up to {choice.precision:.3g}, above "
                         f"{reidentify.PRECISION:g})"))
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}

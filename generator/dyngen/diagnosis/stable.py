@@ -3,10 +3,11 @@ fitted again (all effects together) on each of STRETCHES contiguous stretches of
 recording, against the values from every fit sample. It is "unstable across blocks" where a
 stretch's values differ beyond their uncertainty (chi-square with the stretch's covariance,
 scaled for the residual's correlation, above its 1 - ALPHA quantile) and move the effect's
-torque by more than MOVES of it (weighted norm over the fit data: a sign change moves it by
-more than 1) or leave its physical range. Values a stretch does not determine are not compared.
-The effect stays in the model; it is reported as record.Unstable instead of a finding
-(docs/measured-data.md, "A finding is stable across the fit data").
+torque over the stretch by more than MOVES of it (weighted norm over the stretch's samples: a
+sign change moves it by more than 1) or leave its physical range. Values a stretch does not
+determine count only through the torque they make there. The effect stays in the model; it is
+reported as record.Unstable instead of a finding (docs/measured-data.md, "A finding is stable
+across the fit data").
 """
 
 from __future__ import annotations
@@ -51,23 +52,23 @@ def unstable(context, segments, design, chosen, x, tau_corr) -> dict:
     fits = []
     for m in whole.groups:
         part = type(whole)(renumbered, m, m, m, whole.weights)
-        fits.append((solve(part, renumbered), identifiable(part, renumbered)) if m.count else (None, None))
+        fits.append((solve(part, renumbered), identifiable(part, renumbered), part.H) if m.count else (None,) * 3)
     out = {}
     for i, c in enumerate(renumbered):
         k = c.slots
         values, why = [], []
-        for b, (f, ok) in enumerate(fits):
-            use = k[overall[k] & ok[k]] if f is not None else k[:0]
-            values.append([float(v) if u else None for v, u in zip(f.x[k], overall[k] & ok[k])] if f else None)
-            if not use.size:
+        for b, (f, ok, H) in enumerate(fits):
+            values.append(None if f is None else [float(v) if u else None for v, u in zip(f.x[k], overall[k] & ok[k])])
+            if f is None or not ok[k].any():
                 continue
-            diff = f.x[use] - x[use]
-            cov = f.covariance[np.ix_(use, use)] * tau_corr
-            score = float(diff @ np.linalg.pinv(cov) @ diff)
-            if score <= chi2.ppf(1 - ALPHA, use.size):
+            # compared as torques: directions the stretch does not determine carry its large
+            # variance (chi-square) and little of its torque (the stretch's own normal matrix)
+            diff, H_b = f.x[k] - x[k], H[np.ix_(k, k)]
+            ev, V = np.linalg.eigh(f.covariance[np.ix_(k, k)] * tau_corr)
+            keep = ev > 1e-12 * max(ev.max(), 1e-300)
+            if np.sum((V[:, keep].T @ diff) ** 2 / ev[keep]) <= chi2.ppf(1 - ALPHA, keep.sum()):
                 continue
-            H = whole.H[np.ix_(use, use)]
-            moved = np.sqrt(diff @ H @ diff / max(x[use] @ H @ x[use], 1e-300))
+            moved = np.sqrt(diff @ H_b @ diff / max(x[k] @ H_b @ x[k], 1e-300))
             inside = c.effect.plausible(np.where(overall[k] & ok[k], f.x[k], x[k]))
             if moved > MOVES or not inside:
                 why.append(f"stretch {b + 1}: " + ("outside its physical range" if not inside else
