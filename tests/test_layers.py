@@ -39,7 +39,7 @@ DIAGNOSIS_STAGES = (
     {"refine", "settle"},  # 3. settle
     {"joints", "reidentify", "choose"},  # 4. choose
     {"judge"},  # 5. test
-    {"findings", "findings_check", "across", "notes", "diagnose_options", "pipeline"},  # 6. report; the pipeline
+    {"findings", "findings_check", "stable", "across", "notes", "diagnose_options", "pipeline"},  # 6. report; the pipeline
     {"report", "updated_model", "figures", "outputs", "unusable_output", ""},  # written out; the package
 )
 DIAGNOSIS_RANK = {name: k for k, names in enumerate(DIAGNOSIS_STAGES) for name in names}

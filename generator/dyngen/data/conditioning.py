@@ -157,13 +157,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
             out.warnings.append(f"{r.name}: {what} noise ({_sigma(decision.q_noise)}) allows a cutoff of only "
                                 f"{cutoff:.3g} Hz, below twice the motion's band ({decision.band:.3g} Hz): "
                                 "accelerations are smoothed")
-    elif differentiate and cutoff is not None:
-        sigma = automatic.position_noise(r.q)
-        out.q_noise, out.qdd_noise = sigma, automatic.acceleration_noise(sigma, cutoff, rate)
-    elif differentiate:
-        sigma = automatic.position_noise(r.q)
-        out.q_noise = sigma
-        out.qdd_noise = sigma * np.sqrt(6.0) * rate ** 2  # central second difference of white noise
+    elif differentiate:  # without a filter: the central second difference of white noise
+        out.q_noise = sigma = automatic.position_noise(r.q)
+        out.qdd_noise = automatic.acceleration_noise(sigma, cutoff, rate) if cutoff else sigma * np.sqrt(6.0) * rate ** 2
     return out
 
 

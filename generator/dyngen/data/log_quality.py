@@ -68,10 +68,13 @@ def _all_columns(r: Recording) -> np.ndarray:
     return np.hstack(parts)
 
 
-def _select(r: Recording, keep: np.ndarray) -> Recording:
-    return dataclasses.replace(r, t=r.t[keep], q=r.q[keep], tau=None if r.tau is None else r.tau[keep],
-                               qd=None if r.qd is None else r.qd[keep], qdd=None if r.qdd is None else r.qdd[keep],
-                               extra={k: np.asarray(v)[keep] for k, v in r.extra.items()})
+def _mapped(r: Recording, t: np.ndarray, f) -> Recording:
+    """r at times t, f applied to every column block."""
+    def of(x):
+        return None if x is None else f(np.asarray(x, dtype=float))
+
+    return dataclasses.replace(r, t=t, q=of(r.q), tau=of(r.tau), qd=of(r.qd), qdd=of(r.qdd),
+                               extra={k: of(v) for k, v in r.extra.items()})
 
 
 def repeated_rows(r: Recording) -> np.ndarray:
@@ -113,15 +116,6 @@ def _unheld(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(t, t[changed], x[changed, j]) for j in range(x.shape[1])])
 
 
-def _on_grid(r: Recording, grid: np.ndarray) -> Recording:
-    def spline(x):
-        return CubicSpline(r.t, x, axis=0)(grid)
-
-    return dataclasses.replace(r, t=grid, q=spline(r.q), tau=None if r.tau is None else spline(r.tau),
-                               qd=None if r.qd is None else spline(r.qd), qdd=None if r.qdd is None else spline(r.qdd),
-                               extra={k: spline(np.asarray(v, dtype=float)) for k, v in r.extra.items()})
-
-
 def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogReport]:
     """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are
     exact, a filter over them is not)."""
@@ -133,7 +127,7 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
     repeats = repeated_rows(r)
     if repeats.any():
         report.repeated = int(repeats.sum())
-        r = _select(r, ~repeats)
+        r = _mapped(r, r.t[~repeats], lambda x: x[~repeats])
         share = report.repeated / (report.repeated + r.t.size)
         report.notes.append(f"{report.repeated} repeated rows ({100 * share:.2g} %: the same sample written twice) "
                             "left out")
@@ -162,7 +156,7 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
         report.filled = max(grid.size - r.t.size, 0)
         report.longest_gap = float(steps.max())
         report.regridded = True
-        r = _on_grid(r, grid)
+        r = _mapped(r, grid, lambda x, t=r.t: CubicSpline(t, x, axis=0)(grid))
         report.notes.append(f"stamps uneven (steps {1e3 * float(steps.min()):.3g}-{1e3 * float(steps.max()):.3g} ms): "
                             f"interpolated onto a regular {1e3 * period:.4g} ms grid ({report.filled} samples filled)")
         if report.longest_gap > LONG_GAP * period:

@@ -1,5 +1,9 @@
-"""A finding is stable across recordings, or it is the model's error: a run compared with a
-control run of the same arm without what is looked for (e.g. unloaded beside loaded).
+"""A gain, a payload or a scaled gravity (DIFFERS) may be the nominal model's error: where the
+re-identified link parameters won joints (reidentify.py), one that gains less than min_gain of
+the selection data's mean square beside them, alone on what they leave, is explained by them:
+not told apart from the link parameters being off, so not claimed (explained_by_links). And a
+run is compared with a control run of the same arm without what is looked for (e.g. unloaded
+beside loaded):
 
     result = compared(result, control, "unloaded.csv")
 
@@ -16,6 +20,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from .forward_selection import selection_gain, selection_mse
+from .refine import restricted
 
 DIFFERS = ("gain", "payload", "gravity_scale")
 
@@ -42,3 +48,16 @@ def compared(result, control, control_name: str):
     line = (f"found also in the control run {control_name}, so the nominal model's error (wrong link parameters, most "
             f"often), not a sensor or payload finding: {'; '.join(both)}")
     return replace(result, selected=selected, warnings=[*result.warnings, line])
+
+
+def explained_by_links(context, segments, consistent, design, chosen, min_gain) -> list[int]:
+    """Indices of the chosen DIFFERS effects that gain less than min_gain on the selection
+    samples of the residual the re-identified model leaves (consistent: per segment its correction)."""
+    left = [replace(seg, residual=seg.residual - c) for seg, c in zip(segments, consistent)]
+    out = []
+    for i, c in enumerate(chosen):
+        if c.effect.name in DIFFERS:
+            alone, (one,) = restricted(context, left, design, [c])
+            if selection_gain(one, selection_mse(alone, []), selection_mse(alone, [one])) < min_gain:
+                out.append(i)
+    return out

@@ -37,11 +37,10 @@ def on_folds(context, segments, design, chosen, final, options) -> list[str]:
     return joints.choose(totals, chosen, joints.FOLDS_PER_VALUE)
 
 
-def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain):
+def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain, flagged):
     """(Consistent result, its corrections per segment, modes) where the consistent link
-    parameters win a joint on selection data, else (None, None, modes) (reidentify.py)."""
-    remaining = [seg.residual - seg.correction for seg in segments]  # after the effects (fit-only values)
-    flagged = reidentify.gate(model, segments, remaining, min_gain)
+    parameters win a joint on selection data, else (None, None, modes) (reidentify.py); only
+    on the joints `flagged` by reidentify.gate."""
     if not flagged:
         return None, None, modes
     result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),

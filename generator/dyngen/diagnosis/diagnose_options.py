@@ -27,4 +27,4 @@ class Options:
         None, "always re-identify physically consistent link parameters (with friction and a tilted base) from the fit "
         "data, and use them on the joints where they beat every effect and the simple model on selection data; says "
         "'link parameters off' and writes them to consistent/. By default this is done where the fit data excite the "
-        "link parameters (diagnosis/reidentify.py EXCITED); --no-reidentify never", const=True)
+        "link parameters well enough for what the effects leave (diagnosis/reidentify.py); --no-reidentify never", const=True)

@@ -37,10 +37,10 @@ def with_values(described, design, chosen, final, tau_corr, robot) -> list[Findi
         k = slice(offset, offset + cand.size)
         offset += cand.size
         std = np.sqrt(np.maximum(np.diag(final.covariance)[k], 0.0) * tau_corr)
-        identifiable = _identifiable(design, chosen, k)
+        determined = identifiable(design, chosen)[k]
         names = list(cand.effect.parameters)
-        values = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], identifiable)}
-        std = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, identifiable)}
+        values = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], determined)}
+        std = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, determined)}
         derived = cand.effect.derived(robot, values, std, partial(_torque_rms, design, cand, final.x[k]))
         out.append(replace(e, values=values, std=std, variant=cand.effect.fixed(), derived=derived))
     return out
@@ -52,15 +52,16 @@ def _torque_rms(design, cand, x) -> float:
     return float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
 
 
-def _identifiable(design, chosen, k) -> np.ndarray:
-    """Values the data determine: not in the null space of the weighted normal matrix."""
+def identifiable(design, chosen) -> np.ndarray:
+    """Per value of the chosen (in their order), whether the data determine it: not in the null
+    space of the weighted normal matrix."""
     slots = np.concatenate([c.slots for c in chosen])
     H = design.H[np.ix_(slots, slots)]
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
     vals, vecs = np.linalg.eigh(H / np.outer(d, d))
     weak = vals <= 1e-10 * max(vals.max(), 1e-300)
     loading = (vecs[:, weak] ** 2).sum(axis=1)
-    return loading[k] < 0.5
+    return loading < 0.5
 
 
 def reported(chosen, described, replaced) -> tuple[list[Finding], list[Finding]]:

@@ -23,6 +23,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..identification.sanity import inertia_about_joints
+
 LARGER = 1.5  # a term whose torque exceeds this many times its joint's whole nominal residual (RMS)
 ROTOR_RATIO = 100.0
 
@@ -41,7 +43,6 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
     """(the findings, those outside their range marked suspect; what could not be told apart)."""
     before = np.asarray(selection_before, dtype=float)
     out, large, checked = [], {}, []
-    n = before.size
     inertia = None
     for e in selected:
         checked.append(e)
@@ -55,7 +56,7 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
                       f"({before[j]:.3g} Nm on the selection data): it makes up for another term")
         if e.effect == "armature" and e.values.get("Ia") is not None:
             if inertia is None:
-                inertia = _inertia_about_joints(model, s, fit_signals, n)
+                inertia = inertia_about_joints(model, s, fit_signals)
             ia = e.values["Ia"]
             qdd = np.sqrt(np.mean(np.vstack([sig.qdd[sig.inner(), j] for sig in fit_signals]) ** 2))
             if ia > ROTOR_RATIO * inertia[j]:
@@ -71,9 +72,3 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
         if len(names) > 1:
             out.append(f"joint {j + 1}: {' and '.join(names)} make up for each other; the data cannot tell them apart")
     return checked, out
-
-
-def _inertia_about_joints(model, s, signals, n) -> np.ndarray:
-    q = np.vstack([sig.q[sig.inner()] for sig in signals])
-    q = q[:: max(q.shape[0] // 200, 1)]
-    return np.median([np.diag(model("mass_matrix", x, s).reshape(n, n)) for x in q], axis=0)

@@ -61,15 +61,12 @@ def predict(context, chosen, x, segment) -> np.ndarray:
     effects = list({c.effect.key: c.effect for c in chosen}.values())
     columns = dz.effect_columns(effects, dz.as_chosen(context, chosen), segment)
     out = np.zeros_like(segment.residual)
-    offset = 0
-    for c in chosen:
-        values = x[offset: offset + c.size]
+    for c, values in zip(chosen, dz.split_values(chosen, x)):
         block = columns[c.effect.key] @ values  # (T, N)
         if c.joint is None:
             out += block
         else:
             out[:, c.joint] += block[:, c.joint]
-        offset += c.size
     return out
 
 

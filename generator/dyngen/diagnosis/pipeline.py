@@ -28,13 +28,13 @@ import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import Context, library, simple_model
-from . import choose, findings_check, fit, joints, reidentify, roles, trust
+from . import across, choose, findings_check, fit, joints, reidentify, roles, stable, trust
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
 from .judge import judge, simple_mse
 from .notes import notes
-from .record import CandidateGain, Diagnosis, RecordingNote
+from .record import CandidateGain, Diagnosis, RecordingNote, Unstable
 from .refine import restricted
 from .settle import settle
 
@@ -64,7 +64,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # 6. report
     roles_of = (("fit", fit_signals), ("select", select_signals or []), ("test", test or []))
     result = _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
-                     roles_of)
+                     roles_of, options.min_gain)
     return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
                                           judged.used) + result.warnings)
 
@@ -113,7 +113,7 @@ class Choice:
     reidentified: object  # identification.consistent.Consistent where it won a joint, else None
     consistent: list | None  # per segment its corrections (T, N), with reidentified
     links_hint: list  # 0-based joints where the rigid body's columns explain what the effects leave
-    excitation: float | None  # condition number of the link parameters' scaled columns, where it decided
+    precision: float | None  # reidentify.gate's precision where it left the re-identification off by default
     described: list  # record.Finding per chosen effect, values not yet filled in
     selection_mse: dict  # "before", "effects", "simple": per joint, on the selection samples
 
@@ -133,22 +133,18 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
         modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
         modes = choose.on_folds(context, selecting, design, chosen, final, options)
-    reid, consistent = None, None
-    # Without the re-identification its cheap gate still says where the rigid body's columns
-    # explain what the effects leave: the link parameters may be off there.
-    links_hint, excitation = [], None
-    run_reid = options.reidentify
-    if run_reid is None and design.select.count:  # by default where the fit data excite the link parameters
-        excitation = reidentify.excitation(model, selecting)
-        run_reid = excitation <= reidentify.EXCITED
-    if not run_reid and design.select.count:
-        links_hint = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
-                                     options.min_gain)
-    if run_reid and design.select.count:
-        reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
-                                                      modes, options.min_gain)
+    reid, consistent, links_hint, off_by_default = None, None, [], None
+    if design.select.count:  # the gate: where the rigid body's columns explain what the effects leave
+        flagged, precision = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
+                                             options.min_gain)
+        run_reid = precision <= reidentify.PRECISION if options.reidentify is None else options.reidentify
+        if run_reid:
+            reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
+                                                          modes, options.min_gain, flagged)
+        else:  # the link parameters may be off there
+            links_hint, off_by_default = flagged, (None if options.reidentify is False else precision)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
-    return Choice(selecting, simple, modes, reid, consistent, links_hint, excitation, described, mse)
+    return Choice(selecting, simple, modes, reid, consistent, links_hint, off_by_default, described, mse)
 
 
 @dataclass(frozen=True)
@@ -187,24 +183,40 @@ def _final_fit(robot, model, p, context, settled, choice, separate_selection) ->
 
 
 def _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
-            roles_of) -> Diagnosis:
+            roles_of, min_gain) -> Diagnosis:
     """The record: the findings (those on joints another model won superseded; those outside
     their range marked suspect, findings_check.py), the figures, and the warnings of the checks
     (notes.py's are added by diagnose)."""
     n, modes = robot.dof, choice.modes
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
-    selected, superseded = reported(final.chosen, final.findings, replaced)
+    flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
+                              final.correlation_samples)
+    claimed = [i for i, c in enumerate(final.chosen) if i not in flagged or c.joint in replaced]
+    explained = [] if choice.consistent is None else across.explained_by_links(
+        final.context, choice.segments, choice.consistent, settled.design, settled.chosen, min_gain)
+    links = [i for i in explained if final.chosen[i].effect.name != "payload"]  # a payload is told apart by --control
+    selected, superseded = reported([final.chosen[i] for i in claimed if i not in links],
+                                    [final.findings[i] for i in claimed if i not in links], replaced)
+    unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed))]
+    superseded += [final.findings[i] for i in links if i in claimed]
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
     fit_signals = roles_of[0][1]
     selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
+    if explained:
+        apart.append("not told apart from the link parameters being off (the re-identified links explain them: beside "
+                     f"them each gains less than {min_gain:g} of the selection data's mean square): "
+                     + "; ".join(final.chosen[i].effect.name + ("" if final.chosen[i].joint is None else
+                                 f" on joint {final.chosen[i].joint + 1}") + (": not claimed" if i in links else ": kept (a payload is a change "
+                                 "of the last link's parameters; a control run without it, --control, tells them apart)")
+                                 for i in explained))
     if choice.links_hint:
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in choice.links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)"
-                     + ("" if choice.excitation is None else f"; not tried by default: the fit data excite the link "
-                        f"parameters weakly (condition number {choice.excitation:.3g} of their scaled columns, above "
-                        f"{reidentify.EXCITED:g})"))
+                     + ("" if choice.precision is None else f"; not tried by default: the fit data do not determine the base "
+                        f"coefficients it would move (relative standard deviation up to {choice.precision:.3g}, above "
+                        f"{reidentify.PRECISION:g})"))
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}
     reid = final.reidentified
@@ -216,7 +228,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=final.simple.values.tolist(),
         peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
         candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
-        steps=selection.steps, dropped=settled.dropped, refused=settled.refused, superseded=superseded,
+        steps=selection.steps, dropped=settled.dropped, refused=settled.refused, superseded=superseded, unstable=unstable,
         correlation_samples=final.correlation_samples, segments=judged_segments, joint_models=modes,
         within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(

@@ -32,6 +32,15 @@ class Finding:
 
 
 @dataclass(frozen=True)
+class Unstable:
+    """A selected effect not claimed: its values fitted on each stretch of the fit data on its
+    own disagree with the whole fit's (stable.py); it stays in the model."""
+    finding: Finding  # what it would have been claimed as
+    per_stretch: list  # per stretch its values (None where the stretch does not determine them)
+    reason: str
+
+
+@dataclass(frozen=True)
 class Refusal:
     """A selected effect refused once fitted with the others: values not physically possible."""
     candidate: str  # Candidate.key, or what of it was refused
@@ -96,6 +105,7 @@ class Diagnosis:
     dropped: list  # selected forward, then dropped as not significant (correlated residual)
     refused: list[Refusal]  # selected, then refused: implausible values once fitted with the others
     superseded: list[Finding]  # per-joint effects on joints the simple model won
+    unstable: list[Unstable]  # selected, kept in the model, but not claimed: unstable across blocks
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
     warnings: list = field(default_factory=list)
     joint_models: list = field(default_factory=list)

@@ -182,7 +182,8 @@ def _refine_one(state, index) -> None:
 
     def cost(setting):
         chosen, _, design, _ = state.trial(index, setting)
-        return _weighted_sse(design, solve(design, chosen))
+        fit = solve(design, chosen, covariance=False)
+        return float(design.weights ** 2 @ design.fit.mse(fit.slots, fit.x))
 
     # Searched in the logarithm of the setting (a velocity scale matters by its ratio).
     lo, hi = np.log(interval[0]), np.log(interval[1])
@@ -238,13 +239,6 @@ def _renumbered(chosen) -> list:
         out.append(dz.Candidate(c.effect, c.joint, start, c.size))
         start += c.size
     return out
-
-
-def _weighted_sse(design, fit) -> float:
-    m = design.fit
-    G = m.G[:, fit.slots][:, :, fit.slots]
-    sse = m.c - 2 * m.b[:, fit.slots] @ fit.x + np.einsum("k,jkl,l->j", fit.x, G, fit.x)
-    return float(design.weights ** 2 @ np.maximum(sse, 0.0))
 
 
 def _groups(seg, design) -> list:

@@ -7,14 +7,13 @@ with friction (identification/consistent.py: every link's pseudo-inertia positiv
 friction that opposes motion, a tilted base, regularised toward the diagnosed parameters) is
 the alternative, with the three roles of data kept:
 
-  excited by default (Options.reidentify None) all of this runs only where the fit samples
-          excite the link parameters: the condition number of the rigid body's base columns
-          (each scaled to unit norm, at GATE_RATE) at most EXCITED. On the real LWR4+ (42 for
-          each of its three recordings, from recorded velocities or positions alone) the
-          re-identification, chosen on selection blocks of one recording, took joint 2 of m3
-          from 0.446 to 0.633 Nm from positions alone (the simple model: 0.449), where the
-          effects predict; on the simulated Fourier excitations and Table V (9-25) it names
-          wrong links and predicts another trajectory at the noise;
+  excited by default (Options.reidentify None) it runs where the fit samples determine what it
+          would change: the gate's unconstrained fit of the rigid body's base columns to what
+          the effects leave moves some base coefficients (each one whose torque is at least
+          MOVED of the residual's), and every one of them is determined to PRECISION of its
+          value (its standard deviation from the residual the fit leaves, scaled for that
+          residual's correlation in time): two deviations from zero. (Numbers:
+          docs/measured-data.md, "runs by default where the fit data determine".)
   gate    cheap: the residual the selected effects leave on the fit samples, regressed on the
           rigid body's base columns (unconstrained, at GATE_RATE); the joints where that gains
           `min_gain` of the mean square on the selection samples are those whose residual the
@@ -41,6 +40,7 @@ import dataclasses
 
 import numpy as np
 
+from ..data.correlation import integrated_time
 from .record import LinksOff
 
 RATE = 200.0  # Hz: samples used by the re-identification (the motion's band is far below)
@@ -53,7 +53,8 @@ GRID = (0.0, 0.1, 0.3, 3.0)
 REFIT_WORSE = 1.25  # the refit must fit its (larger) data about as well as the first fit did
 RESTARTS = 2  # of the final solve (the held-out choice of the regularisation uses one)
 FRICTION = ("coulomb", "viscous", "offset", "armature", "ripple")
-EXCITED = 30.0  # the largest condition number of the scaled base columns at which it runs by default
+MOVED = 0.2  # a base coefficient whose torque is this share of the residual's (norm over the fit samples) is moved
+PRECISION = 0.5  # ... and must be determined to this relative standard deviation (two of them from zero)
 JOINT_VALUES = 7  # per joint: Fc, Fv, offset, Ia, two ripple values, and one for the shared link parameters
 
 
@@ -81,29 +82,13 @@ def _gate_columns(model, seg, k):
     return model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
 
 
-def excitation(model, segments) -> float:
-    """The condition number of the rigid body's base columns on the fit samples (at GATE_RATE),
-    each column scaled to unit norm."""
-    G = None
-    for seg in segments:
-        k = np.flatnonzero(seg.fit)[::max(1, int(round(seg.signals.rate / GATE_RATE)))]
-        if k.size:
-            A = _gate_columns(model, seg, k)
-            A = A.reshape(-1, A.shape[2])
-            G = A.T @ A if G is None else G + A.T @ A
-    if G is None:
-        return float("inf")
-    scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
-    ev = np.linalg.eigvalsh(G / np.outer(scale, scale))
-    return float(np.sqrt(ev[-1] / max(ev[0], 1e-300 * ev[-1])))
-
-
-def gate(model, segments, remaining, min_gain: float) -> list[int]:
-    """Joints (0-based) on whose selection samples the unconstrained fit of the rigid body's
-    base columns to `remaining` (per segment, the residual left by the per-joint
-    models) gains at least `min_gain` of the mean square."""
+def gate(model, segments, remaining, min_gain: float) -> tuple[list[int], float]:
+    """(joints, precision): the joints (0-based) on whose selection samples the unconstrained
+    fit of the rigid body's base columns to `remaining` (per segment, the residual left by the
+    per-joint models) gains at least `min_gain` of the mean square; and the largest relative
+    standard deviation of the base coefficients that fit moves (inf if it moves none)."""
     G = g = None
-    sel = []
+    sel, fit = [], []
     for seg, rest in zip(segments, remaining):
         step = max(1, int(round(seg.signals.rate / GATE_RATE)))
         for role in ("fit", "select"):
@@ -111,21 +96,29 @@ def gate(model, segments, remaining, min_gain: float) -> list[int]:
             if not k.size:
                 continue
             A, r = _gate_columns(model, seg, k), rest[k]
+            (fit if role == "fit" else sel).append((A, r))
             if role == "fit":
                 A2 = A.reshape(-1, A.shape[2])
                 G = A2.T @ A2 if G is None else G + A2.T @ A2
                 g = A2.T @ r.reshape(-1) if g is None else g + A2.T @ r.reshape(-1)
-            else:
-                sel.append((A, r))
-    if G is None or not sel:
-        return []
+    if G is None:
+        return [], float("inf")
     scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
     ev, V = np.linalg.eigh(G / np.outer(scale, scale))
     keep = ev > 1e-10 * ev[-1]
     x = (V[:, keep] @ ((V[:, keep].T @ (g / scale)) / ev[keep])) / scale
-    before = sum(np.sum(r ** 2, axis=0) for _, r in sel)
-    after = sum(np.sum((r - A @ x) ** 2, axis=0) for A, r in sel)
-    return [j for j in range(before.size) if after[j] < (1 - min_gain) * before[j]]
+    # the coefficients it moves (their torque at least MOVED of the residual's) and their precision:
+    # correlation-scaled standard deviation over value, from the residual the fit leaves
+    A, r = (np.concatenate(part) for part in zip(*fit))
+    left = r - A @ x
+    tau = np.median([integrated_time(left[:, j]) for j in range(left.shape[1])])
+    std = np.sqrt(tau * np.sum(left ** 2) / max(left.size - keep.sum(), 1) * np.sum(V[:, keep] ** 2 / ev[keep], axis=1))
+    moved = np.abs(x) * scale >= MOVED * np.sqrt(np.sum(r ** 2))
+    precision = float(np.max(std[moved] / scale[moved] / np.abs(x[moved]))) if moved.any() else float("inf")
+    if not sel:
+        return [], precision
+    before, after = (sum(np.sum(m, axis=0) for m in ms) for ms in ([r ** 2 for _, r in sel], [(r - A @ x) ** 2 for A, r in sel]))
+    return [j for j in range(before.size) if after[j] < (1 - min_gain) * before[j]], precision
 
 
 def identify(robot, model, p, fit_pieces, select_pieces=None, regularisation=None):

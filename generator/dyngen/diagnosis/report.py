@@ -23,7 +23,7 @@ def to_json(d, sources: dict) -> str:
         "selection_rms_before": d.selection_before, "selection_rms_after": d.selection_after,
         "selection_rms_simple": d.selection_simple, "simple_wins": d.simple_wins, "simple_values": d.simple_values,
         "peak_before": d.peak_before, "noise_rms": d.noise_rms, "correlation_samples": d.correlation_samples,
-        "selected": d.selected, "superseded": d.superseded, "refused": d.refused, "where": d.where,
+        "selected": d.selected, "superseded": d.superseded, "unstable": d.unstable, "refused": d.refused, "where": d.where,
         "candidates": d.candidates, "steps": d.steps, "dropped": d.dropped, "warnings": d.warnings,
         "recordings": d.conditioning, "joint_models": d.joint_models,
         "completed": {str(j): values for j, values in d.completed.items()},
@@ -83,6 +83,10 @@ def _value_text(e) -> str:
     if e.suspect:
         text += " **suspect**"
     return text
+
+
+def _named(e) -> str:
+    return e.effect + (f" on joint(s) {', '.join(map(str, e.joints))}" if e.joints else "")
 
 
 def _row(label, values) -> str:
@@ -155,6 +159,9 @@ def markdown(d, sources: dict) -> str:
     if d.superseded:
         lines += ["Not kept (the simple model did better on these joints' selection data): "
                   + ", ".join(f"{e.effect} on joint {e.joints[0]}" for e in d.superseded) + ".", ""]
+    if d.unstable:
+        lines += ["Unstable across blocks, so not claimed (kept in the model): "
+                  + "; ".join(f"{_named(u.finding)}: {u.reason}" for u in d.unstable) + ".", ""]
     tied = [j + 1 for j, m in enumerate(d.joint_models) if m == TIED]
     if tied:
         lines += [f"On joint(s) {', '.join(map(str, tied))} the simple model predicts the torque: on the selection "
@@ -222,6 +229,7 @@ def summary_lines(d) -> list[str]:
     for e in d.selected:
         joints = ",".join(map(str, e.joints)) or "-"
         out.append(f"  {e.effect:<12} joints {joints:<14} gain {e.selection_gain:.3f}  {_value_text(e)}")
+    out += [f"  unstable across blocks, not claimed: {_named(u.finding)}" for u in d.unstable]
     if d.consistent:
         out.append(f"  link parameters off: consistent re-identified parameters used on joint(s) "
                    f"{', '.join(map(str, d.consistent.joints))} (consistent/identified.yaml)")

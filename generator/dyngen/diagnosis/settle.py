@@ -68,10 +68,7 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
     """An effect whose fitted values are possible only in part (Term.simplified: a payload
     whose inertia is no body's) is replaced by the simpler form that does best on the
     selection data (weighted as the fit), and everything refitted."""
-    offset = 0
-    for i, c in enumerate(chosen):
-        values = final.x[offset: offset + c.size]
-        offset += c.size
+    for i, (c, values) in enumerate(zip(chosen, dz.split_values(chosen, final.x))):
         simpler = c.effect.simplified(values)
         if simpler is None:
             continue

@@ -7,7 +7,7 @@ recorded accelerations that are noise, a cutoff far above what the positions all
 model torque carries tens of Nm of differentiation noise and the residual exceeds the
 torque itself; every effect fitted to it is then a description of the noise.
 
-    signals, notes = checked(model, s, signals)    # raises Unusable when nothing helps
+    signals = checked(model, s, signals)    # raises Unusable when nothing helps
 
 For each recording the nominal residual RMS is compared with the measured torque's RMS on the
 joints that carry torque (above TORQUE_FLOOR of the largest). Where the residual is ABOVE times
@@ -114,7 +114,7 @@ def _joints(js) -> str:
     return ", ".join(str(j + 1) for j in js)
 
 
-def checked(model, s, signals: list) -> tuple[list, list]:
+def checked(model, s, signals: list) -> list:
     """signals with any untrustworthy recording conditioned again; raises Unusable."""
     from ..data.conditioning import AUTO
 
@@ -156,13 +156,13 @@ def checked(model, s, signals: list) -> tuple[list, list]:
                 "with every conditioning tried (a log whose rows or stamps cannot be repaired, torques that do not "
                 "belong to the positions, or parameters far off); no effect is claimed")
         raise Unusable(line, failed)
-    return out, []
+    return out
 
 
 def checked_roles(model, s, fit, select, test):
     """checked() over the fit, select and test recordings at once (None stays None)."""
     groups = [list(g) if g else [] for g in (fit, select, test)]
-    done, _ = checked(model, s, [x for g in groups for x in g])
+    done = checked(model, s, [x for g in groups for x in g])
     out, k = [], 0
     for original, g in zip((fit, select, test), groups):
         out.append(done[k:k + len(g)] if original is not None else None)

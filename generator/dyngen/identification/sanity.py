@@ -3,28 +3,18 @@ that ended at its grid's edge named, and the result's prediction beside the simp
 
     lines, table, result = check(robot, model, result, fit, select, prior)
 
-Ranges (warnings, the values are kept and written):
-  - rotor inertia: its torque Ia qdd_j (RMS over the fit data) at most the measured torque's RMS
-    on its joint, and Ia at most ROTOR_RATIO times the arm's own inertia about the joint (the
-    median of M_jj over the fit data). A reflected rotor inertia may well exceed the link's own
-    inertia ten times on a wrist joint (gear ratio squared times the rotor's), so the ratio
-    alone flagged a true 0.005 kg m^2 on the LWR's joint 7; 24 x that value once came out on a
-    joint whose data could not separate it from an offset and a lag: its torque is then larger
-    than the joint's whole torque;
-  - an offset or a ripple amplitude: at most the RMS of the measured torque on its joint (a
-    constant larger than the torque it sits in is a term making up for another);
-  - the Coulomb lag and smoothing: a choice at the last value of its grid is a bound, not a
-    finding (options.LAG_GRID, SMOOTHING_GRID). The lag's grid is not widened: on the real
-    LWR4+ (fit m1, select m3) lags at its 40 ms end on joints 2-6 went to 80-160 ms when it was,
-    and joint 5 then predicted m3 worse (0.299 against 0.262 Nm): a longer lag fits the fit data
-    better without being a finding.
-The simple model (terms/simple_model.py: the prior's residual fitted per joint by b + Fc
-tanh(qd / 0.02) + Fv qd on the fit data) and the identified model are both judged on the
---select recordings, which neither fitted; a joint where the simple model predicts better is
-named, with the advice to use the simple model: the result then predicts that joint by the prior's rigid body and the
-simple model's three values (Consistent.simple, written as `simple_model:` in the YAML), as the
-diagnosis does (diagnosis/joints.py). Without --select nothing held out exists, and the table
-says so.
+Ranges (warnings, the values are kept and written): a rotor inertia whose torque Ia qdd_j (RMS
+over the fit data) exceeds the measured torque's RMS on its joint, or which is over ROTOR_RATIO
+times the arm's own inertia about the joint (median M_jj; a reflected rotor inertia may well be
+ten times a wrist link's own); an offset or ripple amplitude above the measured torque's RMS on
+its joint (a term making up for another); a Coulomb lag or smoothing at the last value of its
+grid (options.LAG_GRID, SMOOTHING_GRID: a bound, not a finding; the lag grid is not widened,
+docs/measured-data.md says why). The simple model (terms/simple_model.py, fitted to the prior's
+residual on the fit data) and the identified model are both judged on the --select recordings,
+which neither fitted; where the simple model predicts better, the result predicts that joint by
+the prior's rigid body and the simple model's three values (Consistent.simple, `simple_model:`
+in the YAML), as the diagnosis does (diagnosis/joints.py), and a warning names it. Without
+--select nothing held out exists, and the table says so.
 """
 
 from __future__ import annotations
@@ -48,12 +38,11 @@ class _Segment:  # what baseline.fit reads
     fit: np.ndarray
 
 
-def _inertia_about_joints(model, p, signals) -> np.ndarray:
-    s = model(STANDARD_FROM_DYNAMIC.name, p)
+def inertia_about_joints(model, s, signals) -> np.ndarray:
+    """Per joint the median of M_jj (standard parameters s) over about 200 of the signals' positions."""
     q = np.vstack([sig.q[sig.inner()] for sig in signals])
-    q = q[:: max(q.shape[0] // 200, 1)]
     n = q.shape[1]
-    return np.median([np.diag(model("mass_matrix", x, s).reshape(n, n)) for x in q], axis=0)
+    return np.median([np.diag(model("mass_matrix", x, s).reshape(n, n)) for x in q[:: max(q.shape[0] // 200, 1)]], axis=0)
 
 
 def ranges(robot, model, c, fit) -> list[str]:
@@ -62,7 +51,7 @@ def ranges(robot, model, c, fit) -> list[str]:
     f = c.friction
     tau = np.vstack([sig.tau[sig.inner()] for sig in fit])
     torque = np.sqrt(np.mean(tau ** 2, axis=0))
-    inertia = _inertia_about_joints(model, c.p, fit)
+    inertia = inertia_about_joints(model, model(STANDARD_FROM_DYNAMIC.name, c.p), fit)
     qdd = np.sqrt(np.mean(np.vstack([sig.qdd[sig.inner()] for sig in fit]) ** 2, axis=0))
     for j in range(n):
         ia = f["armature"][j]

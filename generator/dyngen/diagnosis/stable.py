@@ -1,0 +1,79 @@
+"""A finding is stable across the fit data, or it is not claimed: each chosen effect's values,
+fitted again (all effects together) on each of STRETCHES contiguous stretches of every fit
+recording, against the values from every fit sample. It is "unstable across blocks" where a
+stretch's values differ beyond their uncertainty (chi-square with the stretch's covariance,
+scaled for the residual's correlation, above its 1 - ALPHA quantile) and move the effect's
+torque over the stretch by more than MOVES of it (weighted norm over the stretch's samples: a
+sign change moves it by more than 1) or leave its physical range. Values a stretch does not
+determine count only through the torque they make there. The effect stays in the model; it is
+reported as record.Unstable instead of a finding (docs/measured-data.md, "A finding is stable
+across the fit data").
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.stats import chi2
+
+from .findings import identifiable
+from .forward_selection import solve
+from .refine import restricted
+
+STRETCHES = 3
+ALPHA = 1e-3
+MOVES = 0.5
+
+
+def _stretched(segments):
+    """The segments with Segment.groups as every fit recording's STRETCHES contiguous stretches of
+    fit samples (equal counts), one group per stretch over all segments."""
+    fitting = [i for i, seg in enumerate(segments) if seg.fit.any()]
+    total, out = STRETCHES * len(fitting), []
+    for i, seg in enumerate(segments):
+        groups = [np.zeros(seg.fit.size, dtype=bool) for _ in range(total)]
+        if i in fitting:
+            first = STRETCHES * fitting.index(i)
+            for b, idx in enumerate(np.array_split(np.flatnonzero(seg.fit), STRETCHES)):
+                groups[first + b][idx] = True
+        out.append(replace(seg, groups=groups))
+    return out, total
+
+
+def unstable(context, segments, design, chosen, x, tau_corr) -> dict:
+    """chosen index -> (values per stretch, each a list or None where undetermined, reason) for
+    the effects that are unstable across the stretches."""
+    if not chosen:
+        return {}
+    cut, total = _stretched(segments)
+    whole, renumbered = restricted(context, cut, replace(design, groups=[None] * total), chosen)
+    overall = identifiable(whole, renumbered)
+    fits = []
+    for m in whole.groups:
+        part = type(whole)(renumbered, m, m, m, whole.weights)
+        fits.append((solve(part, renumbered), identifiable(part, renumbered), part.H) if m.count else (None,) * 3)
+    out = {}
+    for i, c in enumerate(renumbered):
+        k = c.slots
+        values, why = [], []
+        for b, (f, ok, H) in enumerate(fits):
+            values.append(None if f is None else [float(v) if u else None for v, u in zip(f.x[k], overall[k] & ok[k])])
+            if f is None or not ok[k].any():
+                continue
+            # compared as torques: directions the stretch does not determine carry its large
+            # variance (chi-square) and little of its torque (the stretch's own normal matrix)
+            diff, H_b = f.x[k] - x[k], H[np.ix_(k, k)]
+            ev, V = np.linalg.eigh(f.covariance[np.ix_(k, k)] * tau_corr)
+            keep = ev > 1e-12 * max(ev.max(), 1e-300)
+            if np.sum((V[:, keep].T @ diff) ** 2 / ev[keep]) <= chi2.ppf(1 - ALPHA, keep.sum()):
+                continue
+            moved = np.sqrt(diff @ H_b @ diff / max(x[k] @ H_b @ x[k], 1e-300))
+            inside = c.effect.plausible(np.where(overall[k] & ok[k], f.x[k], x[k]))
+            if moved > MOVES or not inside:
+                why.append(f"stretch {b + 1}: " + ("outside its physical range" if not inside else
+                                                   f"its torque {moved:.0%} off the whole fit's"))
+        if why:
+            out[i] = (values, f"values on {STRETCHES} stretches of each fit recording fitted on their own differ from "
+                              f"the whole fit's beyond their uncertainty ({'; '.join(why)})")
+    return out
