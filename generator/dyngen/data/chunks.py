@@ -12,7 +12,6 @@ files. CSV (plain or .gz) and Parquet are read in blocks; a ROS 2 bag is read wh
 
 from __future__ import annotations
 
-import csv
 import gzip
 import io
 import warnings
@@ -23,10 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..untrusted import MAX_CSV_BYTES, regular_file
+from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
-from .recording import Recording, _check_time, _check_values, _numbers, as_recording, check_header, csv_line
+from .recording import Recording, _check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -64,8 +63,11 @@ def _csv_blocks(path, rows: int):
     regular_file(path, MAX_CSV_BYTES)
     raw = open(path, "rb")
     try:
-        binary = gzip.GzipFile(fileobj=raw) if path.suffix == ".gz" else raw
-        lines_of = io.BufferedReader(_Bounded(binary, name, MAX_CSV_BYTES))
+        packed = path.suffix == ".gz"
+        binary = gzip.GzipFile(fileobj=raw) if packed else raw
+        # the whole-file reader's bounds (untrusted._gunzip): the size, and for .gz the unpacking ratio
+        ratio = max(RATIO_FROM, MAX_RATIO * path.stat().st_size) if packed else None
+        lines_of = io.BufferedReader(_Bounded(binary, name, MAX_CSV_BYTES, ratio, path.stat().st_size))
         try:
             head = lines_of.readline()
             if b"\r" in head.removesuffix(b"\r\n"):  # old Mac line ends (CR alone): as the whole-file reader
@@ -73,7 +75,7 @@ def _csv_blocks(path, rows: int):
                 head = lines_of.readline()
             header_line = _decoded([head], name, 1, 0, "utf-8-sig")
             offset = len(head)
-            header = [h.strip() for h in next(csv.reader([header_line]), [])]
+            header = _header(name, header_line.rstrip("\r\n"))  # the whole-file reader's bounds and message
             yield header
             first, start = 2, 0
             while True:
@@ -124,8 +126,10 @@ class _Bounded(io.RawIOBase):
     """A binary stream that refuses to deliver more than `limit` bytes (a small .gz may
     unpack to gigabytes)."""
 
-    def __init__(self, inner, name, limit):
+    def __init__(self, inner, name, limit, ratio=None, packed_size=0):
+        """ratio: for a .gz, the most it may unpack to (the whole-file reader's decompression-bomb rule)."""
         self.inner, self.name, self.left = inner, name, limit
+        self.ratio, self.packed_size, self.delivered = ratio, packed_size, 0
 
     def readable(self):
         return True
@@ -135,6 +139,10 @@ class _Bounded(io.RawIOBase):
         if len(data) > self.left:
             raise InputError(self.name, "", f"file too large (at most {MAX_CSV_BYTES >> 20} MB)")
         self.left -= len(data)
+        self.delivered += len(data)
+        if self.ratio is not None and self.delivered > self.ratio:
+            raise InputError(self.name, "", f"unpacks to more than {MAX_RATIO} times its size ({self.packed_size >> 10} "
+                             f"kB to over {self.delivered >> 20} MB): a decompression bomb?")
         buffer[:len(data)] = data
         return len(data)
 
