@@ -69,9 +69,10 @@ def directions(derivation: Derivation, sym) -> list[dict]:
     return seeds + [{sym.qd[k]: sp.Integer(1)} for k in range(derivation.n)]
 
 
-def rnea_derivatives(derivation: Derivation) -> Model:
+def rnea_derivatives(derivation: Derivation, base=None) -> Model:
     program, sym, chain = start(derivation)
-    tau = joint_forces(derivation, chain, chain.forward(sym.qd, sym.qdd, derivation.robot.gravity))
+    params = derivation._grouped(program, base)
+    tau = joint_forces(derivation, chain, chain.forward(sym.qd, sym.qdd, derivation.robot.gravity), params)
     forward_mode, columns = ForwardMode(program, tau), []
     for k, seed in enumerate(directions(derivation, sym)):
         program.section = f"d tau / d {'q' if k < derivation.n else 'qd'}{k % derivation.n + 1}"
@@ -82,10 +83,10 @@ def rnea_derivatives(derivation: Derivation) -> Model:
                  "[d tau / d q | d tau / d qd], row-major", program, sym.trig)
 
 
-def forward_dynamics_derivatives(derivation: Derivation) -> Model:
-    fd = forward_dynamics_in(derivation)
+def forward_dynamics_derivatives(derivation: Derivation, base=None) -> Model:
+    fd = forward_dynamics_in(derivation, base)
     program, sym, n = fd.program, fd.symbols, derivation.n
-    tau = joint_forces(derivation, fd.chain, fd.chain.forward(sym.qd, fd.qdd, derivation.robot.gravity))
+    tau = joint_forces(derivation, fd.chain, fd.chain.forward(sym.qd, fd.qdd, derivation.robot.gravity), fd.params)
     frozen = frozenset(x if x.is_Symbol else -x for x in map(sp.sympify, fd.qdd))  # each a let (or its negative)
     assert all(x.is_Symbol for x in frozen), fd.qdd
     forward_mode, columns = ForwardMode(program, tau, frozen), []
@@ -98,10 +99,11 @@ def forward_dynamics_derivatives(derivation: Derivation) -> Model:
                  "[d qdd / d q | d qdd / d qd], row-major", program, sym.trig)
 
 
-def mass_matrix_derivative(derivation: Derivation) -> Model:
+def mass_matrix_derivative(derivation: Derivation, base=None) -> Model:
     """M_dot = sum_k dM/dq_k qd_k: one forward-mode direction (along qd) over M's composite-body
-    program (ForwardMode above), about half the operations of C + C^T (which equals it)."""
-    M = derivation.mass_matrix()
+    program (ForwardMode above), about half the operations of C + C^T (which equals it).
+    base: the inertia kind's BaseSet (M over its grouped parameters, as mass_matrix has it)."""
+    M = derivation.mass_matrix(base)
     sym = joint_symbols(derivation.robot)
     trig = {(joint, fn): s for s, (joint, fn) in M.trig.items()}
     seed = {}
