@@ -56,6 +56,32 @@ class ForwardMode:
         return self._partials[key]
 
 
+class ReverseMode:
+    """Gradients of single outputs of a program with respect to its inputs, as new lets: one
+    sweep per output, last assignment first, each assignment x = f(y_1..y_m) adding
+    (df/dy_k) adj(x) to adj(y_k); the partials are shared by every sweep (ForwardMode's)."""
+
+    def __init__(self, program: Program, outputs, frozen=frozenset()):
+        self.forward = ForwardMode(program, outputs, frozen)
+        self.program, self.frozen = program, frozen
+
+    def gradient(self, output, inputs) -> list:
+        """d output / d y for every y of inputs (symbols); zero where output does not depend on y."""
+        terms = {}
+        output = sp.sympify(output)
+        for f in output.free_symbols - self.frozen:
+            terms[f] = [sp.diff(output, f)]
+        for a in reversed(self.forward.assignments):
+            if a.symbol not in terms:
+                continue
+            adjoint = self.program.let(sp.Add(*terms.pop(a.symbol)))
+            if adjoint == 0:
+                continue
+            for f in sorted(a.expr.free_symbols - self.frozen, key=lambda f: f.name):
+                terms.setdefault(f, []).append(self.forward._partial(a, f) * adjoint)
+        return [self.program.let(sp.Add(*terms.get(y, []))) for y in inputs]
+
+
 def directions(derivation: Derivation, sym) -> list[dict]:
     """Seeds of the 2N directions q_1..q_N, qd_1..qd_N."""
     trig = {(joint, fn): s for s, (joint, fn) in sym.trig.items()}
@@ -69,17 +95,30 @@ def directions(derivation: Derivation, sym) -> list[dict]:
     return seeds + [{sym.qd[k]: sp.Integer(1)} for k in range(derivation.n)]
 
 
+def gradient_rows(program: Program, derivation: Derivation, sym, tau, frozen=frozenset()) -> list:
+    """[d tau_i / d q | d tau_i / d qd] for every i, by reverse mode (one sweep per joint)."""
+    reverse, rows = ReverseMode(program, tau, frozen), []
+    trig = {(joint, fn): s for s, (joint, fn) in sym.trig.items()}
+    joints = derivation.robot.joint_models
+    angles = [(trig[(k, "sin")], trig[(k, "cos")]) if j.revolute else (sym.q[k],) for k, j in enumerate(joints)]
+    for i, t in enumerate(tau):
+        program.section = f"row {i + 1}: d tau{i + 1} / d (q, qd)"
+        g = dict(zip([x for a in angles for x in a] + list(sym.qd),
+                     reverse.gradient(t, [x for a in angles for x in a] + list(sym.qd))))
+        # d/dq_k = d/ds_k c_k - d/dc_k s_k (revolute)
+        dq = [program.let(g[a[0]] * a[1] - g[a[1]] * a[0]) if len(a) == 2 else g[a[0]] for a in angles]
+        rows.append(dq + [g[x] for x in sym.qd])
+    return rows
+
+
 def rnea_derivatives(derivation: Derivation, base=None) -> Model:
     program, sym, chain = start(derivation)
     params = derivation._grouped(program, base)
     tau = joint_forces(derivation, chain, chain.forward(sym.qd, sym.qdd, derivation.robot.gravity), params)
-    forward_mode, columns = ForwardMode(program, tau), []
-    for k, seed in enumerate(directions(derivation, sym)):
-        program.section = f"d tau / d {'q' if k < derivation.n else 'qd'}{k % derivation.n + 1}"
-        columns.append(forward_mode.tangents(seed))
+    rows = gradient_rows(program, derivation, sym, tau)
     n = derivation.n
     return Model("rnea_derivatives", model_inputs(derivation, sym, qd=True, qdd=True, gravity=True),
-                 [columns[k][i] for i in range(n) for k in range(2 * n)], (n, 2 * n),
+                 [x for row in rows for x in row], (n, 2 * n),
                  "[d tau / d q | d tau / d qd], row-major", program, sym.trig)
 
 
@@ -89,11 +128,10 @@ def forward_dynamics_derivatives(derivation: Derivation, base=None) -> Model:
     tau = joint_forces(derivation, fd.chain, fd.chain.forward(sym.qd, fd.qdd, derivation.robot.gravity), fd.params)
     frozen = frozenset(x if x.is_Symbol else -x for x in map(sp.sympify, fd.qdd))  # each a let (or its negative)
     assert all(x.is_Symbol for x in frozen), fd.qdd
-    forward_mode, columns = ForwardMode(program, tau, frozen), []
-    for k, seed in enumerate(directions(derivation, sym)):
+    rows, columns = gradient_rows(program, derivation, sym, tau, frozen), []
+    for k in range(2 * n):
         program.section = f"d qdd / d {'q' if k < n else 'qd'}{k % n + 1} = -M^-1 d tau / d ..."
-        partial = forward_mode.tangents(seed)
-        columns.append(solve(program, fd.factors, [-x for x in partial]))
+        columns.append(solve(program, fd.factors, [-row[k] for row in rows]))
     return Model("forward_dynamics_derivatives", model_inputs(derivation, sym, qd=True, gravity=True, tau=fd.tau),
                  [columns[k][i] for i in range(n) for k in range(2 * n)], (n, 2 * n),
                  "[d qdd / d q | d qdd / d qd], row-major", program, sym.trig)
