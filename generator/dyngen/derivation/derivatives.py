@@ -59,26 +59,45 @@ class ForwardMode:
 class ReverseMode:
     """Gradients of single outputs of a program with respect to its inputs, as new lets: one
     sweep per output, last assignment first, each assignment x = f(y_1..y_m) adding
-    (df/dy_k) adj(x) to adj(y_k); the partials are shared by every sweep (ForwardMode's)."""
+    (df/dy_k) adj(x) to adj(y_k); the partials are shared by every sweep.
 
-    def __init__(self, program: Program, outputs, frozen=frozenset()):
+    angles: sine or cosine symbol -> (angle symbol, its derivative along the angle): an
+    assignment's partial along a joint angle, (df/ds) c - (df/dc) s, is one shared let (often
+    the rotation's other component), so a sweep pays one product for it instead of two."""
+
+    def __init__(self, program: Program, outputs, frozen=frozenset(), angles=None):
         self.forward = ForwardMode(program, outputs, frozen)
-        self.program, self.frozen = program, frozen
+        self.program, self.frozen, self.angles = program, frozen, angles or {}
+        self._partials = {}
+
+    def _inputs(self, a):
+        """(input symbol, partial of a.expr along it), angles merged."""
+        moved = {}
+        for f in sorted(a.expr.free_symbols - self.frozen, key=lambda f: f.name):
+            if f in self.angles:
+                angle, derivative = self.angles[f]
+                moved.setdefault(angle, []).append(sp.diff(a.expr, f) * derivative)
+            else:
+                moved[f] = None
+        for f, parts in moved.items():
+            if (a.symbol, f) not in self._partials:
+                self._partials[(a.symbol, f)] = (self.forward._partial(a, f) if parts is None
+                                                 else self.program.let(sp.expand(sp.Add(*parts))))
+            yield f, self._partials[(a.symbol, f)]
 
     def gradient(self, output, inputs) -> list:
-        """d output / d y for every y of inputs (symbols); zero where output does not depend on y."""
-        terms = {}
+        """d output / d y for every y of inputs (symbols, or angles); zero where output does not depend on y."""
         output = sp.sympify(output)
-        for f in output.free_symbols - self.frozen:
-            terms[f] = [sp.diff(output, f)]
+        assert not output.free_symbols & set(self.angles), output  # an output is a let (or an input)
+        terms = {f: [sp.diff(output, f)] for f in output.free_symbols - self.frozen}
         for a in reversed(self.forward.assignments):
             if a.symbol not in terms:
                 continue
             adjoint = self.program.let(sp.Add(*terms.pop(a.symbol)))
             if adjoint == 0:
                 continue
-            for f in sorted(a.expr.free_symbols - self.frozen, key=lambda f: f.name):
-                terms.setdefault(f, []).append(self.forward._partial(a, f) * adjoint)
+            for f, partial in self._inputs(a):
+                terms.setdefault(f, []).append(partial * adjoint)
         return [self.program.let(sp.Add(*terms.get(y, []))) for y in inputs]
 
 
@@ -97,17 +116,16 @@ def directions(derivation: Derivation, sym) -> list[dict]:
 
 def gradient_rows(program: Program, derivation: Derivation, sym, tau, frozen=frozenset()) -> list:
     """[d tau_i / d q | d tau_i / d qd] for every i, by reverse mode (one sweep per joint)."""
-    reverse, rows = ReverseMode(program, tau, frozen), []
     trig = {(joint, fn): s for s, (joint, fn) in sym.trig.items()}
-    joints = derivation.robot.joint_models
-    angles = [(trig[(k, "sin")], trig[(k, "cos")]) if j.revolute else (sym.q[k],) for k, j in enumerate(joints)]
+    angles = {}
+    for k, joint in enumerate(derivation.robot.joint_models):
+        if joint.revolute:
+            s, c = trig[(k, "sin")], trig[(k, "cos")]
+            angles.update({s: (sym.q[k], c), c: (sym.q[k], -s)})
+    reverse, rows = ReverseMode(program, tau, frozen, angles), []
     for i, t in enumerate(tau):
         program.section = f"row {i + 1}: d tau{i + 1} / d (q, qd)"
-        g = dict(zip([x for a in angles for x in a] + list(sym.qd),
-                     reverse.gradient(t, [x for a in angles for x in a] + list(sym.qd))))
-        # d/dq_k = d/ds_k c_k - d/dc_k s_k (revolute)
-        dq = [program.let(g[a[0]] * a[1] - g[a[1]] * a[0]) if len(a) == 2 else g[a[0]] for a in angles]
-        rows.append(dq + [g[x] for x in sym.qd])
+        rows.append(reverse.gradient(t, list(sym.q) + list(sym.qd)))
     return rows
 
 
