@@ -1,15 +1,19 @@
-"""Analytic derivatives of inverse and forward dynamics, by forward mode over the program's lets.
+"""Analytic derivatives of inverse and forward dynamics, by reverse mode over the program's lets.
 
-Every assignment x = f(y_1, ..., y_m) of a program is a small polynomial in earlier variables,
-so its tangent along one input direction is dx = sum_k (df/dy_k) dy_k over the y_k whose
-tangent is not zero, itself a new let: the derivative program has the same shape (and the
-same common subexpressions) as the program it differentiates, with no expanded expression
-ever formed. The direction q_k seeds ds_k = c_k, dc_k = -s_k (revolute) or dq_k = 1
-(prismatic); qd_k seeds dqd_k = 1.
+Every assignment x = f(y_1, ..., y_m) of a program is a small polynomial in earlier variables.
+Reverse mode (ReverseMode) sweeps the assignments one output depends on, last first, adding
+(df/dy_k) adj(x) to adj(y_k): one sweep per joint torque tau_i gives the whole row
+[d tau_i / d q | d tau_i / d qd], N sweeps where forward mode (ForwardMode: one sweep per input
+direction, dx = sum_k (df/dy_k) dy_k) needs 2N. Both add lets to the same program (its common
+subexpressions carry over, no expanded expression is ever formed), and the partials df/dy_k are
+lets shared by every sweep. A joint angle's sine and cosine are merged into the angle: an
+assignment's partial along q_k is (df/ds_k) c_k - (df/dc_k) s_k, one let.
 
 Inverse dynamics:  D = [d tau / d q | d tau / d qd]  (N x 2N) of rnea at (q, qd, qdd).
 Forward dynamics:  d qdd / d(q, qd) = -M^-1 D at qdd = FD(q, qd, tau), with D taken with qdd
 held fixed (its lets frozen) and M^-1 applied through the L D L^T factors FD already has.
+Both read the grouped parameters (Derivation._grouped) when given the full kind's BaseSet.
+M_dot (mass_matrix_derivative) is one forward-mode direction along qd.
 """
 
 from __future__ import annotations
@@ -23,20 +27,26 @@ from .newton_euler import joint_symbols
 from .program import Program
 
 
+def reached(program: Program, outputs, frozen=frozenset()) -> list:
+    """The assignments the outputs need, in order, those of the frozen symbols (held constant)
+    and what only they need left out; taken before any derivative is added to the program."""
+    needed = set().union(*(sp.sympify(o).free_symbols for o in outputs))
+    kept = []
+    for a in reversed(program.assignments):
+        if a.symbol in needed and a.symbol not in frozen:
+            kept.append(a)
+            needed |= a.expr.free_symbols
+    return kept[::-1]
+
+
 class ForwardMode:
     """Tangents of some outputs of a program along input directions, as new lets of the same
     program; the partial derivatives of an assignment are shared by every direction."""
 
     def __init__(self, program: Program, outputs, frozen=frozenset()):
-        """frozen: symbols held constant (tangent zero); what only they need is not visited."""
-        self.program, self.outputs, self.frozen = program, list(outputs), frozen
-        needed = set().union(*(sp.sympify(o).free_symbols for o in self.outputs))
-        kept = []
-        for a in reversed(program.assignments):  # before any tangent is added
-            if a.symbol in needed and a.symbol not in frozen:
-                kept.append(a)
-                needed |= a.expr.free_symbols
-        self.assignments = kept[::-1]
+        """frozen: symbols held constant (tangent zero)."""
+        self.program, self.outputs = program, list(outputs)
+        self.assignments = reached(program, self.outputs, frozen)
         self._partials = {}
 
     def tangents(self, seed: dict) -> list:
@@ -66,23 +76,20 @@ class ReverseMode:
     the rotation's other component), so a sweep pays one product for it instead of two."""
 
     def __init__(self, program: Program, outputs, frozen=frozenset(), angles=None):
-        self.forward = ForwardMode(program, outputs, frozen)
         self.program, self.frozen, self.angles = program, frozen, angles or {}
+        self.assignments = reached(program, outputs, frozen)
         self._partials = {}
 
     def _inputs(self, a):
-        """(input symbol, partial of a.expr along it), angles merged."""
+        """(input symbol or angle, the partial of a.expr along it, a let)."""
         moved = {}
         for f in sorted(a.expr.free_symbols - self.frozen, key=lambda f: f.name):
-            if f in self.angles:
-                angle, derivative = self.angles[f]
-                moved.setdefault(angle, []).append(sp.diff(a.expr, f) * derivative)
-            else:
-                moved[f] = None
+            angle, derivative = self.angles.get(f, (f, 1))
+            moved.setdefault(angle, []).append(sp.diff(a.expr, f) * derivative)
         for f, parts in moved.items():
             if (a.symbol, f) not in self._partials:
-                self._partials[(a.symbol, f)] = (self.forward._partial(a, f) if parts is None
-                                                 else self.program.let(sp.expand(sp.Add(*parts))))
+                merged = len(parts) > 1 or f not in a.expr.free_symbols  # along an angle
+                self._partials[(a.symbol, f)] = self.program.let(sp.expand(sp.Add(*parts)) if merged else parts[0])
             yield f, self._partials[(a.symbol, f)]
 
     def gradient(self, output, inputs) -> list:
@@ -90,7 +97,7 @@ class ReverseMode:
         output = sp.sympify(output)
         assert not output.free_symbols & set(self.angles), output  # an output is a let (or an input)
         terms = {f: [sp.diff(output, f)] for f in output.free_symbols - self.frozen}
-        for a in reversed(self.forward.assignments):
+        for a in reversed(self.assignments):
             if a.symbol not in terms:
                 continue
             adjoint = self.program.let(sp.Add(*terms.pop(a.symbol)))
@@ -99,19 +106,6 @@ class ReverseMode:
             for f, partial in self._inputs(a):
                 terms.setdefault(f, []).append(partial * adjoint)
         return [self.program.let(sp.Add(*terms.get(y, []))) for y in inputs]
-
-
-def directions(derivation: Derivation, sym) -> list[dict]:
-    """Seeds of the 2N directions q_1..q_N, qd_1..qd_N."""
-    trig = {(joint, fn): s for s, (joint, fn) in sym.trig.items()}
-    seeds = []
-    for k, joint in enumerate(derivation.robot.joint_models):
-        if joint.revolute:
-            s, c = trig[(k, "sin")], trig[(k, "cos")]
-            seeds.append({s: c, c: -s})
-        else:
-            seeds.append({sym.q[k]: sp.Integer(1)})
-    return seeds + [{sym.qd[k]: sp.Integer(1)} for k in range(derivation.n)]
 
 
 def gradient_rows(program: Program, derivation: Derivation, sym, tau, frozen=frozenset()) -> list:

@@ -1,6 +1,6 @@
 """Forward dynamics qdd = M(q)^-1 (tau - b(q, qd)) as straight-line code, two ways: the
-articulated-body algorithm (articulated_body.py) and, here, M by unit
-accelerations, the bias b = rnea(q, qd, 0) (gravity included) and a square-root-free
+articulated-body algorithm (articulated_body.py) and, here, M by composite bodies
+(composite.py), the bias b = rnea(q, qd, 0) (gravity included) and a square-root-free
 Cholesky factorisation M = L D L^T (a serial chain's M is dense: no sparsity to use beyond
 its symmetry), all in one program so that the sines, cosines and rotations are shared.
 The emitted forward_dynamics is the one with fewer operations for the arm; the derivatives of
@@ -54,17 +54,6 @@ def solve(program: Program, f: LDLT, b) -> list:
     return x
 
 
-def mass_matrix_in(derivation: Derivation, chain, params=None) -> sp.Matrix:
-    """M(q) in the chain's program, column k from a unit acceleration of joint k."""
-    n = derivation.n
-    M = sp.zeros(n, n)
-    for k in range(n):
-        column = joint_forces(derivation, chain, chain.forward([0] * n, [int(j == k) for j in range(n)], [0, 0, 0]), params)
-        for j in range(k + 1):
-            M[j, k] = M[k, j] = column[j]
-    return M
-
-
 @dataclass
 class ForwardDynamics:
     """The pieces the derivatives of forward dynamics reuse."""
@@ -85,7 +74,7 @@ def forward_dynamics_in(derivation: Derivation, base=None) -> ForwardDynamics:
     n = derivation.n
     tau = [sp.Symbol(f"tau{i + 1}", real=True) for i in range(n)]
     params = derivation._grouped(program, base)
-    M = mass_matrix_columns(chain, params)  # composite bodies: a third of mass_matrix_in's products
+    M = mass_matrix_columns(chain, params)  # composite bodies: 245 products on the LWR, 642 from unit accelerations
     bias = joint_forces(derivation, chain, chain.forward(sym.qd, [0] * n, derivation.robot.gravity), params)
     factors = factor(program, M)
     program.section = "qdd = M^-1 (tau - b)"
