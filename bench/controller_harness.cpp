@@ -5,7 +5,8 @@
 // wrappers cas_<fn>(inputs..., params, out) and casb_<fn>(inputs..., out).
 //
 //   harness verify    MODEL STATES                     VERIFY <function> <dyngen> <casadi> <casadi baked>
-//                                                      (max relative error of each against Pinocchio)
+//                                                      (max relative error of each against Pinocchio;
+//                                                      normwise for FD and its derivatives: verify_one)
 //   harness time      MODEL STATES BATCHES              TIME <function> <dyngen> <pinocchio> <casadi> <casadi baked> (ns)
 //   harness callgrind MODEL STATES FUNCTION SIDE CALLS  SIDE: dyngen pinocchio casadi casadi_baked
 //                                                      (CALLS = 0: the baseline run)
