@@ -8,7 +8,8 @@ by casadi.solve, the derivatives by casadi.jacobian; parameters as input and bak
 ONE executable (generated C + CasADi's C, one file per function compiled once into a private
 cache by bench/casadi_objects.py, + bench/controller_harness.cpp + bench/pinocchio_side.cpp
 + bench/pinocchio_controller.cpp, header-only Pinocchio, the same compiler and flags), check
-that every side agrees with Pinocchio on every state (relative 1e-9), then count instructions
+that every side agrees with Pinocchio on every state (relative 1e-9; normwise for FD and its
+derivatives, controller_harness.cpp says why), then count instructions
 per call with valgrind (CALLS calls minus a 0-call run, / CALLS) and, with --time, the median
 ns/call over interleaved batches:
 

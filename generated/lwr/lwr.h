@@ -41,12 +41,12 @@
  *   lwr_jacobian_dot_qd          149 mul, 93 add, 0 div, 6 sin/cos
  *   lwr_control                  586 mul, 511 add, 0 div, 6 sin/cos
  *   lwr_control_with_jacobian    757 mul, 626 add, 0 div, 7 sin/cos
- *   lwr_coriolis_matrix          1467 mul, 1401 add, 0 div, 6 sin/cos
- *   lwr_mass_matrix_derivative   670 mul, 436 add, 0 div, 6 sin/cos
+ *   lwr_coriolis_matrix          1304 mul, 1161 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix_derivative   664 mul, 440 add, 0 div, 6 sin/cos
  *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 6 sin/cos
- *   lwr_forward_dynamics         1003 mul, 803 add, 7 div, 6 sin/cos
- *   lwr_rnea_derivatives         2955 mul, 2931 add, 0 div, 6 sin/cos
- *   lwr_forward_dynamics_derivatives 4715 mul, 4463 add, 7 div, 6 sin/cos
+ *   lwr_forward_dynamics         654 mul, 583 add, 7 div, 6 sin/cos
+ *   lwr_rnea_derivatives         2161 mul, 1845 add, 0 div, 6 sin/cos
+ *   lwr_forward_dynamics_derivatives 3365 mul, 2901 add, 7 div, 6 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -309,7 +309,7 @@ void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_
  *   qd       [7]  joint velocities
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   C        [7 x 7]  row-major (written)
- * 1467 mul, 1401 add, 0 div, 6 sin/cos
+ * 1304 mul, 1161 add, 0 div, 6 sin/cos
  */
 void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *C);
 
@@ -318,7 +318,7 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
  *   qd       [7]  joint velocities
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   Mdot     [7 x 7]  row-major, symmetric (written)
- * 670 mul, 436 add, 0 div, 6 sin/cos
+ * 664 mul, 440 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *Mdot);
 
@@ -338,7 +338,7 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
  *   tau      [7]  joint torques/forces
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   qdd      [7]  joint accelerations (written)
- * 1003 mul, 803 add, 7 div, 6 sin/cos
+ * 654 mul, 583 add, 7 div, 6 sin/cos
  */
 void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd);
 
@@ -348,7 +348,7 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
  *   qdd      [7]  joint accelerations
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [7 x 14]  row-major, [d tau / d q | d tau / d qd] (written)
- * 2955 mul, 2931 add, 0 div, 6 sin/cos
+ * 2161 mul, 1845 add, 0 div, 6 sin/cos
  */
 void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *D);
 
@@ -358,7 +358,7 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
  *   tau      [7]  joint torques/forces
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [7 x 14]  row-major, [d qdd / d q | d qdd / d qd] (written)
- * 4715 mul, 4463 add, 7 div, 6 sin/cos
+ * 3365 mul, 2901 add, 7 div, 6 sin/cos
  */
 void lwr_forward_dynamics_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *D);
 

@@ -41,12 +41,12 @@
  *   stanford_jacobian_dot_qd     128 mul, 85 add, 0 div, 4 sin/cos
  *   stanford_control             416 mul, 370 add, 0 div, 4 sin/cos
  *   stanford_control_with_jacobian 566 mul, 485 add, 0 div, 5 sin/cos
- *   stanford_coriolis_matrix     878 mul, 793 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix_derivative 397 mul, 263 add, 0 div, 4 sin/cos
+ *   stanford_coriolis_matrix     752 mul, 648 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix_derivative 388 mul, 259 add, 0 div, 4 sin/cos
  *   stanford_regressor_slotine_li 456 mul, 290 add, 0 div, 4 sin/cos
- *   stanford_forward_dynamics    822 mul, 675 add, 6 div, 4 sin/cos
- *   stanford_rnea_derivatives    1795 mul, 1731 add, 0 div, 4 sin/cos
- *   stanford_forward_dynamics_derivatives 2936 mul, 2726 add, 6 div, 4 sin/cos
+ *   stanford_forward_dynamics    459 mul, 416 add, 6 div, 4 sin/cos
+ *   stanford_rnea_derivatives    1253 mul, 1123 add, 0 div, 4 sin/cos
+ *   stanford_forward_dynamics_derivatives 2048 mul, 1815 add, 6 div, 4 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -309,7 +309,7 @@ void stanford_control_with_jacobian(const stanford_real *q, const stanford_real 
  *   qd       [6]  joint velocities
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   C        [6 x 6]  row-major (written)
- * 878 mul, 793 add, 0 div, 4 sin/cos
+ * 752 mul, 648 add, 0 div, 4 sin/cos
  */
 void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *C);
 
@@ -318,7 +318,7 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
  *   qd       [6]  joint velocities
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   Mdot     [6 x 6]  row-major, symmetric (written)
- * 397 mul, 263 add, 0 div, 4 sin/cos
+ * 388 mul, 259 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot);
 
@@ -338,7 +338,7 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
  *   tau      [6]  joint torques/forces
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   qdd      [6]  joint accelerations (written)
- * 822 mul, 675 add, 6 div, 4 sin/cos
+ * 459 mul, 416 add, 6 div, 4 sin/cos
  */
 void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd);
 
@@ -348,7 +348,7 @@ void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, 
  *   qdd      [6]  joint accelerations
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [6 x 12]  row-major, [d tau / d q | d tau / d qd] (written)
- * 1795 mul, 1731 add, 0 div, 4 sin/cos
+ * 1253 mul, 1123 add, 0 div, 4 sin/cos
  */
 void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *D);
 
@@ -358,7 +358,7 @@ void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, 
  *   tau      [6]  joint torques/forces
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [6 x 12]  row-major, [d qdd / d q | d qdd / d qd] (written)
- * 2936 mul, 2726 add, 6 div, 4 sin/cos
+ * 2048 mul, 1815 add, 6 div, 4 sin/cos
  */
 void stanford_forward_dynamics_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *D);
 

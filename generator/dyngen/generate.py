@@ -78,7 +78,7 @@ def _build(robot: Robot, progress: Progress) -> tuple[dict, Emitted]:
                   "unit_accelerations": derivation.unit_accelerations(), **KinematicsModels(robot).all(),
                   "control": control_model(robot, bases),
                   "control_with_jacobian": control_model(robot, bases, with_jacobian=True),
-                  **controller_models(derivation, operations)}
+                  **controller_models(derivation, operations, bases)}
     with progress.step("emit C"):
         emitted = emit(robot, derivation, regressors, bases, models)
     return bases, emitted

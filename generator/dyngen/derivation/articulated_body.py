@@ -94,9 +94,11 @@ def dot(a, b):
     return sp.Add(*(x * y for x, y in zip(a, b)))
 
 
-def articulated_body(derivation: Derivation) -> Model:
+def articulated_body(derivation: Derivation, base=None) -> Model:
+    """base: the full kind's BaseSet, to read the grouped parameters (Derivation._grouped)."""
     program, sym, chain = start(derivation)
     n, lets = derivation.n, program.let_vector
+    params = derivation._grouped(program, base)
     tau = [sp.Symbol(f"tau{i + 1}", real=True) for i in range(n)]
     geo = chain.geometry
     R = [_mat_let(program, g.R) for g in geo]
@@ -123,7 +125,7 @@ def articulated_body(derivation: Derivation) -> Model:
         jw, jv = scale(sym.qd[i], S[i][0]), scale(sym.qd[i], S[i][1])
         w, v = lets(add(w, jw)), lets(add(v, jv))
         bias_acc.append(tuple(lets(x) for x in motion_cross(w, v, jw, jv)))
-        I = link_inertia(derivation.s[PER_LINK * i: PER_LINK * (i + 1)])
+        I = link_inertia(params[PER_LINK * i: PER_LINK * (i + 1)])
         inertia.append(I)
         bias.append(tuple(lets(x) for x in force_cross(w, v, *(lets(x) for x in I.times(w, v)))))
     # pass 2: articulated inertias, tip to base

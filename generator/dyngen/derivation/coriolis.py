@@ -62,31 +62,34 @@ def start(derivation: Derivation):
     return program, sym, Chain(derivation.robot, program, sym)
 
 
-def joint_forces(derivation: Derivation, chain: Chain, motions) -> list:
-    """Joint forces of the link motions with the standard parameters s as symbols."""
+def joint_forces(derivation: Derivation, chain: Chain, motions, params=None) -> list:
+    """Joint forces of the link motions with the standard parameters s as symbols (or params,
+    expressions of them: the grouped parameters of Derivation._grouped)."""
+    params = derivation.s if params is None else params
     wrenches = []
     for i, motion in enumerate(motions):
         chain.program.section = f"link {i + 1}: link wrench"
-        wrenches.append(link_wrench(chain.program, motion, derivation.s[PER_LINK * i: PER_LINK * (i + 1)]))
+        wrenches.append(link_wrench(chain.program, motion, params[PER_LINK * i: PER_LINK * (i + 1)]))
     return chain.backward(wrenches)
 
 
-def coriolis_columns(derivation: Derivation, chain: Chain, qd) -> sp.Matrix:
+def coriolis_columns(derivation: Derivation, chain: Chain, qd, params=None) -> sp.Matrix:
     """C(q, qd) in the chain's program, column j = B(qd, e_j)."""
     n = derivation.n
     half = chain.program.let_vector([HALF * x for x in qd])
     C = sp.zeros(n, n)
     for j in range(n):
         unit = [int(k == j) for k in range(n)]
-        column = joint_forces(derivation, chain, bilinear_forward(chain, half, unit, [0] * n, [0, 0, 0]))
+        column = joint_forces(derivation, chain, bilinear_forward(chain, half, unit, [0] * n, [0, 0, 0]), params)
         for i in range(n):
             C[i, j] = column[i]
     return C
 
 
-def coriolis_matrix(derivation: Derivation) -> Model:
+def coriolis_matrix(derivation: Derivation, base=None) -> Model:
+    """base: the inertia kind's BaseSet (C is M's Christoffel symbols; they keep M, Derivation.mass_matrix)."""
     program, sym, chain = start(derivation)
-    C = coriolis_columns(derivation, chain, sym.qd)
+    C = coriolis_columns(derivation, chain, sym.qd, derivation._grouped(program, base))
     return Model("coriolis_matrix", model_inputs(derivation, sym, qd=True), list(C),
                  (derivation.n, derivation.n), "Christoffel Coriolis matrix C(q, qd), row-major", program, sym.trig)
 

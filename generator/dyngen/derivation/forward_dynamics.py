@@ -1,6 +1,6 @@
 """Forward dynamics qdd = M(q)^-1 (tau - b(q, qd)) as straight-line code, two ways: the
-articulated-body algorithm (articulated_body.py) and, here, M by unit
-accelerations, the bias b = rnea(q, qd, 0) (gravity included) and a square-root-free
+articulated-body algorithm (articulated_body.py) and, here, M by composite bodies
+(composite.py), the bias b = rnea(q, qd, 0) (gravity included) and a square-root-free
 Cholesky factorisation M = L D L^T (a serial chain's M is dense: no sparsity to use beyond
 its symmetry), all in one program so that the sines, cosines and rotations are shared.
 The emitted forward_dynamics is the one with fewer operations for the arm; the derivatives of
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .articulated_body import articulated_body
+from .composite import mass_matrix_columns
 from .coriolis import joint_forces, model_inputs, start
 from .models import Derivation, Model
 from .program import Program
@@ -53,17 +54,6 @@ def solve(program: Program, f: LDLT, b) -> list:
     return x
 
 
-def mass_matrix_in(derivation: Derivation, chain) -> sp.Matrix:
-    """M(q) in the chain's program, column k from a unit acceleration of joint k."""
-    n = derivation.n
-    M = sp.zeros(n, n)
-    for k in range(n):
-        column = joint_forces(derivation, chain, chain.forward([0] * n, [int(j == k) for j in range(n)], [0, 0, 0]))
-        for j in range(k + 1):
-            M[j, k] = M[k, j] = column[j]
-    return M
-
-
 @dataclass
 class ForwardDynamics:
     """The pieces the derivatives of forward dynamics reuse."""
@@ -74,33 +64,37 @@ class ForwardDynamics:
     tau: list
     factors: LDLT
     qdd: list
+    params: list  # the parameters the recursion read (s, or grouped)
 
 
-def forward_dynamics_in(derivation: Derivation) -> ForwardDynamics:
+def forward_dynamics_in(derivation: Derivation, base=None) -> ForwardDynamics:
+    """base: the full kind's BaseSet, to run the recursion over the grouped parameters
+    (Derivation._grouped: Y s = Y s* for every q, qd, qdd, so M and b are unchanged)."""
     program, sym, chain = start(derivation)
     n = derivation.n
     tau = [sp.Symbol(f"tau{i + 1}", real=True) for i in range(n)]
-    M = mass_matrix_in(derivation, chain)
-    bias = joint_forces(derivation, chain, chain.forward(sym.qd, [0] * n, derivation.robot.gravity))
+    params = derivation._grouped(program, base)
+    M = mass_matrix_columns(chain, params)  # composite bodies: 245 products on the LWR, 642 from unit accelerations
+    bias = joint_forces(derivation, chain, chain.forward(sym.qd, [0] * n, derivation.robot.gravity), params)
     factors = factor(program, M)
     program.section = "qdd = M^-1 (tau - b)"
     qdd = solve(program, factors, [program.let(t - b) for t, b in zip(tau, bias)])
-    return ForwardDynamics(program, sym, chain, tau, factors, qdd)
+    return ForwardDynamics(program, sym, chain, tau, factors, qdd, params)
 
 
-def ldlt_forward_dynamics(derivation: Derivation) -> Model:
-    fd = forward_dynamics_in(derivation)
+def ldlt_forward_dynamics(derivation: Derivation, base=None) -> Model:
+    fd = forward_dynamics_in(derivation, base)
     return Model("forward_dynamics", model_inputs(derivation, fd.symbols, qd=True, gravity=True, tau=fd.tau), fd.qdd, (derivation.n,),
                  "forward dynamics qdd = M^-1 (tau - c - g), L D L^T", fd.program, fd.symbols.trig)
 
 
-def candidates(derivation: Derivation) -> dict:
-    """Both derivations of forward dynamics, by method name."""
-    return {"ldlt": ldlt_forward_dynamics(derivation), "articulated_body": articulated_body(derivation)}
+def candidates(derivation: Derivation, base=None) -> dict:
+    """Both derivations of forward dynamics, by method name (base: the full kind's BaseSet)."""
+    return {"ldlt": ldlt_forward_dynamics(derivation, base), "articulated_body": articulated_body(derivation, base)}
 
 
-def forward_dynamics(derivation: Derivation, operations) -> Model:
+def forward_dynamics(derivation: Derivation, operations, base=None) -> Model:
     """The candidate with fewer operations (operations: model -> its count, the emitter's), the
     L D L^T on a tie: a fixed function of the arm."""
-    models = candidates(derivation)
+    models = candidates(derivation, base)
     return min(models.values(), key=lambda m: (operations(m), m is not models["ldlt"]))
