@@ -150,6 +150,39 @@ def test_one_tilt_for_identify_and_diagnose():
     assert np.linalg.norm(turned) == pytest.approx(np.linalg.norm(g), rel=1e-12)
 
 
+def test_one_tilt_angle_against_a_turned_gravity():
+    """The one tilt-angle formula (terms.tilt.angle_deg, angles_deg) against a base turned by a
+    known rotation (Rodrigues, written here): gravity in the turned base frame R^T g gives the
+    components a across it, and the angle must be the rotation's, split along the directions it
+    turns gravity towards (u1 = base +x, u2 = base -y for gravity along -z). The diagnosis's
+    derived angles and its range check use the same formula."""
+    from dyngen.terms import Tilt, tilt
+
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    g = np.array([0.0, 0.0, -9.81])
+    n, u = g / 9.81, np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    rng = np.random.default_rng(21)
+    for degrees in (0.5, 3.0, 9.0, 25.0):
+        phi = rng.uniform(0, 2 * np.pi)
+        k = np.array([np.cos(phi), np.sin(phi), 0.0])  # a horizontal axis
+        K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        th = np.radians(degrees)
+        R = np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K
+        turned = R.T @ g
+        a = u @ turned
+        # the rotation taking g to `turned`: about g x turned by the angle between them
+        omega = np.degrees(np.arccos(turned @ g / (g @ g))) * np.cross(g, turned) / np.linalg.norm(np.cross(g, turned))
+        # turning gravity towards u_k is a rotation about n x u_k
+        expected = [omega @ np.cross(n, u[0]), omega @ np.cross(n, u[1])]
+        assert tilt.angle_deg(g, a) == pytest.approx(degrees, rel=1e-9)
+        assert tilt.angles_deg(g, a) == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        term = Tilt(9.81, (u[0], u[1]))
+        derived = term.derived(robot, {"dg1": a[0], "dg2": a[1]}, {"dg1": 0.0, "dg2": 0.0}, None)
+        assert derived["tilt_deg"] == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        assert derived["tilt_total_deg"] == pytest.approx(degrees, rel=1e-9)
+        assert Tilt.inside(a, {"g": 9.81}) == (degrees < tilt.MAX_TILT_DEG)
+
+
 def test_excitation_matrix_is_what_identify_fits(model):
     """The excitation's information matrix times [pi_full(p), per joint Fc, Fv, b and Ia where
     the rigid body does not carry it] is Pinocchio's rnea plus the friction, offset and rotor
