@@ -183,6 +183,38 @@ def test_one_tilt_angle_against_a_turned_gravity():
         assert Tilt.inside(a, {"g": 9.81}) == (degrees < tilt.MAX_TILT_DEG)
 
 
+def test_one_consistency_check_against_the_pseudo_inertia():
+    """The one physical-consistency check of link parameters (parameters.consistency_margin):
+    the diagnosis's payload (terms.body.consistent_inertia, standard values) and the extraction's
+    links (extraction.problem.is_consistent, dynamic values) against the pseudo-inertia written
+    here from the standard values alone, J = [[tr(I_o)/2 E - I_o, m c], [(m c)^T, m]]: a body
+    exactly when J is positive semidefinite (random bodies, about half breaking the triangle
+    inequality)."""
+    from dyngen.extraction.problem import is_consistent
+    from dyngen.parameters import dynamic_from_standard_link
+    from dyngen.terms.body import consistent_inertia
+
+    rng = np.random.default_rng(5)
+    verdicts = []
+    for _ in range(400):
+        m = rng.uniform(0.1, 5.0)
+        h = m * rng.uniform(-0.2, 0.2, 3)
+        moments = rng.uniform(0.0, 0.1, 3)
+        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        c = h / m
+        I_o = Q @ np.diag(moments) @ Q.T + m * (c @ c * np.eye(3) - np.outer(c, c))
+        standard = np.array([m, *h, I_o[0, 0], I_o[0, 1], I_o[0, 2], I_o[1, 1], I_o[1, 2], I_o[2, 2]])
+        J = np.block([[0.5 * np.trace(I_o) * np.eye(3) - I_o, h[:, None]], [h[None, :], np.array([[m]])]])
+        smallest = np.linalg.eigvalsh(J)[0]
+        if abs(smallest) < 1e-9:
+            continue  # on the boundary: rounding decides
+        expected = smallest > 0
+        assert consistent_inertia(standard) == expected
+        assert bool(is_consistent(np.array(dynamic_from_standard_link(standard)))[0]) == expected
+        verdicts.append(expected)
+    assert 100 < sum(verdicts) < len(verdicts) - 100  # both kinds, many of each
+
+
 def test_excitation_matrix_is_what_identify_fits(model):
     """The excitation's information matrix times [pi_full(p), per joint Fc, Fv, b and Ia where
     the rigid body does not carry it] is Pinocchio's rnea plus the friction, offset and rotor

@@ -67,6 +67,22 @@ def dynamic_from_standard_link(s10):
     ]
 
 
+def inertia_margin(entries) -> float:
+    """lambda_min(tr(I)/2 E - I) of an inertia about the centre of mass, given as (xx, xy, xz,
+    yy, yz, zz): tr(I)/2 - lambda_max(I), so >= 0 exactly when the principal moments meet the
+    triangle inequalities (which make them non-negative too) and the pseudo-inertia is positive
+    semidefinite. The one physical-consistency check of link parameters: the extraction's
+    constraint and margin, identify's report and the diagnosis's payload use it."""
+    xx, xy, xz, yy, yz, zz = entries
+    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+    return float(np.linalg.eigvalsh(0.5 * np.trace(inertia) * np.eye(3) - inertia).min())
+
+
+def consistency_margin(link10) -> float:
+    """inertia_margin of one link's dynamic parameters (its inertia about the centre of mass)."""
+    return inertia_margin(link10[4:10])
+
+
 def standard_from_dynamic(p: np.ndarray) -> np.ndarray:
     """Numeric, all links: (10N,) dynamic -> (10N,) standard."""
     p = np.asarray(p, dtype=float).reshape(-1, PER_LINK)

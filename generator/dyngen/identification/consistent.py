@@ -38,8 +38,8 @@ import os
 import numpy as np
 
 from ..errors import InputError
-from ..extraction.problem import consistency_margin, pinned
-from ..parameters import PER_LINK
+from ..extraction.problem import pinned
+from ..parameters import PER_LINK, consistency_margin
 from ..terms import tilt
 from ..terms.body import armature_identifiable
 from ..terms.friction import SIMPLE_SCALE

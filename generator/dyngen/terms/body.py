@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK
+from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK, consistency_margin, dynamic_from_standard_link
 from .term import Term, Value
 
 
@@ -196,13 +196,11 @@ def nearest_body_inertia(I) -> np.ndarray:
     return V @ np.diag(np.maximum(best, 0.0)) @ V.T
 
 
-def consistent_inertia(values, tolerance: float = 0.0) -> bool:
+def consistent_inertia(values) -> bool:
     """Whether a fitted payload's 10 standard values (m, m c, inertia about the frame origin)
-    describe a body: inertia about its centre of mass with non-negative principal moments that
-    satisfy the triangle inequalities."""
-    m, c = values[0], np.asarray(values[1:4]) / values[0]
-    e = np.linalg.eigvalsh(_matrix(values[4:10]) - m * _point(c))
-    return bool(e[0] >= -tolerance and e[0] + e[1] >= e[2] - tolerance)
+    describe a body: its inertia about its centre of mass meets the triangle inequalities
+    (parameters.consistency_margin, the extraction's check; the mass is the range's)."""
+    return consistency_margin(dynamic_from_standard_link(values)) >= 0.0
 
 
 def standard_of_payload(values: dict, variant=None) -> np.ndarray:
