@@ -129,11 +129,12 @@ def test_the_diagnosis_candidates_are_the_terms(model):
 
 
 def test_one_tilt_for_identify_and_diagnose():
-    """identify's rotation columns (terms.tilt.rotation_columns) and the diagnosis's Tilt are the
-    same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
+    """identify's rotation columns (identification.blocks.tilt_columns) and the diagnosis's Tilt are
+    the same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
     gravity along -z), and the turned gravity vector keeps its size."""
     from oracles.random_params import random_parameters
 
+    from dyngen.identification.blocks import tilt_columns
     from dyngen.terms import Tilt, tilt
 
     robot = load_robot(ROOT / "examples" / "lwr.yaml")
@@ -145,7 +146,7 @@ def test_one_tilt_for_identify_and_diagnose():
     context = Context(None, robot, p, None, 0.002)
     estimate = (0.3, -0.5)
     ours = Tilt.of(context).at(estimate).columns(context, SimpleNamespace(q=q), None)
-    assert np.allclose(tilt.rotation_columns(robot, p, q, g, estimate), ours, rtol=1e-12, atol=1e-12)
+    assert np.allclose(tilt_columns(g, estimate)(tilt.gravity_matrix(robot, p, q)), ours, rtol=1e-12, atol=1e-12)
     turned = g + tilt.directions(g).T @ tilt.change(g, estimate)
     assert np.linalg.norm(turned) == pytest.approx(np.linalg.norm(g), rel=1e-12)
 

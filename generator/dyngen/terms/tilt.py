@@ -237,13 +237,6 @@ def recording_gravity(context, signals) -> np.ndarray:
     return G + B @ np.asarray(context.load)
 
 
-def rotation_columns(robot, p, q, g, a0=(0.0, 0.0)) -> np.ndarray:
-    """(T, N, 2): the tilt's columns at positions q for link parameters p and gravity g,
-    linearised at a0 (identify's rotation; the diagnosis's Tilt is the same term)."""
-    D = directions(g)
-    return Tilt.regressor(gravity_matrix(robot, p, q), D[0], D[1], float(np.linalg.norm(g)), a0)
-
-
 def torque(robot, p, q, g, a) -> np.ndarray:
     """(T, N): the exact torque change of the rotation (linear in the gravity vector)."""
     return gravity_matrix(robot, p, q) @ (directions(g).T @ change(g, a))
