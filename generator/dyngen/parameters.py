@@ -67,14 +67,19 @@ def dynamic_from_standard_link(s10):
     ]
 
 
+def inertia_array(six) -> np.ndarray:
+    """Numeric 3x3 symmetric matrix from (xx, xy, xz, yy, yz, zz)."""
+    xx, xy, xz, yy, yz, zz = six
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+
+
 def inertia_margin(entries) -> float:
     """lambda_min(tr(I)/2 E - I) of an inertia about the centre of mass, given as (xx, xy, xz,
     yy, yz, zz): tr(I)/2 - lambda_max(I), so >= 0 exactly when the principal moments meet the
     triangle inequalities (which make them non-negative too) and the pseudo-inertia is positive
     semidefinite. The one physical-consistency check of link parameters: the extraction's
     constraint and margin, identify's report and the diagnosis's payload use it."""
-    xx, xy, xz, yy, yz, zz = entries
-    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+    inertia = inertia_array(entries)
     return float(np.linalg.eigvalsh(0.5 * np.trace(inertia) * np.eye(3) - inertia).min())
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK, consistency_margin, dynamic_from_standard_link
+from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK, consistency_margin, dynamic_from_standard_link, inertia_array
 from .term import Term, Value
 
 
@@ -105,7 +105,7 @@ class Payload(Term):
                    "centre, with the nearest body's inertia per kg or none, whichever does better on selection "
                    "data)", values[4:].tolist())
         m, c = values[0], values[1:4] / values[0]
-        nearest = nearest_body_inertia(_matrix(values[4:10]) - m * _point(c))
+        nearest = nearest_body_inertia(inertia_array(values[4:10]) - m * _point(c))
         return refusal, [FixedShapePayload(c, J, self.max_mass, values[:4]) for J in (nearest / m, np.zeros((3, 3)))]
 
     def columns(self, context, signals, tau_model):
@@ -161,17 +161,12 @@ class FixedShapePayload(Payload):
             return None
         m = values["m"]
         c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
-        J = _matrix((variant or {}).get("inertia_per_kg", [0.0] * 6))
+        J = inertia_array((variant or {}).get("inertia_per_kg", [0.0] * 6))
         I = m * (J + _point(c))
         return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
 
 
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))  # XX, XY, XZ, YY, YZ, ZZ
-
-
-def _matrix(six) -> np.ndarray:
-    XX, XY, XZ, YY, YZ, ZZ = six
-    return np.array([[XX, XY, XZ], [XY, YY, YZ], [XZ, YZ, ZZ]], dtype=float)
 
 
 def _point(c) -> np.ndarray:
