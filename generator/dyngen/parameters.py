@@ -88,6 +88,25 @@ def consistency_margin(link10) -> float:
     return inertia_margin(link10[4:10])
 
 
+def consistency_problem(link10, tolerance: float = 0.0) -> str | None:
+    """Why one link's dynamic parameters are no rigid body's, or None when they are one: m > 0,
+    the inertia about the centre of mass positive definite (smallest principal moment above
+    |tolerance| times the largest) and consistency_margin >= tolerance times the largest moment.
+    A simulator's rounding is the tolerance: < 0 forgives round-off in parameters that are exactly
+    on the boundary, > 0 keeps room from it for a program that checks in its own rounding."""
+    m = float(link10[0])
+    if not m > 0:
+        return f"mass {m!r} is not positive"
+    moments = [float(e) for e in np.linalg.eigvalsh(inertia_array(link10[4:10]))]
+    largest = max(abs(moments[2]), np.finfo(float).tiny)
+    listed = f"principal moments {moments[0]!r}, {moments[1]!r}, {moments[2]!r}"
+    if not moments[0] > abs(tolerance) * largest:
+        return f"inertia about the CoM is not positive definite ({listed})"
+    if not consistency_margin(link10) >= tolerance * largest:
+        return f"inertia about the CoM violates the triangle inequality A + B >= C ({listed}); no rigid body has it"
+    return None
+
+
 def standard_from_dynamic(p: np.ndarray) -> np.ndarray:
     """Numeric, all links: (10N,) dynamic -> (10N,) standard."""
     p = np.asarray(p, dtype=float).reshape(-1, PER_LINK)
