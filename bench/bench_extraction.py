@@ -27,7 +27,8 @@ from common import arguments, on_path  # noqa: E402  (bench/ is sys.path[0])
 ROOT = on_path()
 
 from dyngen.description import load_robot  # noqa: E402
-from dyngen.extraction.problem import Options, build_problem, consistency_margin  # noqa: E402
+from dyngen.extraction.problem import Options, build_problem  # noqa: E402
+from dyngen.parameters import consistency_margin  # noqa: E402
 from dyngen.extraction.run import extract  # noqa: E402
 from dyngen.generate import generate  # noqa: E402
 from dyngen.runtime import load  # noqa: E402

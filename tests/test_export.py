@@ -262,6 +262,46 @@ def test_inconsistent_parameters_are_refused_naming_the_link(tmp_path):
         to_urdf(robot, good[:-1])
 
 
+def test_export_checks_are_the_one_consistency_check():
+    """The export's refusal (frames.check_consistent) and the URDF copy's test of a chain link
+    (urdf_copy._physical) against the pseudo-inertia written here, J = [[tr(I)/2 E - I, 0], [0, m]]
+    with I about the centre of mass: a body exactly when J is positive semidefinite. The copy
+    keeps room (MuJoCo rounds), so it may refuse a body but never accepts a non-body; random
+    bodies, about half breaking the triangle inequality."""
+    from dyngen.export.frames import check_consistent
+    from dyngen.export.urdf_copy import _physical
+
+    rng = np.random.default_rng(11)
+    verdicts, copied = [], []
+    for _ in range(400):
+        m = rng.uniform(0.1, 5.0)
+        c = rng.uniform(-0.2, 0.2, 3)
+        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        inertia = Q @ np.diag(rng.uniform(0.001, 0.1, 3)) @ Q.T
+        J = np.block([[0.5 * np.trace(inertia) * np.eye(3) - inertia, np.zeros((3, 1))],
+                      [np.zeros((1, 3)), np.array([[m]])]])
+        smallest = np.linalg.eigvalsh(J)[0]
+        if abs(smallest) < 1e-9:
+            continue  # on the boundary: rounding decides
+        expected = smallest > 0
+        link = np.array([m, *c, inertia[0, 0], inertia[0, 1], inertia[0, 2], inertia[1, 1], inertia[1, 2],
+                         inertia[2, 2]])
+        try:
+            check_consistent(link[None, :])
+            refused = False
+        except ValueError as error:
+            assert "link 1: inertia about the CoM violates the triangle inequality" in str(error)
+            refused = True
+        assert refused == (not expected)
+        about_origin = inertia + m * (c @ c * np.eye(3) - np.outer(c, c))  # standard parameters
+        accepted = _physical(m, m * c, about_origin)
+        assert not (accepted and not expected)
+        verdicts.append(expected)
+        copied.append(accepted)
+    assert 100 < sum(verdicts) < len(verdicts) - 100  # both kinds, many of each
+    assert sum(copied) > 0.9 * sum(verdicts)  # the room refuses only bodies near the boundary
+
+
 def test_symbolic_gravity_is_refused_for_mjcf(tmp_path):
     text = (ROOT / "examples" / "lwr.yaml").read_text()
     variant = text.replace("gravity: [0, 0, -9.81]", "gravity: [gx, gy, gz]")

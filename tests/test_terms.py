@@ -129,11 +129,12 @@ def test_the_diagnosis_candidates_are_the_terms(model):
 
 
 def test_one_tilt_for_identify_and_diagnose():
-    """identify's rotation columns (terms.tilt.rotation_columns) and the diagnosis's Tilt are the
-    same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
+    """identify's rotation columns (identification.blocks.tilt_columns) and the diagnosis's Tilt are
+    the same term: equal columns at the same estimate, directions u1, u2 = n x u1 (base +x, -y for
     gravity along -z), and the turned gravity vector keeps its size."""
     from oracles.random_params import random_parameters
 
+    from dyngen.identification.blocks import tilt_columns
     from dyngen.terms import Tilt, tilt
 
     robot = load_robot(ROOT / "examples" / "lwr.yaml")
@@ -145,9 +146,74 @@ def test_one_tilt_for_identify_and_diagnose():
     context = Context(None, robot, p, None, 0.002)
     estimate = (0.3, -0.5)
     ours = Tilt.of(context).at(estimate).columns(context, SimpleNamespace(q=q), None)
-    assert np.allclose(tilt.rotation_columns(robot, p, q, g, estimate), ours, rtol=1e-12, atol=1e-12)
+    assert np.allclose(tilt_columns(g, estimate)(tilt.gravity_matrix(robot, p, q)), ours, rtol=1e-12, atol=1e-12)
     turned = g + tilt.directions(g).T @ tilt.change(g, estimate)
     assert np.linalg.norm(turned) == pytest.approx(np.linalg.norm(g), rel=1e-12)
+
+
+def test_one_tilt_angle_against_a_turned_gravity():
+    """The one tilt-angle formula (terms.tilt.angle_deg, angles_deg) against a base turned by a
+    known rotation (Rodrigues, written here): gravity in the turned base frame R^T g gives the
+    components a across it, and the angle must be the rotation's, split along the directions it
+    turns gravity towards (u1 = base +x, u2 = base -y for gravity along -z). The diagnosis's
+    derived angles and its range check use the same formula."""
+    from dyngen.terms import Tilt, tilt
+
+    robot = load_robot(ROOT / "examples" / "lwr.yaml")
+    g = np.array([0.0, 0.0, -9.81])
+    n, u = g / 9.81, np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    rng = np.random.default_rng(21)
+    for degrees in (0.5, 3.0, 9.0, 25.0):
+        phi = rng.uniform(0, 2 * np.pi)
+        k = np.array([np.cos(phi), np.sin(phi), 0.0])  # a horizontal axis
+        K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        th = np.radians(degrees)
+        R = np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K
+        turned = R.T @ g
+        a = u @ turned
+        # the rotation taking g to `turned`: about g x turned by the angle between them
+        omega = np.degrees(np.arccos(turned @ g / (g @ g))) * np.cross(g, turned) / np.linalg.norm(np.cross(g, turned))
+        # turning gravity towards u_k is a rotation about n x u_k
+        expected = [omega @ np.cross(n, u[0]), omega @ np.cross(n, u[1])]
+        assert tilt.angle_deg(g, a) == pytest.approx(degrees, rel=1e-9)
+        assert tilt.angles_deg(g, a) == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        term = Tilt(9.81, (u[0], u[1]))
+        derived = term.derived(robot, {"dg1": a[0], "dg2": a[1]}, {"dg1": 0.0, "dg2": 0.0}, None)
+        assert derived["tilt_deg"] == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        assert derived["tilt_total_deg"] == pytest.approx(degrees, rel=1e-9)
+        assert Tilt.inside(a, {"g": 9.81}) == (degrees < tilt.MAX_TILT_DEG)
+
+
+def test_one_consistency_check_against_the_pseudo_inertia():
+    """The one physical-consistency check of link parameters (parameters.consistency_margin):
+    the diagnosis's payload (terms.body.consistent_inertia, standard values) and the extraction's
+    links (extraction.problem.is_consistent, dynamic values) against the pseudo-inertia written
+    here from the standard values alone, J = [[tr(I_o)/2 E - I_o, m c], [(m c)^T, m]]: a body
+    exactly when J is positive semidefinite (random bodies, about half breaking the triangle
+    inequality)."""
+    from dyngen.extraction.problem import is_consistent
+    from dyngen.parameters import dynamic_from_standard_link
+    from dyngen.terms.body import consistent_inertia
+
+    rng = np.random.default_rng(5)
+    verdicts = []
+    for _ in range(400):
+        m = rng.uniform(0.1, 5.0)
+        h = m * rng.uniform(-0.2, 0.2, 3)
+        moments = rng.uniform(0.0, 0.1, 3)
+        Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        c = h / m
+        I_o = Q @ np.diag(moments) @ Q.T + m * (c @ c * np.eye(3) - np.outer(c, c))
+        standard = np.array([m, *h, I_o[0, 0], I_o[0, 1], I_o[0, 2], I_o[1, 1], I_o[1, 2], I_o[2, 2]])
+        J = np.block([[0.5 * np.trace(I_o) * np.eye(3) - I_o, h[:, None]], [h[None, :], np.array([[m]])]])
+        smallest = np.linalg.eigvalsh(J)[0]
+        if abs(smallest) < 1e-9:
+            continue  # on the boundary: rounding decides
+        expected = smallest > 0
+        assert consistent_inertia(standard) == expected
+        assert bool(is_consistent(np.array(dynamic_from_standard_link(standard)))[0]) == expected
+        verdicts.append(expected)
+    assert 100 < sum(verdicts) < len(verdicts) - 100  # both kinds, many of each
 
 
 def test_excitation_matrix_is_what_identify_fits(model):

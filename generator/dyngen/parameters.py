@@ -67,6 +67,46 @@ def dynamic_from_standard_link(s10):
     ]
 
 
+def inertia_array(six) -> np.ndarray:
+    """Numeric 3x3 symmetric matrix from (xx, xy, xz, yy, yz, zz)."""
+    xx, xy, xz, yy, yz, zz = six
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+
+
+def inertia_margin(entries) -> float:
+    """lambda_min(tr(I)/2 E - I) of an inertia about the centre of mass, given as (xx, xy, xz,
+    yy, yz, zz): tr(I)/2 - lambda_max(I), so >= 0 exactly when the principal moments meet the
+    triangle inequalities (which make them non-negative too) and the pseudo-inertia is positive
+    semidefinite. The one physical-consistency check of link parameters: the extraction's
+    constraint and margin, identify's report and the diagnosis's payload use it."""
+    inertia = inertia_array(entries)
+    return float(np.linalg.eigvalsh(0.5 * np.trace(inertia) * np.eye(3) - inertia).min())
+
+
+def consistency_margin(link10) -> float:
+    """inertia_margin of one link's dynamic parameters (its inertia about the centre of mass)."""
+    return inertia_margin(link10[4:10])
+
+
+def consistency_problem(link10, tolerance: float = 0.0) -> str | None:
+    """Why one link's dynamic parameters are no rigid body's, or None when they are one: m > 0,
+    the inertia about the centre of mass positive definite (smallest principal moment above
+    |tolerance| times the largest) and consistency_margin >= tolerance times the largest moment.
+    A simulator's rounding is the tolerance: < 0 forgives round-off in parameters that are exactly
+    on the boundary, > 0 keeps room from it for a program that checks in its own rounding."""
+    m = float(link10[0])
+    if not m > 0:
+        return f"mass {m!r} is not positive"
+    moments = [float(e) for e in np.linalg.eigvalsh(inertia_array(link10[4:10]))]
+    largest = max(abs(moments[2]), np.finfo(float).tiny)
+    listed = f"principal moments {moments[0]!r}, {moments[1]!r}, {moments[2]!r}"
+    if not moments[0] > abs(tolerance) * largest:
+        return f"inertia about the CoM is not positive definite ({listed})"
+    if not consistency_margin(link10) >= tolerance * largest:
+        return f"inertia about the CoM violates the triangle inequality A + B >= C ({listed}); no rigid body has it"
+    return None
+
+
 def standard_from_dynamic(p: np.ndarray) -> np.ndarray:
     """Numeric, all links: (10N,) dynamic -> (10N,) standard."""
     p = np.asarray(p, dtype=float).reshape(-1, PER_LINK)

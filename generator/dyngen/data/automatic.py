@@ -43,7 +43,6 @@ class Decision:
     q_noise: np.ndarray  # per joint position noise sigma [rad]
     qdd_noise: np.ndarray  # per joint predicted acceleration noise after the filter [rad/s^2]
     band: float  # Hz: 99 % of the motion's velocity power lies below
-    qdd_rms: float  # the motion's acceleration RMS (over joints) [rad/s^2]
 
 
 def position_noise(q: np.ndarray) -> np.ndarray:
@@ -86,9 +85,8 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
         return qd, np.gradient(qd, t, axis=0)
 
     if q.shape[0] < 32 or float(sigma.max()) <= NO_FILTER_NOISE:
-        qd, qdd = derivatives(q)
-        return Decision(None, sigma, np.zeros_like(sigma), motion_band(qd, rate) if q.shape[0] >= 32 else 0.0,
-                        float(np.sqrt(np.mean(qdd ** 2))))
+        band = motion_band(derivatives(q)[0], rate) if q.shape[0] >= 32 else 0.0
+        return Decision(None, sigma, np.zeros_like(sigma), band)
     noise = float(np.sqrt(np.mean(sigma ** 2)))
     top = MAX_FRACTION * rate
     cutoff = rate / 20
@@ -105,6 +103,5 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
             cutoff = new
             break
         cutoff = new
-    qd, qdd = derivatives(lowpass_of(cutoff)(q))
-    return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate, order), motion_band(qd, rate),
-                    float(np.sqrt(np.mean(qdd ** 2))))
+    qd = derivatives(lowpass_of(cutoff)(q))[0]
+    return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate, order), motion_band(qd, rate))

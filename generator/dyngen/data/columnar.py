@@ -35,7 +35,6 @@ def format_of(path) -> str | None:
     return None
 
 
-
 def _module(name: str, path):
     try:
         return __import__(name, fromlist=["_"])

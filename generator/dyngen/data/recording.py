@@ -56,7 +56,7 @@ def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ())
         text = text.replace("\r\n", "\n").replace("\r", "\n")
     header_line, _, body = text.partition("\n")
     header = _header(name, header_line)
-    columns = _check_header(name, header, dof, require_torques, required)
+    columns = check_header(name, header, dof, require_torques, required, "line 1 (header)")
     data = _numbers(body, name, header)
     return from_columns(name, header, columns, data, dof)
 
@@ -106,10 +106,6 @@ def _header(name, line: str) -> list[str]:
 
 def check_header(name, header, dof, require_torques=True, required=(), where="columns") -> dict:
     """{column name: index} of a header, or an InputError naming what is wrong (at `where`)."""
-    return _check_header(name, header, dof, require_torques, required, where)
-
-
-def _check_header(name, header, dof, require_torques, required, where="line 1 (header)") -> dict:
     if not header or header == [""]:
         raise InputError(name, where, "empty file; expected a header such as t, q1..qN, tau1..tauN")
     columns = {}

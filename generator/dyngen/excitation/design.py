@@ -67,7 +67,6 @@ class Design:
     scaled_condition: float  # with unit-norm columns
     random_condition: float  # the same for random coefficients with the same limits (median of the candidates)
     random_scaled_condition: float
-    random_trajectory: FourierTrajectory
     evaluations: int
     seconds: float = 0.0
 
@@ -243,8 +242,7 @@ def optimise(robot, model, settings: Settings | None = None) -> Design:
     traj = shape.trajectory(x)
     cond, scaled = _conditions(matrix(x))
     rcond, rscaled = _conditions(matrix(starts[random_index]))
-    return Design(traj, cond, scaled, rcond, rscaled, shape.trajectory(starts[random_index]), evaluations,
-                  time.perf_counter() - start)
+    return Design(traj, cond, scaled, rcond, rscaled, evaluations, time.perf_counter() - start)
 
 
 def random_design(robot, settings: Settings, seed: int) -> FourierTrajectory:

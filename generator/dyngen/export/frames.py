@@ -17,7 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-# Relative tolerance of the physical-consistency check (eigenvalues of the CoM inertia).
+from ..parameters import consistency_problem, inertia_array
+
+# Relative tolerance of the physical-consistency check: round-off in parameters written on the
+# boundary (a thin rod's A + B = C) is forgiven; MuJoCo loads such a body.
 CONSISTENCY_TOL = 1e-12
 
 
@@ -55,27 +58,17 @@ class Inertial:
 
 
 def link_matrix(pi) -> np.ndarray:
-    _, _, _, _, xx, xy, xz, yy, yz, zz = pi
-    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], dtype=float)
+    """One link's inertia about its CoM, from its dynamic parameters."""
+    return inertia_array(pi[4:10])
 
 
 def check_consistent(p: np.ndarray) -> None:
     """Raise ValueError naming the first link whose parameters no rigid body has: simulators
-    refuse them (MuJoCo) or silently misbehave. m > 0, CoM inertia positive definite and
-    A + B >= C on its principal moments, to a relative tolerance CONSISTENCY_TOL."""
+    refuse them (MuJoCo) or silently misbehave. parameters.consistency_problem, to CONSISTENCY_TOL."""
     for i, pi in enumerate(p, start=1):
-        m = pi[0]
-        if not m > 0:
-            raise ValueError(f"link {i}: mass {float(m)!r} is not positive; simulators cannot load it")
-        e = [float(x) for x in np.linalg.eigvalsh(link_matrix(pi))]
-        tol = CONSISTENCY_TOL * max(abs(e[2]), np.finfo(float).tiny)
-        if not e[0] > tol:
-            raise ValueError(f"link {i}: inertia about the CoM is not positive definite (principal moments "
-                             f"{e[0]!r}, {e[1]!r}, {e[2]!r}); simulators cannot load it")
-        if e[0] + e[1] < e[2] - tol:
-            raise ValueError(f"link {i}: inertia about the CoM violates the triangle inequality A + B >= C "
-                             f"(principal moments {e[0]!r}, {e[1]!r}, {e[2]!r}); no rigid body has it, "
-                             f"simulators cannot load it")
+        problem = consistency_problem(pi, -CONSISTENCY_TOL)
+        if problem is not None:
+            raise ValueError(f"link {i}: {problem}; simulators cannot load it")
 
 
 def link_parameters(robot, p) -> np.ndarray:

@@ -25,6 +25,7 @@ from ..description.joint_model import _floats
 from ..description.urdf import _inertial, load_urdf
 from ..description.urdf_xml import MAX_URDF_BYTES, read_urdf
 from ..errors import InputError
+from ..parameters import consistency_problem, inertia_array
 from ..untrusted import read_text
 
 
@@ -35,8 +36,7 @@ def _s(m, c, I):
 
 
 def _link_values(values):
-    m, c, (xx, xy, xz, yy, yz, zz) = values.m, values.c, values.I
-    return _s(m, c, np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+    return _s(values.m, values.c, inertia_array(values.I))
 
 
 def urdf_copy(robot, p) -> str:
@@ -58,8 +58,7 @@ def urdf_copy(robot, p) -> str:
             body = _inertial(file.links[link]).moved(R, t)
             m_own, h_own, J_own = _s(body.mass, body.com, body.inertia)
         m_file, h_file, J_file = _link_values(original.nominal[i])
-        xx, xy, xz, yy, yz, zz = p[i, 4:]
-        m_new, h_new, J_new = _s(p[i, 0], p[i, 1:4], np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]))
+        m_new, h_new, J_new = _s(p[i, 0], p[i, 1:4], inertia_array(p[i, 4:]))
         k = _largest_share(m_new, h_new, J_new, m_file - m_own, h_file - h_own, J_file - J_own)
         m = m_new - k * (m_file - m_own)
         h = h_new - k * (h_file - h_own)
@@ -78,14 +77,20 @@ def urdf_copy(robot, p) -> str:
     return '<?xml version="1.0" encoding="utf-8"?>\n' + prefix + "\n" + ET.tostring(root, encoding="unicode") + "\n"
 
 
+# MuJoCo checks the triangle inequality in its own rounding (of the file's decimal text and its
+# diagonalisation): a chain link written exactly on the boundary can be refused, so keep room.
+MUJOCO_ROOM = 1e-3
+
+
 def _physical(m, h, J) -> bool:
-    """Positive mass, and a centre-of-mass inertia that is positive definite and meets the
-    triangle inequality (what MuJoCo checks)."""
+    """Standard parameters about the frame origin (m, m c, J) that a simulator loads: their
+    dynamic form is parameters.consistency_problem-free with room MUJOCO_ROOM."""
     if m <= 0:
         return False
     c = h / m
-    e = np.linalg.eigvalsh(J - m * (c @ c * np.eye(3) - np.outer(c, c)))
-    return e[0] > 0 and e[2] <= (e[0] + e[1]) * (1 - 1e-3)  # a margin: MuJoCo checks in its own rounding
+    I = J - m * (c @ c * np.eye(3) - np.outer(c, c))
+    link10 = [m, *c, I[0, 0], I[0, 1], I[0, 2], I[1, 1], I[1, 2], I[2, 2]]
+    return consistency_problem(link10, MUJOCO_ROOM) is None
 
 
 def _largest_share(m_new, h_new, J_new, m_others, h_others, J_others) -> float:

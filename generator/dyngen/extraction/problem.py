@@ -16,7 +16,7 @@ from scipy.optimize import linprog
 from ..description.expressions import ExpressionError, parse_expression, shorten
 from ..description.extraction_options import Options  # noqa: F401  (re-exported: the problem is built from them)
 from ..errors import Infeasible, InputError
-from ..parameters import PER_LINK, dynamic_name, dynamic_symbols
+from ..parameters import PER_LINK, consistency_margin, dynamic_name, dynamic_symbols, inertia_margin
 from .targets import Target
 
 
@@ -137,13 +137,6 @@ def most_consistent_inertia(lower, upper, link: int) -> tuple[np.ndarray, float]
     return entries, inertia_margin(entries)
 
 
-def inertia_margin(entries) -> float:
-    """lambda_min(tr(I)/2 E - I) of I given as (xx, xy, xz, yy, yz, zz)."""
-    xx, xy, xz, yy, yz, zz = entries
-    inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-    return float(np.linalg.eigvalsh(0.5 * np.trace(inertia) * np.eye(3) - inertia).min())
-
-
 def strict_center(problem: Problem, options: Options) -> np.ndarray:
     """Parameters strictly inside every bound and strictly consistent where the bounds allow: the
     driver's barrier method starts from points pulled towards it. Masses and centres of mass at the
@@ -172,10 +165,6 @@ def is_consistent(p: np.ndarray, margin: float = 0.0) -> np.ndarray:
     for link in np.asarray(p, dtype=float).reshape(-1, PER_LINK):
         out.append(link[0] > 0 and consistency_margin(link) >= margin)
     return np.array(out)
-
-
-def consistency_margin(link10) -> float:
-    return inertia_margin(link10[4:10])
 
 
 def pinned(problem, p, rel: float = 1e-6) -> list:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..parameters import PER_LINK
-from .problem import consistency_margin, pinned
+from ..parameters import PER_LINK, consistency_margin
+from .problem import pinned
 
 
 def links_yaml(p) -> str:

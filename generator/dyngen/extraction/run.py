@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..parameters import PER_LINK, dynamic_name
+from ..parameters import PER_LINK, consistency_margin, dynamic_name
 from ..reduction.identifiability import classify
 from . import driver
-from .problem import Infeasible, Options, Problem, Stage, build_problem, consistency_margin
+from .problem import Infeasible, Options, Problem, Stage, build_problem
 from .targets import Target, target
 
 KINDS = ("gravity", "inertia", "full")

@@ -212,7 +212,7 @@ def sources_of(recordings, block_rows: int = ROWS) -> list:
 
 
 def tilt_columns(g_vec, a=(0.0, 0.0)):
-    """G (T, N, 3) -> the tilt's columns linearised at a: tilt.rotation_columns of G."""
+    """G (T, N, 3) -> the tilt's columns linearised at a (terms.tilt.Tilt.regressor)."""
     if g_vec is None:
         return None
     D, size = tilt.directions(g_vec), float(np.linalg.norm(g_vec))

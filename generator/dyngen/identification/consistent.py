@@ -38,8 +38,8 @@ import os
 import numpy as np
 
 from ..errors import InputError
-from ..extraction.problem import consistency_margin, pinned
-from ..parameters import PER_LINK
+from ..extraction.problem import pinned
+from ..parameters import PER_LINK, consistency_margin
 from ..terms import tilt
 from ..terms.body import armature_identifiable
 from ..terms.friction import SIMPLE_SCALE
@@ -47,6 +47,7 @@ from . import held_out
 from .blocks import Blocks, sources_of, tilt_columns, velocity_limits
 from .columns import PER_JOINT, group_of, kinds_of, name_of
 from .consistent_output import Consistent
+from .least_squares import WEAK
 from .normal import Normal, Swaps, solve_unconstrained
 from .identify_options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOptions
 from .solver import Solver
@@ -112,8 +113,6 @@ def _unexcited(normal, fit, weights, r) -> set:
     have a direction weaker than least_squares.WEAK, the label that carries most of the weakest
     one is left out (a ripple cos q_j, sin q_j shaped like joint j's gravity; coefficients the
     data do not excite are left to the prior and consistency instead)."""
-    from .least_squares import WEAK
-
     G, _ = normal.total(fit, weights)
     norms = np.sqrt(np.maximum(np.diag(G), 0.0))
     out = {k - r for k in range(r, G.shape[0]) if norms[k] == 0}

@@ -144,10 +144,8 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
 
 def tilt_change(c) -> np.ndarray:
     """The tilt's change of the gravity vector in the base frame [m/s^2]."""
-    from ..terms.tilt import change, directions, gravity_of
-
-    g = gravity_of(c.tilt_model[0])
-    return directions(g).T @ change(g, c.friction["tilt"])
+    g = tilt.gravity_of(c.tilt_model[0])
+    return tilt.directions(g).T @ tilt.change(g, c.friction["tilt"])
 
 
 def consistent_table(c) -> str:

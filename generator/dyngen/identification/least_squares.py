@@ -35,14 +35,6 @@ class Estimate:
                 for k in self.unexcited]
 
 
-def fit(A: np.ndarray, b: np.ndarray, names: list[str], weak: float = WEAK) -> Estimate:
-    """The fit of the rows [A | b], through their triangular factor (fit_factor): the same
-    computation as the rows accumulated block by block (identification/triangular.py)."""
-    rows = np.column_stack([np.asarray(A, dtype=float), np.asarray(b, dtype=float)])
-    return fit_factor(rows if rows.shape[0] < rows.shape[1] else np.linalg.qr(rows, mode="r"), rows.shape[0], names,
-                      weak)
-
-
 def fit_factor(R: np.ndarray, rows: int, names: list[str], weak: float = WEAK) -> Estimate:
     """The fit of `rows` rows whose [A | b] has the triangular factor R (R^T R = [A b]^T [A b]):
     the singular values and right singular vectors of A are those of R's first c columns, U^T b

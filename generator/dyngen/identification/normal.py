@@ -30,9 +30,11 @@ def segments(part: np.ndarray) -> list:
     return [(int(part[a]), slice(int(a), int(b))) for a, b in zip(starts, stops)]
 
 
-def local_labels(labels, j: int) -> list[int]:
-    """Indices of the labels whose column is non-zero in joint j's rows."""
-    return [k for k, (kind, jj) in enumerate(labels) if kind == "tilt" or jj == j]
+def local_columns(labels, r: int, j: int, hidden: int) -> tuple[list[int], np.ndarray]:
+    """(the labels whose column is non-zero in joint j's rows, joint j's columns of the normal
+    equations: the coefficients, those labels and the hidden ones)."""
+    ks = [k for k, (kind, jj) in enumerate(labels) if kind == "tilt" or jj == j]
+    return ks, np.r_[np.arange(r), r + np.asarray(ks, dtype=int), r + len(labels) + np.arange(hidden)]
 
 
 def _in_rows(v: np.ndarray, j: int) -> np.ndarray:
@@ -64,8 +66,7 @@ class Normal:
             if each is not None:
                 each(piece)
             for j in range(dof):
-                ks = local_labels(labels, j)
-                idx = np.r_[np.arange(r), r + np.asarray(ks, dtype=int), r + len(labels) + np.arange(hidden)]
+                ks, idx = local_columns(labels, r, j, hidden)
                 A = joint_design(piece, labels, j, ks)
                 if hidden:
                     A = np.hstack([A, piece.along[:, j:j + 1]])
@@ -85,15 +86,18 @@ class Normal:
             swaps.add(piece)
         return swaps.normals(self)
 
+    def _with(self, G, g) -> "Normal":
+        """The same rows' sums (labels, bb, n) with other G and g."""
+        out = Normal.__new__(Normal)
+        out.r, out.labels, out.dof, out.hidden, out.bb, out.n = self.r, self.labels, self.dof, self.hidden, self.bb, self.n
+        out.G, out.g = G, g
+        return out
+
     @classmethod
     def per_joint(cls, normals: list) -> "Normal":
         """Joint j's blocks from normals[j] (each differs from the others in joint columns only)."""
-        out = Normal.__new__(Normal)
-        first = normals[0]
-        out.r, out.labels, out.dof, out.hidden, out.bb, out.n = first.r, first.labels, first.dof, first.hidden, first.bb, first.n
-        out.G = np.stack([m.G[:, j] for j, m in enumerate(normals)], axis=1)
-        out.g = np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1)
-        return out
+        return normals[0]._with(np.stack([m.G[:, j] for j, m in enumerate(normals)], axis=1),
+                                np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1))
 
     def rotated(self, ks, betas) -> "Normal":
         """A copy in which label ks[d]'s column c_d is c_d - betas[d] * w, w the first hidden
@@ -102,11 +106,7 @@ class Normal:
         M = np.eye(self.G.shape[-1])
         for k, beta in zip(ks, betas):
             M[self.r + len(self.labels), self.r + k] = -beta
-        out = Normal.__new__(Normal)
-        out.r, out.labels, out.dof, out.hidden, out.bb, out.n = self.r, self.labels, self.dof, self.hidden, self.bb, self.n
-        out.G = np.einsum("ai,pjab,bk->pjik", M, self.G, M)
-        out.g = np.einsum("ai,pja->pji", M, self.g)
-        return out
+        return self._with(np.einsum("ai,pjab,bk->pjik", M, self.G, M), np.einsum("ai,pja->pji", M, self.g))
 
     def total(self, parts, weights=None, keep=None) -> tuple[np.ndarray, np.ndarray]:
         """(A^T W A, A^T W b) over the given parts, joint j's rows weighted by weights[j]^2,
@@ -145,8 +145,7 @@ class Swaps:
         values = [make(piece) for make in self.makes]
         for k in self.ks:
             j = self.labels[k][1]
-            local = local_labels(self.labels, j)
-            idx = np.r_[np.arange(self.r), self.r + np.asarray(local, dtype=int), self.r + len(self.labels) + np.arange(self.hidden)]
+            local, idx = local_columns(self.labels, self.r, j, self.hidden)
             F = np.column_stack([_in_rows(piece.columns[self.labels[kk]], j) for kk in local]
                                 + ([piece.along[:, j]] if self.hidden else []))
             C = np.column_stack([v[:, j] for v in values])
@@ -159,9 +158,7 @@ class Swaps:
     def normals(self, base: Normal) -> list:
         outs = []
         for v in range(len(self.makes)):
-            out = Normal.__new__(Normal)
-            out.r, out.labels, out.dof, out.hidden = base.r, base.labels, base.dof, base.hidden
-            out.G, out.g, out.bb, out.n = base.G.copy(), base.g.copy(), base.bb, base.n
+            out = base._with(base.G.copy(), base.g.copy())
             for k in self.ks:
                 j, i = self.labels[k][1], self.r + k
                 out.G[:, j, i, :] = out.G[:, j, :, i] = self.rows[v, :, j]

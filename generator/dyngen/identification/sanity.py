@@ -1,20 +1,11 @@
-"""Identification sanity: every identified value inside its physical range, every search
-that ended at its grid's edge named, and the result's prediction beside the simple model's.
+"""Identification sanity: every identified value inside its physical range (warnings; the
+values are kept), every search that ended at its grid's edge named (a bound, not a finding; the
+lag grid is not widened, docs/measured-data.md says why), and the result's prediction beside
+the simple model's on the --select recordings, which neither fitted. Where the simple model
+predicts a joint better, the result predicts it as the diagnosis does (diagnosis/joints.py):
+the prior's rigid body and the simple model's three values (Consistent.simple).
 
     lines, table, result = check(robot, model, result, fit, select, prior)
-
-Ranges (warnings, the values are kept and written): a rotor inertia whose torque Ia qdd_j (RMS
-over the fit data) exceeds the measured torque's RMS on its joint, or which is over ROTOR_RATIO
-times the arm's own inertia about the joint (median M_jj; a reflected rotor inertia may well be
-ten times a wrist link's own); an offset or ripple amplitude above the measured torque's RMS on
-its joint (a term making up for another); a Coulomb lag or smoothing at the last value of its
-grid (options.LAG_GRID, SMOOTHING_GRID: a bound, not a finding; the lag grid is not widened,
-docs/measured-data.md says why). The simple model (terms/simple_model.py, fitted to the prior's
-residual on the fit data) and the identified model are both judged on the --select recordings,
-which neither fitted; where the simple model predicts better, the result predicts that joint by
-the prior's rigid body and the simple model's three values (Consistent.simple, `simple_model:`
-in the YAML), as the diagnosis does (diagnosis/joints.py), and a warning names it. Without
---select nothing held out exists, and the table says so.
 """
 
 from __future__ import annotations
@@ -27,7 +18,7 @@ from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
 from ..terms import simple_model as baseline
 from .identify_options import LAG_GRID, SMOOTHING_GRID
 
-ROTOR_RATIO = 100.0
+ROTOR_RATIO = 100.0  # a reflected rotor inertia may well be ten times a wrist link's own inertia
 TIE = 1.0  # the simple model is preferred where its held-out RMS is below TIE x the identified model's
 
 

@@ -29,13 +29,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..description.robot import LinkValues
 from ..extraction import driver
 from ..extraction.problem import Options as ExtractOptions
 from ..extraction.problem import Stage, build_problem
 from ..extraction.targets import Target
 from ..parameters import PER_LINK
 from .columns import BOUNDED
-
 
 
 def generators(labels, r: int, V, cone) -> np.ndarray:
@@ -80,8 +80,6 @@ class Solver:
                                               global_algorithm="none", margin=options.margin)
         described = robot_with_default_bounds(robot)
         if prior is not None:
-            from ..description.robot import LinkValues
-
             links = np.asarray(prior, dtype=float).reshape(-1, PER_LINK)
             described = replace(described, nominal=tuple(LinkValues.from_tuple(row) for row in links))
         self.problem = build_problem(described, self.extract_options)
@@ -144,8 +142,6 @@ def robot_with_default_bounds(robot):
     within 2 m of its frame, inertias within 100 kg m^2 (consistency does the real work)."""
     if robot.lower is not None:
         return robot
-    from ..description.robot import LinkValues
-
     lo = LinkValues(1e-3, (-2.0, -2.0, -2.0), (0.0, -100.0, -100.0, 0.0, -100.0, 0.0))
     hi = LinkValues(1000.0, (2.0, 2.0, 2.0), (100.0, 100.0, 100.0, 100.0, 100.0, 100.0))
     return replace(robot, lower=(lo,) * robot.dof, upper=(hi,) * robot.dof)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK
+from ..parameters import PER_LINK, STANDARD_NAMES_PER_LINK, consistency_margin, dynamic_from_standard_link, inertia_array
 from .term import Term, Value
 
 
@@ -105,7 +105,7 @@ class Payload(Term):
                    "centre, with the nearest body's inertia per kg or none, whichever does better on selection "
                    "data)", values[4:].tolist())
         m, c = values[0], values[1:4] / values[0]
-        nearest = nearest_body_inertia(_matrix(values[4:10]) - m * _point(c))
+        nearest = nearest_body_inertia(inertia_array(values[4:10]) - m * _point(c))
         return refusal, [FixedShapePayload(c, J, self.max_mass, values[:4]) for J in (nearest / m, np.zeros((3, 3)))]
 
     def columns(self, context, signals, tau_model):
@@ -161,17 +161,12 @@ class FixedShapePayload(Payload):
             return None
         m = values["m"]
         c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
-        J = _matrix((variant or {}).get("inertia_per_kg", [0.0] * 6))
+        J = inertia_array((variant or {}).get("inertia_per_kg", [0.0] * 6))
         I = m * (J + _point(c))
         return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
 
 
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))  # XX, XY, XZ, YY, YZ, ZZ
-
-
-def _matrix(six) -> np.ndarray:
-    XX, XY, XZ, YY, YZ, ZZ = six
-    return np.array([[XX, XY, XZ], [XY, YY, YZ], [XZ, YZ, ZZ]], dtype=float)
 
 
 def _point(c) -> np.ndarray:
@@ -196,13 +191,11 @@ def nearest_body_inertia(I) -> np.ndarray:
     return V @ np.diag(np.maximum(best, 0.0)) @ V.T
 
 
-def consistent_inertia(values, tolerance: float = 0.0) -> bool:
+def consistent_inertia(values) -> bool:
     """Whether a fitted payload's 10 standard values (m, m c, inertia about the frame origin)
-    describe a body: inertia about its centre of mass with non-negative principal moments that
-    satisfy the triangle inequalities."""
-    m, c = values[0], np.asarray(values[1:4]) / values[0]
-    e = np.linalg.eigvalsh(_matrix(values[4:10]) - m * _point(c))
-    return bool(e[0] >= -tolerance and e[0] + e[1] >= e[2] - tolerance)
+    describe a body: its inertia about its centre of mass meets the triangle inequalities
+    (parameters.consistency_margin, the extraction's check; the mass is the range's)."""
+    return consistency_margin(dynamic_from_standard_link(values)) >= 0.0
 
 
 def standard_of_payload(values: dict, variant=None) -> np.ndarray:

@@ -70,15 +70,21 @@ def tilt_axes(robot) -> tuple[str, str]:
     return names[0], names[1]
 
 
-def tilt_angles_deg(robot, dg) -> tuple[float, float]:
-    """Rotation angles [deg] of gravity towards u1 and u2 for the components (dg1, dg2)."""
-    g = np.linalg.norm([float(x) for x in robot.gravity])
-    return float(np.degrees(np.arctan2(dg[0], g))), float(np.degrees(np.arctan2(dg[1], g)))
-
-
 def angle_deg(g, a) -> float:
-    """The tilt angle [deg] of the rotation that gives gravity the components a across it."""
-    return float(np.degrees(np.arcsin(min(np.hypot(*a) / np.linalg.norm(g), 1.0))))
+    """The tilt angle [deg] of the rotation that gives gravity g (its vector or size) the
+    components a across it: a rotation keeps |g|, so |a| = |g| sin(angle). The one formula for
+    identify's refusal and report and the diagnosis's range and angles (angles_deg)."""
+    return float(np.degrees(np.arcsin(min(np.hypot(*a[:2]) / np.linalg.norm(g), 1.0))))
+
+
+def angles_deg(g, a) -> tuple[float, float]:
+    """The tilt's rotation vector [deg] split along the two directions it turns gravity towards
+    (u1, u2): angle_deg(g, a) times a / |a|, so that their hypot is the tilt angle."""
+    size = float(np.hypot(*a[:2]))
+    if size == 0.0:
+        return 0.0, 0.0
+    angle = angle_deg(g, a)
+    return angle * float(a[0]) / size, angle * float(a[1]) / size
 
 
 def change(g, a) -> np.ndarray:
@@ -144,7 +150,7 @@ class Tilt(Term):
 
     @classmethod
     def inside(cls, values, scales=None):
-        return bool(np.hypot(*values[:2]) < scales["g"] * np.sin(np.radians(MAX_TILT_DEG)))
+        return angle_deg(scales["g"], values) < MAX_TILT_DEG
 
     @staticmethod
     def regressor(G, u1, u2, g: float, estimate=(0.0, 0.0)):
@@ -178,10 +184,12 @@ class Tilt(Term):
     def derived(self, robot, values, std, torque_rms):
         if None in values.values():
             return {}
-        a1, a2 = tilt_angles_deg(robot, [values["dg1"], values["dg2"]])
-        s1, s2 = tilt_angles_deg(robot, [std["dg1"], std["dg2"]])
-        return {"tilt_deg": [a1, a2], "tilt_std_deg": [abs(s1), abs(s2)], "tilt_towards": list(tilt_axes(robot)),
-                "tilt_total_deg": float(np.hypot(a1, a2))}
+        a = [values["dg1"], values["dg2"]]
+        a1, a2 = angles_deg(self.g, a)
+        # a std's angle: that of a tilt of one std along each direction alone
+        s1, s2 = angle_deg(self.g, [std["dg1"], 0.0]), angle_deg(self.g, [0.0, std["dg2"]])
+        return {"tilt_deg": [a1, a2], "tilt_std_deg": [s1, s2], "tilt_towards": list(tilt_axes(robot)),
+                "tilt_total_deg": angle_deg(self.g, a)}
 
 
 class GravityScale(Term):
@@ -227,13 +235,6 @@ def recording_gravity(context, signals) -> np.ndarray:
         return G
     B = context.memo(("body_gravity", id(signals)), lambda: body_gravity_matrix(context.robot, signals.q, poses()))
     return G + B @ np.asarray(context.load)
-
-
-def rotation_columns(robot, p, q, g, a0=(0.0, 0.0)) -> np.ndarray:
-    """(T, N, 2): the tilt's columns at positions q for link parameters p and gravity g,
-    linearised at a0 (identify's rotation; the diagnosis's Tilt is the same term)."""
-    D = directions(g)
-    return Tilt.regressor(gravity_matrix(robot, p, q), D[0], D[1], float(np.linalg.norm(g)), a0)
 
 
 def torque(robot, p, q, g, a) -> np.ndarray:

@@ -1,0 +1,198 @@
+"""A new user's trial on another arm's logs (issue 25): a UR5 in MuJoCo carrying a payload, logged
+as a polling logger writes it, run through exactly the README's commands with default options.
+
+Nothing here comes from tests/simulation: the arm, its friction, the controller and the logger
+are written below, so the trial does not share the project's own assumptions about a log.
+
+- The arm: examples/ur5.yaml's nominal links (exported to MJCF by dyngen, which tests/test_export.py
+  checks against Pinocchio), with what the YAML does not have: MuJoCo's frictionloss (dry friction
+  that sticks at rest, not a tanh), viscous damping and a reflected rotor inertia on every joint,
+  and the known effect, a 1.5 kg payload 4 cm beyond the flange. An unloaded run of the same arm
+  is the control.
+- The motion: `dyngen excite examples/ur5.yaml --rate 500 --periods 18` (3 minutes), tracked by
+  the nominal model's inverse dynamics plus PD at 2 kHz (so the arm never moves exactly along
+  the reference and friction is the PD's to overcome).
+- The robot publishes its state at 500 Hz: positions from a 16-bit encoder (2 pi / 65536 rad,
+  each joint's zero at a random count phase), the applied torque with noise (0.25 Nm on joints
+  1-3, 0.08 Nm on 4-6). A logger on its own clock polls it every 2 ms, late by an exponential
+  0.3 ms and now and then stalled (up to 6.8 ms), writing its own time as the stamp: a row read
+  before the next state arrived repeats the last one, a stall drops states, and the steps are
+  0.7-8.8 ms.
+- Fit / select / test: the log cut by time into its first 60 %, the next 20 % and the last 20 %.
+
+    python bench/trial_other_arm.py [--out /tmp/trial_ur5]
+
+prints the log's statistics, runs `dyngen identify` and `dyngen diagnose` (defaults) and prints
+what they said beside the truth. Seeds are fixed; the log is the same on every run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "generator"))  # this tree's dyngen, not an installed one
+
+from dyngen.description import load_robot  # noqa: E402
+from dyngen.export import to_mjcf  # noqa: E402
+
+YAML = ROOT / "examples" / "ur5.yaml"
+SIM_DT = 0.0005  # 2 kHz physics and control
+PUBLISH_EVERY = 4  # state published every 4 steps: 500 Hz
+COUNTS = 2 ** 16  # encoder counts per turn
+TORQUE_NOISE = np.array([0.25, 0.25, 0.25, 0.08, 0.08, 0.08])  # Nm, 1 sigma
+# The truth the commands should find (per joint): dry (sticky) friction, viscous, rotor inertia.
+FRICTIONLOSS = np.array([4.0, 4.0, 3.0, 1.2, 1.2, 1.0])  # Nm
+DAMPING = np.array([3.0, 3.0, 2.0, 0.6, 0.6, 0.5])  # Nm s / rad
+ARMATURE = np.array([0.20, 0.20, 0.10, 0.03, 0.03, 0.03])  # kg m^2
+PAYLOAD_KG, PAYLOAD_Z = 1.5, 0.04  # beyond the flange, along its z
+KP = np.array([800.0, 1600.0, 600.0, 300.0, 300.0, 200.0])
+KD = np.array([40.0, 80.0, 30.0, 8.0, 8.0, 5.0])
+
+
+def nominal_vector() -> np.ndarray:
+    doc = yaml.safe_load(YAML.read_text())
+    return np.array([v for link in doc["parameters"]["nominal"] for v in [link["m"], *link["c"], *link["I"]]],
+                    dtype=float)
+
+
+def arm_xml(payload: bool) -> str:
+    """The exported nominal UR5 with the friction, rotor inertia and (optionally) the payload."""
+    xml = to_mjcf(load_robot(YAML), nominal_vector())
+    for j in range(6):
+        xml = re.sub(rf'(<joint name="joint_{j + 1}"[^>]*?)armature="0" damping="0" frictionloss="0"',
+                     rf'\1armature="{float(ARMATURE[j])!r}" damping="{float(DAMPING[j])!r}" frictionloss="{float(FRICTIONLOSS[j])!r}"',
+                     xml)
+    if payload:
+        site = '<site name="dh_frame_6" pos="0.0 0.0 0.0823" quat="1.0 0.0 0.0 0.0"/>'
+        assert site in xml
+        xml = xml.replace(site, site + f'<body name="payload" pos="0 0 {0.0823 + PAYLOAD_Z!r}"><inertial pos="0 0 0" '
+                          f'mass="{PAYLOAD_KG!r}" diaginertia="0.002 0.002 0.002"/></body>')
+    return xml
+
+
+def reference(path: Path):
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    return data[:, 0], data[:, 1:7], data[:, 7:13], data[:, 13:19]
+
+
+def simulate(payload: bool, ref_path: Path, seed: int):
+    """The robot's published states: time, true q, applied torque (before the sensors)."""
+    model = mujoco.MjModel.from_xml_string(arm_xml(payload))
+    model.opt.timestep = SIM_DT
+    nominal = mujoco.MjModel.from_xml_string(to_mjcf(load_robot(YAML), nominal_vector()))  # the controller's model
+    data, ff = mujoco.MjData(model), mujoco.MjData(nominal)
+    t_ref, q_ref, qd_ref, qdd_ref = reference(ref_path)
+    steps = int(round(t_ref[-1] / SIM_DT))
+    data.qpos[:] = q_ref[0]
+    ts, qs, taus = [], [], []
+    for k in range(steps + 1):
+        t = k * SIM_DT
+        qr = np.array([np.interp(t, t_ref, q_ref[:, j]) for j in range(6)])
+        vr = np.array([np.interp(t, t_ref, qd_ref[:, j]) for j in range(6)])
+        ar = np.array([np.interp(t, t_ref, qdd_ref[:, j]) for j in range(6)])
+        ff.qpos[:], ff.qvel[:], ff.qacc[:] = qr, vr, ar
+        mujoco.mj_inverse(nominal, ff)
+        tau = ff.qfrc_inverse + KP * (qr - data.qpos) + KD * (vr - data.qvel)
+        data.qfrc_applied[:] = tau
+        if k % PUBLISH_EVERY == 0:
+            ts.append(t)
+            qs.append(data.qpos.copy())
+            taus.append(tau.copy())
+        mujoco.mj_step(model, data)
+    return np.array(ts), np.array(qs), np.array(taus)
+
+
+def sensors(q, tau, rng):
+    """A 16-bit encoder (each joint's zero at a random phase of a count) and torque noise."""
+    step = 2 * np.pi / COUNTS
+    phase = rng.uniform(0, 1, 6)
+    q_meas = (np.floor(q / step + phase) - phase + 0.5) * step
+    return q_meas, tau + rng.normal(size=tau.shape) * TORQUE_NOISE
+
+
+def poll(t_state, rng):
+    """The logger's rows: for each, its stamp and the index of the state it read."""
+    period = 2e-3
+    n = int(t_state[-1] / period)
+    late = rng.exponential(0.3e-3, n)
+    stalled = rng.random(n) < 0.015
+    late[stalled] = rng.uniform(2e-3, 6.8e-3, stalled.sum())
+    written = np.arange(n) * period + 1e-3 + late
+    for k in range(1, n):  # a logger catching up after a stall writes 0.7 ms apart
+        written[k] = max(written[k], written[k - 1] + 0.7e-3)
+    written = written[written <= t_state[-1]]
+    index = np.searchsorted(t_state, written - 0.1e-3, side="right") - 1  # the last state that arrived
+    return np.round(written, 6), index
+
+
+def write_csv(path: Path, t, q, tau):
+    header = "t," + ",".join(f"q{j}" for j in range(1, 7)) + "," + ",".join(f"tau{j}" for j in range(1, 7))
+    np.savetxt(path, np.column_stack([t, q, tau]), delimiter=",", header=header, comments="", fmt="%.9g")
+
+
+def make_log(out: Path, payload: bool, ref: Path, seed: int) -> dict:
+    rng = np.random.default_rng(seed)
+    t_state, q, tau = simulate(payload, ref, seed)
+    q_meas, tau_meas = sensors(q, tau, rng)
+    stamp, index = poll(t_state, rng)
+    rows_q, rows_tau = q_meas[index], tau_meas[index]
+    repeated = np.r_[False, index[1:] == index[:-1]]
+    steps = np.diff(stamp)
+    name = "loaded" if payload else "unloaded"
+    cut = stamp[0] + np.array([0.6, 0.8]) * (stamp[-1] - stamp[0])
+    pieces = {"fit": stamp < cut[0], "select": (stamp >= cut[0]) & (stamp < cut[1]), "test": stamp >= cut[1]}
+    for role, rows in pieces.items():
+        write_csv(out / f"{name}_{role}.csv", stamp[rows], rows_q[rows], rows_tau[rows])
+    write_csv(out / f"{name}_all.csv", stamp, rows_q, rows_tau)
+    return {"rows": len(stamp), "repeated %": round(100 * repeated.mean(), 2),
+            "states dropped %": round(100 * (1 - len(np.unique(index)) / len(t_state)), 2),
+            "step ms min/median/max": [round(1e3 * float(f), 3) for f in (steps.min(), np.median(steps), steps.max())],
+            "torque RMS (test)": [round(float(x), 3) for x in np.sqrt(np.mean(rows_tau[pieces["test"]] ** 2, axis=0))]}
+
+
+def run(command, out: Path, name: str) -> int:
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "generator"))
+    result = subprocess.run([sys.executable, "-m", "dyngen", *command], cwd=out, env=env, capture_output=True,
+                            text=True)
+    (out / f"{name}.txt").write_text(result.stdout + result.stderr)
+    print(f"\n$ dyngen {' '.join(command)}   (exit {result.returncode})")
+    print(result.stdout + result.stderr)
+    return result.returncode
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="/tmp/trial_ur5")
+    out = Path(parser.parse_args().out)
+    out.mkdir(parents=True, exist_ok=True)
+    ref = out / "excitation.csv"
+    if not ref.exists():
+        run(["excite", str(YAML), "-o", str(ref), "--rate", "500", "--periods", "18", "-q"], out, "excite")
+    stats = {name: make_log(out, name == "loaded", ref, seed) for name, seed in (("loaded", 1), ("unloaded", 2))}
+    print(json.dumps(stats, indent=1))
+    (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
+    print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS.tolist(), "viscous", DAMPING.tolist(),
+          "rotor inertia", ARMATURE.tolist())
+    identified = out / "identified.yaml"
+    run(["identify", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv", "-o", str(identified)],
+        out, "identify")
+    run(["diagnose", str(YAML), "--params", str(identified), "--data", "loaded_fit.csv", "--select",
+         "loaded_select.csv", "--test", "loaded_test.csv", "--out", "diagnose_identified"], out, "diagnose_identified")
+    run(["diagnose", str(YAML), "--params", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv",
+         "--test", "loaded_test.csv", "--control", "unloaded_fit.csv", "--out", "diagnose_nominal"], out,
+        "diagnose_nominal")
+
+
+if __name__ == "__main__":
+    main()
