@@ -192,8 +192,8 @@ class Blocks:
         else:  # contiguous stretches of equal duration: parts[0] of them
             u = (block.t - source.t0) / max(source.t1 - source.t0, 1e-300)
             at = np.minimum((u * part[0]).astype(int), part[0] - 1)
-        p = Piece(block, slice(None), np.ascontiguousarray(Y.transpose(1, 0, 2)), np.asarray(block.tau, dtype=float),
-                  at, {})
+        # Yj joint by joint as a view, not a copy: BLAS takes the rows of one joint at their stride
+        p = Piece(block, slice(None), Y.transpose(1, 0, 2), np.asarray(block.tau, dtype=float), at, {})
         p.source, p.start = source, start
         p.coulomb = lambda smoothing, lags: source.coulomb(block, before, start, smoothing, lags)
         coulomb = p.coulomb(self.smoothing, self.lags) if any(k == "coulomb" for k, _ in self.labels) else None

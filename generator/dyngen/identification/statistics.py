@@ -38,24 +38,21 @@ MIN_BLOCKS = 10
 LAGS = 2048  # autocorrelation lags kept per recording and joint (the correlation time's sum)
 
 
-def _label_matrix(piece, labels, dof) -> np.ndarray:
-    """(T, N, L): every label's column in every joint's rows (zero where it does not enter)."""
-    out = np.zeros((piece.tau.shape[0], dof, len(labels)))
-    for k, label in enumerate(labels):
-        v = piece.columns[label]
-        if v.ndim == 2:
-            out[:, :, k] = v
-        else:
-            out[:, label[1], k] = v
-    return out
-
-
 def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int) -> list:
     """Per piece (T, N): measured less fitted torque for the values x of the columns keep."""
     full = np.zeros(r + len(labels))
     full[keep] = x
-    return [piece.tau - np.einsum("jtr,r->tj", piece.Yj, full[:r]) - _label_matrix(piece, labels, dof) @ full[r:]
-            for piece in pieces]
+    out = []
+    for piece in pieces:
+        e = piece.tau - (piece.Yj @ full[:r]).T  # one matrix-vector product per joint
+        for k in np.flatnonzero(full[r:]):
+            v, value = piece.columns[labels[k]], full[r + k]
+            if v.ndim == 2:  # the arm's label, in every joint's rows
+                e -= v * value
+            else:
+                e[:, labels[k][1]] -= v * value
+        out.append(e)
+    return out
 
 
 class _Correlation:
@@ -96,7 +93,14 @@ class _Correlation:
 def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
     """(T, c): per sample, sum over joints of a_t w_j^2 e_t (the fit's scores)."""
     we = weights ** 2 * e
-    return np.hstack([np.einsum("jtr,tj->tr", piece.Yj, we), np.einsum("tjk,tj->tk", _label_matrix(piece, labels, dof), we)])
+    out = np.empty((e.shape[0], r + len(labels)))
+    out[:, :r] = piece.Yj[0] * we[:, :1]
+    for j in range(1, dof):  # joint by joint: a sum of scaled rows, no (T, N, r) temporary
+        out[:, :r] += piece.Yj[j] * we[:, j:j + 1]
+    for k, label in enumerate(labels):
+        v = piece.columns[label]
+        out[:, r + k] = (v * we).sum(axis=1) if v.ndim == 2 else v * we[:, label[1]]
+    return out
 
 
 def _score_blocks(spilled, length: int):
