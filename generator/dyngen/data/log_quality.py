@@ -80,21 +80,86 @@ def _mapped(r: Recording, t: np.ndarray, f) -> Recording:
 def repeated_rows(r: Recording) -> np.ndarray:
     """Boolean (T,): rows that repeat the row before in every column while the positions move
     (the row after the repeats has other positions than the repeated sample)."""
-    data = _all_columns(r)
-    same = np.zeros(r.t.size, dtype=bool)
+    repeats, _ = _repeats(_all_columns(r), r.q)
+    return repeats
+
+
+def _repeats(data: np.ndarray, q: np.ndarray, before=None) -> tuple[np.ndarray, int]:
+    """(repeats as repeated_rows has them, the first row of the run of repeats at the end): a run
+    counts when the row after it has other positions than the run; a run at the very end (no row
+    after it) is kept. before: the row before data's first (a block of a longer recording)."""
+    same = np.zeros(data.shape[0], dtype=bool)
     same[1:] = np.all(data[1:] == data[:-1], axis=1)
-    if not same.any():
-        return same
-    # a run of repeats counts when the row after it has other positions (walking back, each run
-    # inherits that from its successor); a run at the very end is kept
-    moving = np.zeros(r.t.size, dtype=bool)
-    next_moves = False
-    for i in range(r.t.size - 1, 0, -1):
-        if same[i]:
-            moving[i] = next_moves
-        else:
-            next_moves = bool(np.any(r.q[i] != r.q[i - 1]))
-    return same & moving
+    if before is not None and data.shape[0]:
+        same[0] = bool(np.all(data[0] == before))
+    other = np.flatnonzero(~same)  # rows that are no repeat of the row before
+    end = int(other[-1]) + 1 if other.size else 0  # from here on, repeats with no row after them yet
+    after = other[np.minimum(np.searchsorted(other, np.arange(end), side="right"), other.size - 1)]
+    moving = np.zeros(data.shape[0], dtype=bool)  # the row after each run has other positions than the run
+    moving[:end] = np.any(q[after] != q[np.maximum(after - 1, 0)], axis=1)
+    return same & moving, end
+
+
+class Streamed:
+    """regular_samples' repeated rows for a recording read in blocks (data/chunks.py): left out
+    block by block, a run of repeats at a block's end held back until the row after it (in a later
+    block) says whether the arm moved. Held columns and jittered or uneven stamps need the whole
+    recording (interpolation over the updates, a clock fitted to all stamps): they are told in
+    one warning, not repaired.
+
+        streamed = Streamed(); for block in streamed.blocks(chunks(...)): ...; streamed.report
+    """
+
+    def __init__(self):
+        self.report, self.rows = LogReport(), 0
+
+    def blocks(self, blocks):
+        before, pending, name = None, None, ""
+        for block in blocks:
+            name = block.name
+            r = block if pending is None else _joined(pending, block)
+            data = _all_columns(r)
+            repeats, end = _repeats(data, r.q, before)
+            self.report.repeated += int(repeats[:end].sum())
+            if end:
+                keep = ~repeats[:end]
+                before, pending = data[end - 1], (_mapped(r, r.t[end:], lambda x: x[end:]) if end < r.t.size else None)
+                done = _mapped(r, r.t[:end][keep], lambda x: x[:end][keep])
+                self.rows += done.t.size
+                self._check(done)  # after the repeats are gone, as regular_samples looks at them
+                yield done
+            else:  # the block is one run of repeats: it waits, whole
+                pending = r
+        if pending is not None:  # a run at the very end is kept
+            self.rows += pending.t.size
+            yield pending
+        self._say(name)
+
+    def _check(self, block) -> None:
+        if block.t.size < 16 or self.report.warnings:
+            return
+        steps = np.diff(block.t)
+        uneven = np.max(np.abs(steps - np.median(steps))) > UNEVEN * np.median(steps)
+        held = held_blocks(block)
+        if held or uneven:
+            what = ", ".join(f"{k} updated every {v:g} rows" for k, v in held.items()) or "uneven time stamps"
+            self.report.warnings.append(f"{block.name}: {what}; read in blocks, this is not repaired (the whole-recording "
+                                        "repairs run where the recording is read whole: within --max-rows)")
+
+    def _say(self, name) -> None:
+        count = self.report.repeated
+        if count:
+            share = count / (count + self.rows)
+            self.report.notes.append(f"{count} repeated rows ({100 * share:.2g} %: the same sample written twice) left out")
+            if share > REPEATS_WORTH_SAYING:
+                self.report.warnings.insert(0, f"{name}: {count} rows ({100 * share:.2g} %) repeat the row before while "
+                                            "the arm moves (a logger writing one sample twice): left out")
+
+
+def _joined(a: Recording, b: Recording) -> Recording:
+    cat = (lambda x, y: None if x is None else np.concatenate([x, y]))
+    return dataclasses.replace(b, t=cat(a.t, b.t), q=cat(a.q, b.q), tau=cat(a.tau, b.tau), qd=cat(a.qd, b.qd),
+                               qdd=cat(a.qdd, b.qdd), extra={k: cat(a.extra[k], v) for k, v in b.extra.items()})
 
 
 def held_blocks(r: Recording) -> dict:

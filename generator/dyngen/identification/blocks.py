@@ -53,6 +53,7 @@ class Source:
     _gravity: dict = field(default_factory=dict)  # the tilt's G(q) per block (held)
     _parsed: bool = False  # the file's blocks are in the temporary folder
     _temporary: object = None  # tempfile.TemporaryDirectory: removed with the Source
+    _log: object = None  # data.log_quality.Streamed of the parse: the repeated rows left out
 
     @classmethod
     def held(cls, signals, block_rows: int = ROWS) -> "Source":
@@ -76,6 +77,9 @@ class Source:
             source.moved = source.moved or bool(np.ptp(np.r_[first.q[:1], block.q], axis=0).max() > 0)
             source.torque = source.torque or bool(np.any(block.tau))
         source.name, source.t0, source.t1 = first.name, float(first.t[0]), float(block.t[-1])
+        log = source._log.report  # what data.conditioning would say of the rows as the logger wrote them
+        source.note = "; ".join(log.notes + [source.note])
+        source.warnings += log.warnings
         return source
 
     def blocks(self):
@@ -96,6 +100,7 @@ class Source:
 
     def _file_blocks(self):
         from ..data.chunks import chunks
+        from ..data.log_quality import Streamed
 
         folder = self._folder()
         if self._parsed:
@@ -107,7 +112,9 @@ class Source:
                 yield SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
                                       qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
             return
-        for number, block in enumerate(chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic)):
+        self._log = Streamed()  # repeated rows left out as data.conditioning does
+        for number, block in enumerate(self._log.blocks(chunks(self.path, self.dof, True, (), self.block_rows,
+                                                               self.effort_topic))):
             np.save(os.path.join(folder, f"{number}.npy"), np.column_stack([block.t, block.q, block.qd, block.qdd,
                                                                             block.tau]))
             yield block
