@@ -103,9 +103,9 @@ def _repeats(data: np.ndarray, q: np.ndarray, before=None) -> tuple[np.ndarray, 
 class Streamed:
     """regular_samples' repeated rows for a recording read in blocks (data/chunks.py): left out
     block by block, a run of repeats at a block's end held back until the row after it (in a later
-    block) says whether the arm moved. Held columns and jittered or uneven stamps need the whole
-    recording (interpolation over the updates, a clock fitted to all stamps): they are told in
-    one warning, not repaired.
+    block) says whether the arm moved. Held columns and jittered stamps need the whole recording
+    (interpolation over the updates, a clock fitted to all stamps): they are told in one warning,
+    not repaired. (Uneven stamps are kept as they are without a filter, as regular_samples does.)
 
         streamed = Streamed(); for block in streamed.blocks(chunks(...)): ...; streamed.report
     """
@@ -138,11 +138,10 @@ class Streamed:
     def _check(self, block) -> None:
         if block.t.size < 16 or self.report.warnings:
             return
-        steps = np.diff(block.t)
-        uneven = np.max(np.abs(steps - np.median(steps))) > UNEVEN * np.median(steps)
         held = held_blocks(block)
-        if held or uneven:
-            what = ", ".join(f"{k} updated every {v:g} rows" for k, v in held.items()) or "uneven time stamps"
+        jitter = timeline.regular(block.t, block.q)[1]  # where conditioning would put the samples on a clock
+        if held or jitter:
+            what = ", ".join(f"{k} updated every {v:g} rows" for k, v in held.items()) or "time stamps jitter"
             self.report.warnings.append(f"{block.name}: {what}; read in blocks, this is not repaired (the whole-recording "
                                         "repairs run where the recording is read whole: within --max-rows)")
 

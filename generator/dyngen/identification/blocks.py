@@ -54,6 +54,8 @@ class Source:
     _parsed: bool = False  # the file's blocks are in the temporary folder
     _temporary: object = None  # tempfile.TemporaryDirectory: removed with the Source
     _log: object = None  # data.log_quality.Streamed of the parse: the repeated rows left out
+    _starts: list = field(default_factory=list)  # a parsed file's blocks: first data sample, samples
+    _sizes: list = field(default_factory=list)
 
     @classmethod
     def held(cls, signals, block_rows: int = ROWS) -> "Source":
@@ -104,21 +106,23 @@ class Source:
 
         folder = self._folder()
         if self._parsed:
-            for number in itertools.count():
-                path = os.path.join(folder, f"{number}.npy")
-                if not os.path.exists(path):
-                    return
-                data, n = np.load(path), self.dof
-                yield SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
-                                      qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
+            yield from map(self.block, range(len(self._starts)))
             return
         self._log = Streamed()  # repeated rows left out as data.conditioning does
         for number, block in enumerate(self._log.blocks(chunks(self.path, self.dof, True, (), self.block_rows,
                                                                self.effort_topic))):
             np.save(os.path.join(folder, f"{number}.npy"), np.column_stack([block.t, block.q, block.qd, block.qdd,
                                                                             block.tau]))
+            self._starts.append(sum(self._sizes))
+            self._sizes.append(block.t.size)
             yield block
         self._parsed = True
+
+    def block(self, number: int) -> SimpleNamespace:
+        """Block `number` of a parsed file, from the temporary folder."""
+        data, n = np.load(os.path.join(self._folder(), f"{number}.npy")), self.dof
+        return SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
+                               qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
 
     def gravity(self, number: str, make) -> np.ndarray:
         """make(), kept in the temporary folder for the next passes (the tilt's G(q): forward
@@ -188,9 +192,30 @@ class Blocks:
                 ahead = pool.submit(next, pieces, None)
                 yield piece
 
-    def fit_only(self, parts):
-        """The pieces whose samples are all in `parts` (the fit's, not the --select recordings)."""
-        return (p for p in self if np.isin(p.part, parts).all())
+    def each(self, work, workers: int = 2):
+        """work(piece) for every piece, in their order. Where every source is a parsed file, two
+        worker processes do the work (both cores on a pass: the regressor and the sums of a block
+        are most of the time); they are forked here, so they see this pass's settings and work,
+        and read their blocks from the temporary folder. Their results come back in block
+        order, so whatever the caller sums is summed as in one process."""
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        global _PASS
+        if workers < 2 or not all(s._parsed for s in self.sources) or "fork" not in multiprocessing.get_all_start_methods():
+            yield from map(work, self)
+            return
+        tasks = iter([(i, n) for i, s in enumerate(self.sources) for n in range(len(s._starts))])
+        _PASS = (self, work)
+        try:
+            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+                ahead = [pool.submit(_work_on, task) for task in itertools.islice(tasks, 2 * workers)]
+                while ahead:  # a few blocks ahead, not all: the results wait in memory
+                    done = ahead.pop(0).result()
+                    ahead += [pool.submit(_work_on, task) for task in itertools.islice(tasks, 1)]
+                    yield done
+        finally:
+            _PASS = None
 
     def piece(self, source, part, block, before, number, start) -> Piece:
         Y = self.model.batch("regressor", block.q, block.qd, block.qdd)
@@ -211,6 +236,18 @@ class Blocks:
             p.along = p.gravity @ self.along  # the hidden column of the tilt's rotation (normal.py: rotated)
         p.columns = {lab: p.column(lab, coulomb, tilted) for lab in self.labels}
         return p
+
+
+_PASS = None  # (Blocks, work) of the pass whose worker processes are forked (Blocks.each)
+
+
+def _work_on(task):
+    """In a worker process: the pass's work on block `number` of source i."""
+    blocks, work = _PASS
+    i, number = task
+    source = blocks.sources[i]
+    before = source.block(number - 1) if number else None
+    return work(blocks.piece(source, blocks.parts[i], source.block(number), before, number, source._starts[number]))
 
 
 def sources_of(recordings, block_rows: int = ROWS) -> list:

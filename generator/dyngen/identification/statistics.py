@@ -152,13 +152,20 @@ def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     labels, r = normal.labels, normal.r
     sse, correlation, spilled = 0.0, {}, []
     folder = tempfile.TemporaryDirectory(prefix="dyngen-scores-")
-    for piece in blocks.fit_only(parts):
+
+    def scored(piece):  # the residuals of a block of the fit parts, its score rows written (blocks.each)
+        if not np.isin(piece.part, parts).all():
+            return None
         e = residuals([piece], labels, r, x, keep, dof)[0]
+        at = (next(i for i, s in enumerate(blocks.sources) if s is piece.source), piece.start)
+        np.save(os.path.join(folder.name, "%d-%d.npy" % at), _score_rows(piece, labels, r, weights, e, dof)[:, keep])
+        return at, e
+
+    for at, e in filter(None, blocks.each(scored)):
         sse += float(((e * weights) ** 2).sum())
         for j in range(dof):
-            correlation.setdefault((id(piece.source), j), _Correlation()).add(e[:, j])
-        spilled.append((piece.source, piece.start, os.path.join(folder.name, f"{len(spilled)}.npy")))
-        np.save(spilled[-1][2], _score_rows(piece, labels, r, weights, e, dof)[:, keep])
+            correlation.setdefault((at[0], j), _Correlation()).add(e[:, j])
+        spilled.append((blocks.sources[at[0]], at[1], os.path.join(folder.name, "%d-%d.npy" % at)))
     sigma2 = sse / max(rows - int(strong.sum()), 1)
     textbook = np.sqrt(np.maximum(sigma2 * np.diag(inverse), 0.0))
     times = [c.time() for c in correlation.values() if c.n > 8]
