@@ -107,7 +107,10 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
     if spread.rows <= max_rows:
         return Sampled(spread.windows(first.name), spread.rows, seconds, None)
     gap = sums.result(first.name, True) if sums is not None else gap_run(task)  # the latter: read whole
-    return Sampled(spread.windows(first.name), spread.rows, seconds, gap)
+    windows = spread.windows(first.name)
+    for w in windows if local else ():
+        w.stream = task  # the diagnosis' final fit reads every row of it (diagnosis/pipeline.py every_row)
+    return Sampled(windows, spread.rows, seconds, gap)
 
 
 def _part(r, mask):
