@@ -103,12 +103,8 @@ def _repeats(data: np.ndarray, q: np.ndarray, before=None) -> tuple[np.ndarray, 
 class Streamed:
     """regular_samples' repeated rows for a recording read in blocks (data/chunks.py): left out
     block by block, a run of repeats at a block's end held back until the row after it (in a later
-    block) says whether the arm moved. Held columns and jittered stamps need the whole recording
-    (interpolation over the updates, a clock fitted to all stamps): they are told in one warning,
-    not repaired. (Uneven stamps are kept as they are without a filter, as regular_samples does.)
-
-        streamed = Streamed(); for block in streamed.blocks(chunks(...)): ...; streamed.report
-    """
+    block) says whether the arm moved. Held columns and jittered stamps need the whole recording:
+    they are told in one warning, not repaired. Use: for block in streamed.blocks(chunks(...))."""
 
     def __init__(self):
         self.report, self.rows = LogReport(), 0
@@ -116,43 +112,40 @@ class Streamed:
     def blocks(self, blocks):
         before, pending, name = None, None, ""
         for block in blocks:
-            name = block.name
-            r = block if pending is None else _joined(pending, block)
+            name, r = block.name, (block if pending is None else _joined(pending, block))
             data = _all_columns(r)
             repeats, end = _repeats(data, r.q, before)
             self.report.repeated += int(repeats[:end].sum())
+            pending = _mapped(r, r.t[end:], lambda x: x[end:]) if end < r.t.size else None
             if end:
-                keep = ~repeats[:end]
-                before, pending = data[end - 1], (_mapped(r, r.t[end:], lambda x: x[end:]) if end < r.t.size else None)
+                before, keep = data[end - 1], ~repeats[:end]
                 done = _mapped(r, r.t[:end][keep], lambda x: x[:end][keep])
                 self.rows += done.t.size
-                self._check(done)  # after the repeats are gone, as regular_samples looks at them
+                self._check(done)  # without the repeats, as regular_samples looks at them
                 yield done
-            else:  # the block is one run of repeats: it waits, whole
-                pending = r
         if pending is not None:  # a run at the very end is kept
             self.rows += pending.t.size
             yield pending
-        self._say(name)
+        _say_repeats(self.report, name, self.rows)
 
     def _check(self, block) -> None:
         if block.t.size < 16 or self.report.warnings:
             return
-        held = held_blocks(block)
-        jitter = timeline.regular(block.t, block.q)[1]  # where conditioning would put the samples on a clock
+        held, jitter = held_blocks(block), timeline.regular(block.t, block.q)[1]
         if held or jitter:
             what = ", ".join(f"{k} updated every {v:g} rows" for k, v in held.items()) or "time stamps jitter"
             self.report.warnings.append(f"{block.name}: {what}; read in blocks, this is not repaired (the whole-recording "
                                         "repairs run where the recording is read whole: within --max-rows)")
 
-    def _say(self, name) -> None:
-        count = self.report.repeated
-        if count:
-            share = count / (count + self.rows)
-            self.report.notes.append(f"{count} repeated rows ({100 * share:.2g} %: the same sample written twice) left out")
-            if share > REPEATS_WORTH_SAYING:
-                self.report.warnings.insert(0, f"{name}: {count} rows ({100 * share:.2g} %) repeat the row before while "
-                                            "the arm moves (a logger writing one sample twice): left out")
+
+def _say_repeats(report: LogReport, name: str, kept: int) -> None:
+    if report.repeated:
+        share = report.repeated / (report.repeated + kept)
+        report.notes.insert(0, f"{report.repeated} repeated rows ({100 * share:.2g} %: the same sample written twice) "
+                            "left out")
+        if share > REPEATS_WORTH_SAYING:
+            report.warnings.insert(0, f"{name}: {report.repeated} rows ({100 * share:.2g} %) repeat the row before "
+                                   "while the arm moves (a logger writing one sample twice): left out")
 
 
 def _joined(a: Recording, b: Recording) -> Recording:
@@ -192,12 +185,7 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
     if repeats.any():
         report.repeated = int(repeats.sum())
         r = _mapped(r, r.t[~repeats], lambda x: x[~repeats])
-        share = report.repeated / (report.repeated + r.t.size)
-        report.notes.append(f"{report.repeated} repeated rows ({100 * share:.2g} %: the same sample written twice) "
-                            "left out")
-        if share > REPEATS_WORTH_SAYING:
-            report.warnings.append(f"{r.name}: {report.repeated} rows ({100 * share:.2g} %) repeat the row before "
-                                   "while the arm moves (a logger writing one sample twice): left out")
+        _say_repeats(report, r.name, r.t.size)
     held = held_blocks(r)
     for name, every in held.items():
         setattr(r, name, _unheld(r.t, getattr(r, name)))

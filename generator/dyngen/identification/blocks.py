@@ -174,30 +174,15 @@ class Blocks:
         self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
 
     def __iter__(self):
-        """The next block's piece is made in a second thread while this one's is used (reading,
-        the C regressor and NumPy release the GIL: two cores on a pass); the order, and so every
-        sum, is that of one thread."""
-        from concurrent.futures import ThreadPoolExecutor
-
-        def made():
-            for source, part in zip(self.sources, self.parts):
-                source._coulomb.clear()
-                for block, before, number, start in source.blocks():
-                    yield self.piece(source, part, block, before, number, start)
-
-        pieces = made()
-        with ThreadPoolExecutor(1) as pool:
-            ahead = pool.submit(next, pieces, None)
-            while (piece := ahead.result()) is not None:
-                ahead = pool.submit(next, pieces, None)
-                yield piece
+        for source, part in zip(self.sources, self.parts):
+            source._coulomb.clear()
+            for block, before, number, start in source.blocks():
+                yield self.piece(source, part, block, before, number, start)
 
     def each(self, work, workers: int = 2):
-        """work(piece) for every piece, in their order. Where every source is a parsed file, two
-        worker processes do the work (both cores on a pass: the regressor and the sums of a block
-        are most of the time); they are forked here, so they see this pass's settings and work,
-        and read their blocks from the temporary folder. Their results come back in block
-        order, so whatever the caller sums is summed as in one process."""
+        """work(piece) for every piece, in order: for parsed files in two worker processes (both
+        cores), forked now so that they see this pass's settings, reading their blocks from the
+        temporary folder; in block order, so what the caller sums is summed as in one process."""
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
