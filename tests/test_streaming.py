@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from dyngen.data import Conditioning, condition, read_recording
-from dyngen.data.chunks import chunks, whole
+from dyngen.data.chunks import chunks
+from dyngen.data.recording import Recording
 from dyngen.errors import InputError
 from dyngen.identification import identify
 from dyngen.identification.samples import REGRESSOR
@@ -32,6 +33,16 @@ LWR = ROOT / "examples" / "lwr.yaml"
 FOLDER = ROOT / "generated" / "lwr"
 N = 7
 ENCODER = 2 * np.pi / 2 ** 20  # a 20-bit encoder step [rad]
+
+
+def whole(path, dof: int, **kw) -> Recording:
+    """The blocks joined: what read_recording returns."""
+    pieces = list(chunks(path, dof, **kw))
+    first = pieces[0]
+    cat = (lambda xs: None if xs[0] is None else np.concatenate(xs))
+    return Recording(first.name, cat([p.t for p in pieces]), cat([p.q for p in pieces]),
+                     cat([p.tau for p in pieces]), cat([p.qd for p in pieces]), cat([p.qdd for p in pieces]),
+                     {k: cat([p.extra[k] for p in pieces]) for k in first.extra})
 
 
 @pytest.fixture(scope="module")

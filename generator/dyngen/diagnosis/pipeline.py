@@ -189,14 +189,9 @@ def _final_fit(robot, model, p, context, settled, choice, separate_selection) ->
 
 
 def _streams(segments) -> list:
-    """The tasks (streaming.gap.GapTask) of the long recordings whose windows (streaming/sample.py)
-    the segments are, once each."""
-    out = []
-    for seg in segments:
-        task = getattr(getattr(seg.signals, "source", None), "stream", None)
-        if task is not None and task not in out:
-            out.append(task)
-    return out
+    """The long recordings (streaming.gap.GapTask) whose windows (streaming/sample.py) the segments are."""
+    tasks = [getattr(getattr(seg.signals, "source", None), "stream", None) for seg in segments]
+    return [task for k, task in enumerate(tasks) if task is not None and task not in tasks[:k]]
 
 
 def every_row(context, chosen, tasks, size: int) -> dz.Moments:

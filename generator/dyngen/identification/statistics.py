@@ -45,12 +45,10 @@ def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int)
     out = []
     for piece in pieces:
         e = piece.tau - (piece.Yj @ full[:r]).T  # one matrix-vector product per joint
-        for k in np.flatnonzero(full[r:]):
-            v, value = piece.columns[labels[k]], full[r + k]
-            if v.ndim == 2:  # the arm's label, in every joint's rows
-                e -= v * value
-            else:
-                e[:, labels[k][1]] -= v * value
+        for k in np.flatnonzero(full[r:]):  # a joint's label in its own rows, the arm's in every joint's
+            v = piece.columns[labels[k]]
+            rows = e if v.ndim == 2 else e[:, labels[k][1]]  # a view: subtracted in place
+            rows -= v * full[r + k]
         out.append(e)
     return out
 
