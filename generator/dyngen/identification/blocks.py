@@ -30,8 +30,10 @@ import numpy as np
 
 from ..terms import tilt
 from .columns import Piece, coulomb_matrix
+from .identify_options import LAG_GRID
 
 ROWS = 8192  # samples per block (7 joints x 50 regressor columns of them: 23 MB)
+BEFORE = 1024  # rows of the block before that a worker reads (1 s at 1 kHz): enough for any lag of LAG_GRID
 _IDENTIFICATIONS = itertools.count()
 
 
@@ -118,9 +120,10 @@ class Source:
             yield block
         self._parsed = True
 
-    def block(self, number: int) -> SimpleNamespace:
-        """Block `number` of a parsed file, from the temporary folder."""
-        data, n = np.load(os.path.join(self._folder(), f"{number}.npy")), self.dof
+    def block(self, number: int, last: int | None = None) -> SimpleNamespace:
+        """Block `number` of a parsed file, from the temporary folder (last: its last rows only)."""
+        data, n = np.load(os.path.join(self._folder(), f"{number}.npy"), mmap_mode="r" if last else None), self.dof
+        data = np.array(data[-last:]) if last else data
         return SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
                                qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
 
@@ -231,7 +234,10 @@ def _work_on(task):
     blocks, work = _PASS
     i, number = task
     source = blocks.sources[i]
-    before = source.block(number - 1) if number else None
+    # the Coulomb column's lag (at most LAG_GRID's 40 ms) reaches into the block before: its last rows suffice
+    before = source.block(number - 1, last=BEFORE) if number else None
+    if before is not None and before.t[-1] - before.t[0] <= max(LAG_GRID):  # a fast recording: all of it
+        before = source.block(number - 1)
     return work(blocks.piece(source, blocks.parts[i], source.block(number), before, number, source._starts[number]))
 
 
