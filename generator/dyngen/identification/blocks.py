@@ -190,7 +190,8 @@ class Blocks:
         from concurrent.futures import ProcessPoolExecutor
 
         global _PASS
-        if workers < 2 or not all(s._parsed for s in self.sources) or "fork" not in multiprocessing.get_all_start_methods():
+        if workers < 2 or not all(s._parsed for s in self.sources) or "fork" not in multiprocessing.get_all_start_methods() \
+                or multiprocessing.current_process().daemon:  # a pool's worker may not start processes
             yield from map(work, self)
             return
         tasks = iter([(i, n) for i, s in enumerate(self.sources) for n in range(len(s._starts))])
