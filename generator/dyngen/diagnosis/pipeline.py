@@ -189,8 +189,10 @@ def _final_fit(robot, model, p, context, settled, choice, separate_selection) ->
 
 
 def _streams(segments) -> list:
-    """The long recordings (streaming.gap.GapTask) whose windows (streaming/sample.py) the segments are."""
-    tasks = [getattr(getattr(seg.signals, "source", None), "stream", None) for seg in segments]
+    """The long recordings (streaming.gap.GapTask) whose windows (streaming/sample.py) the segments
+    are, where the windows kept their columns as recorded (trust.py may have filtered them since)."""
+    tasks = [getattr(getattr(seg.signals, "source", None), "stream", None) if seg.signals.lowpass is None else None
+             for seg in segments]
     return [task for k, task in enumerate(tasks) if task is not None and task not in tasks[:k]]
 
 
