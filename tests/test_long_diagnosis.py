@@ -57,6 +57,14 @@ def test_long_recording_diagnosed_on_windows_with_the_gap_over_every_sample(tmp_
     # the windows' diagnosis finds the sensor's offset
     offset = [e for e in doc["selected"] if e["effect"] == "offset" and e["joints"] == [3]]
     assert offset and abs(offset[0]["values"]["b"] - 1.5) < 0.1
+    # chosen alone on J3, its value is set by every row (the final fit reads the file again in blocks):
+    # the least squares of a constant, the gap's mean over the whole recording, not over the windows
+    assert [e["effect"] for e in doc["selected"] if 3 in e["joints"]] == ["offset"]
+    assert abs(offset[0]["values"]["b"] - gap[:, 2].mean()) < 1e-9
+    in_windows = np.zeros(r.t.size, dtype=bool)
+    for start in starts:
+        in_windows |= (r.t - r.t[0] >= start) & (r.t - r.t[0] < start + 6.0)
+    assert abs(gap[in_windows, 2].mean() - gap[:, 2].mean()) > 1e-5  # the windows alone would not give it
     assert "## Long recordings: diagnosed on a sample" in (tmp_path / "d" / "report.md").read_text()
 
 

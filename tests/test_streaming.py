@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from dyngen.data import Conditioning, condition, read_recording
-from dyngen.data.chunks import chunks, whole
+from dyngen.data.chunks import chunks
+from dyngen.data.recording import Recording
 from dyngen.errors import InputError
 from dyngen.identification import identify
 from dyngen.identification.samples import REGRESSOR
@@ -32,6 +33,16 @@ LWR = ROOT / "examples" / "lwr.yaml"
 FOLDER = ROOT / "generated" / "lwr"
 N = 7
 ENCODER = 2 * np.pi / 2 ** 20  # a 20-bit encoder step [rad]
+
+
+def whole(path, dof: int, **kw) -> Recording:
+    """The blocks joined: what read_recording returns."""
+    pieces = list(chunks(path, dof, **kw))
+    first = pieces[0]
+    cat = (lambda xs: None if xs[0] is None else np.concatenate(xs))
+    return Recording(first.name, cat([p.t for p in pieces]), cat([p.q for p in pieces]),
+                     cat([p.tau for p in pieces]), cat([p.qd for p in pieces]), cat([p.qdd for p in pieces]),
+                     {k: cat([p.extra[k] for p in pieces]) for k in first.extra})
 
 
 @pytest.fixture(scope="module")
@@ -98,6 +109,41 @@ def test_blocks_equal_the_in_memory_fit(tmp_path, model, kind):
         sigma2 = np.sum((b - Y @ x) ** 2) / (b.size - Y.shape[1])
         assert np.allclose(streamed.estimate.std, np.sqrt(sigma2 * np.diag(np.linalg.inv(Y.T @ Y))), rtol=1e-5)
         assert streamed.estimate.condition == pytest.approx(np.linalg.cond(Y), rel=1e-6)
+
+
+def test_repeated_rows_split_across_block_edges_are_left_out_as_in_memory(tmp_path, model):
+    """A logger that wrote samples twice: a run of two copies starting at the first row of the
+    second block of 97, and a copy that is the last row of a block (whether it counts depends on
+    the next block's first row). Read in blocks, the rows are the clean recording's, exactly (the
+    oracle: the rows before they were copied), as conditioning the whole file gives them; the
+    least squares in blocks is the in-memory fit of the clean recording."""
+    from dyngen.identification.blocks import Source
+
+    clean = write_robot(tmp_path / "clean.csv", seed=5)
+    lines = clean.read_text().splitlines()
+    rows = lines[1:]
+
+    def copy(row, later):  # the same sample, stamped `later` seconds after it when written again
+        t, rest = row.split(",", 1)
+        return f"{float(t) + later!r},{rest}"
+
+    # data rows 97, 98 repeat row 96 (block 2 begins with them); row 193 (the end of block 2) repeats row 192
+    logged = rows[:97] + [copy(rows[96], 1e-3), copy(rows[96], 2e-3)] + rows[97:191] + [copy(rows[190], 2e-3)] + rows[191:]
+    assert len(logged) > 3 * 97
+    dup = tmp_path / "logged.csv"
+    dup.write_text("\n".join([lines[0]] + logged) + "\n")
+    truth = read_recording(clean, N)
+    source = Source.of_file(dup, N, block_rows=97)
+    got = [b for b, *_ in source.blocks()]
+    for column in ("t", "q", "qd", "qdd", "tau"):
+        np.testing.assert_array_equal(np.concatenate([getattr(b, column) for b in got]), getattr(truth, column))
+    assert source.rows == truth.t.size and "3 repeated rows" in source.note
+    whole_file = condition(read_recording(dup, N))
+    np.testing.assert_array_equal(whole_file.q, truth.q)
+    assert whole_file.note == source.note
+    streamed = identify_recordings([task(dup)], names_of(model, "full"), workers=1)
+    assert streamed.sums[0].streamed and streamed.sums[0].samples == truth.t.size
+    same_estimate(streamed.estimate, identify(model, [condition(truth)], "full"))
 
 
 def test_conditioning_of_the_whole_recording_when_blocks_cannot_do_it(tmp_path, model):

@@ -25,7 +25,7 @@ from ..errors import InputError
 from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
-from .recording import Recording, _check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line
+from .recording import _check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -152,13 +152,3 @@ def _parquet_blocks(path, rows: int):
     yield header
     for start, data in batches:
         yield start, data, columnar.parquet_row
-
-
-def whole(path, dof: int, **kw) -> Recording:
-    """The blocks joined: what read_recording returns (for tests of the two readers)."""
-    pieces = list(chunks(path, dof, **kw))
-    first = pieces[0]
-    cat = (lambda xs: None if xs[0] is None else np.concatenate(xs))
-    return Recording(first.name, cat([p.t for p in pieces]), cat([p.q for p in pieces]),
-                     cat([p.tau for p in pieces]), cat([p.qd for p in pieces]), cat([p.qdd for p in pieces]),
-                     {k: cat([p.extra[k] for p in pieces]) for k in first.extra})

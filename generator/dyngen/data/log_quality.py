@@ -80,21 +80,78 @@ def _mapped(r: Recording, t: np.ndarray, f) -> Recording:
 def repeated_rows(r: Recording) -> np.ndarray:
     """Boolean (T,): rows that repeat the row before in every column while the positions move
     (the row after the repeats has other positions than the repeated sample)."""
-    data = _all_columns(r)
-    same = np.zeros(r.t.size, dtype=bool)
+    repeats, _ = _repeats(_all_columns(r), r.q)
+    return repeats
+
+
+def _repeats(data: np.ndarray, q: np.ndarray, before=None) -> tuple[np.ndarray, int]:
+    """(repeats as repeated_rows has them, the first row of the run of repeats at the end): a run
+    counts when the row after it has other positions than the run; a run at the very end (no row
+    after it) is kept. before: the row before data's first (a block of a longer recording)."""
+    same = np.zeros(data.shape[0], dtype=bool)
     same[1:] = np.all(data[1:] == data[:-1], axis=1)
-    if not same.any():
-        return same
-    # a run of repeats counts when the row after it has other positions (walking back, each run
-    # inherits that from its successor); a run at the very end is kept
-    moving = np.zeros(r.t.size, dtype=bool)
-    next_moves = False
-    for i in range(r.t.size - 1, 0, -1):
-        if same[i]:
-            moving[i] = next_moves
-        else:
-            next_moves = bool(np.any(r.q[i] != r.q[i - 1]))
-    return same & moving
+    if before is not None and data.shape[0]:
+        same[0] = bool(np.all(data[0] == before))
+    other = np.flatnonzero(~same)  # rows that are no repeat of the row before
+    end = int(other[-1]) + 1 if other.size else 0  # from here on, repeats with no row after them yet
+    after = other[np.minimum(np.searchsorted(other, np.arange(end), side="right"), other.size - 1)]
+    moving = np.zeros(data.shape[0], dtype=bool)  # the row after each run has other positions than the run
+    moving[:end] = np.any(q[after] != q[np.maximum(after - 1, 0)], axis=1)
+    return same & moving, end
+
+
+class Streamed:
+    """regular_samples' repeated rows for a recording read in blocks (data/chunks.py): left out
+    block by block, a run of repeats at a block's end held back until the row after it (in a later
+    block) says whether the arm moved. Held columns and jittered stamps need the whole recording:
+    they are told in one warning, not repaired. Use: for block in streamed.blocks(chunks(...))."""
+
+    def __init__(self):
+        self.report, self.rows = LogReport(), 0
+
+    def blocks(self, blocks):
+        before, pending, name = None, None, ""
+        for block in blocks:
+            name, r = block.name, (block if pending is None else _joined(pending, block))
+            data = _all_columns(r)
+            repeats, end = _repeats(data, r.q, before)
+            self.report.repeated += int(repeats[:end].sum())
+            pending = _mapped(r, r.t[end:], lambda x: x[end:]) if end < r.t.size else None
+            if end:
+                before, keep = data[end - 1], ~repeats[:end]
+                done = _mapped(r, r.t[:end][keep], lambda x: x[:end][keep])
+                self.rows += done.t.size
+                self._check(done)  # without the repeats, as regular_samples looks at them
+                yield done
+        if pending is not None:  # a run at the very end is kept
+            self.rows += pending.t.size
+            yield pending
+        _say_repeats(self.report, name, self.rows)
+
+    def _check(self, block) -> None:
+        if block.t.size < 16 or self.report.warnings:
+            return
+        held, jitter = held_blocks(block), timeline.regular(block.t, block.q)[1]
+        if held or jitter:
+            what = ", ".join(f"{k} updated every {v:g} rows" for k, v in held.items()) or "time stamps jitter"
+            self.report.warnings.append(f"{block.name}: {what}; read in blocks, this is not repaired (the whole-recording "
+                                        "repairs run where the recording is read whole: within --max-rows)")
+
+
+def _say_repeats(report: LogReport, name: str, kept: int) -> None:
+    if report.repeated:
+        share = report.repeated / (report.repeated + kept)
+        report.notes.insert(0, f"{report.repeated} repeated rows ({100 * share:.2g} %: the same sample written twice) "
+                            "left out")
+        if share > REPEATS_WORTH_SAYING:
+            report.warnings.insert(0, f"{name}: {report.repeated} rows ({100 * share:.2g} %) repeat the row before "
+                                   "while the arm moves (a logger writing one sample twice): left out")
+
+
+def _joined(a: Recording, b: Recording) -> Recording:
+    cat = (lambda x, y: None if x is None else np.concatenate([x, y]))
+    return dataclasses.replace(b, t=cat(a.t, b.t), q=cat(a.q, b.q), tau=cat(a.tau, b.tau), qd=cat(a.qd, b.qd),
+                               qdd=cat(a.qdd, b.qdd), extra={k: cat(a.extra[k], v) for k, v in b.extra.items()})
 
 
 def held_blocks(r: Recording) -> dict:
@@ -128,12 +185,7 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
     if repeats.any():
         report.repeated = int(repeats.sum())
         r = _mapped(r, r.t[~repeats], lambda x: x[~repeats])
-        share = report.repeated / (report.repeated + r.t.size)
-        report.notes.append(f"{report.repeated} repeated rows ({100 * share:.2g} %: the same sample written twice) "
-                            "left out")
-        if share > REPEATS_WORTH_SAYING:
-            report.warnings.append(f"{r.name}: {report.repeated} rows ({100 * share:.2g} %) repeat the row before "
-                                   "while the arm moves (a logger writing one sample twice): left out")
+        _say_repeats(report, r.name, r.t.size)
     held = held_blocks(r)
     for name, every in held.items():
         setattr(r, name, _unheld(r.t, getattr(r, name)))

@@ -30,8 +30,10 @@ import numpy as np
 
 from ..terms import tilt
 from .columns import Piece, coulomb_matrix
+from .identify_options import LAG_GRID
 
 ROWS = 8192  # samples per block (7 joints x 50 regressor columns of them: 23 MB)
+BEFORE = 1024  # rows of the block before that a worker reads (1 s at 1 kHz): enough for any lag of LAG_GRID
 _IDENTIFICATIONS = itertools.count()
 
 
@@ -53,6 +55,9 @@ class Source:
     _gravity: dict = field(default_factory=dict)  # the tilt's G(q) per block (held)
     _parsed: bool = False  # the file's blocks are in the temporary folder
     _temporary: object = None  # tempfile.TemporaryDirectory: removed with the Source
+    _log: object = None  # data.log_quality.Streamed of the parse: the repeated rows left out
+    _starts: list = field(default_factory=list)  # a parsed file's blocks: first data sample, samples
+    _sizes: list = field(default_factory=list)
 
     @classmethod
     def held(cls, signals, block_rows: int = ROWS) -> "Source":
@@ -76,6 +81,9 @@ class Source:
             source.moved = source.moved or bool(np.ptp(np.r_[first.q[:1], block.q], axis=0).max() > 0)
             source.torque = source.torque or bool(np.any(block.tau))
         source.name, source.t0, source.t1 = first.name, float(first.t[0]), float(block.t[-1])
+        log = source._log.report  # what data.conditioning would say of the rows as the logger wrote them
+        source.note = "; ".join(log.notes + [source.note])
+        source.warnings += log.warnings
         return source
 
     def blocks(self):
@@ -96,22 +104,28 @@ class Source:
 
     def _file_blocks(self):
         from ..data.chunks import chunks
+        from ..data.log_quality import Streamed
 
         folder = self._folder()
         if self._parsed:
-            for number in itertools.count():
-                path = os.path.join(folder, f"{number}.npy")
-                if not os.path.exists(path):
-                    return
-                data, n = np.load(path), self.dof
-                yield SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
-                                      qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
+            yield from map(self.block, range(len(self._starts)))
             return
-        for number, block in enumerate(chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic)):
+        self._log = Streamed()  # repeated rows left out as data.conditioning does
+        for number, block in enumerate(self._log.blocks(chunks(self.path, self.dof, True, (), self.block_rows,
+                                                               self.effort_topic))):
             np.save(os.path.join(folder, f"{number}.npy"), np.column_stack([block.t, block.q, block.qd, block.qdd,
                                                                             block.tau]))
+            self._starts.append(sum(self._sizes))
+            self._sizes.append(block.t.size)
             yield block
         self._parsed = True
+
+    def block(self, number: int, last: int | None = None) -> SimpleNamespace:
+        """Block `number` of a parsed file, from the temporary folder (last: its last rows only)."""
+        data, n = np.load(os.path.join(self._folder(), f"{number}.npy"), mmap_mode="r" if last else None), self.dof
+        data = np.array(data[-last:]) if last else data
+        return SimpleNamespace(t=data[:, 0], q=data[:, 1:1 + n], qd=data[:, 1 + n:1 + 2 * n],
+                               qdd=data[:, 1 + 2 * n:1 + 3 * n], tau=data[:, 1 + 3 * n:])
 
     def gravity(self, number: str, make) -> np.ndarray:
         """make(), kept in the temporary folder for the next passes (the tilt's G(q): forward
@@ -163,27 +177,34 @@ class Blocks:
         self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
 
     def __iter__(self):
-        """The next block's piece is made in a second thread while this one's is used (reading,
-        the C regressor and NumPy release the GIL: two cores on a pass); the order, and so every
-        sum, is that of one thread."""
-        from concurrent.futures import ThreadPoolExecutor
+        for source, part in zip(self.sources, self.parts):
+            source._coulomb.clear()
+            for block, before, number, start in source.blocks():
+                yield self.piece(source, part, block, before, number, start)
 
-        def made():
-            for source, part in zip(self.sources, self.parts):
-                source._coulomb.clear()
-                for block, before, number, start in source.blocks():
-                    yield self.piece(source, part, block, before, number, start)
+    def each(self, work, workers: int = 2):
+        """work(piece) for every piece, in order: for parsed files in two worker processes (both
+        cores), forked now so that they see this pass's settings, reading their blocks from the
+        temporary folder; in block order, so what the caller sums is summed as in one process."""
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
 
-        pieces = made()
-        with ThreadPoolExecutor(1) as pool:
-            ahead = pool.submit(next, pieces, None)
-            while (piece := ahead.result()) is not None:
-                ahead = pool.submit(next, pieces, None)
-                yield piece
-
-    def fit_only(self, parts):
-        """The pieces whose samples are all in `parts` (the fit's, not the --select recordings)."""
-        return (p for p in self if np.isin(p.part, parts).all())
+        global _PASS
+        if workers < 2 or not all(s._parsed for s in self.sources) or "fork" not in multiprocessing.get_all_start_methods() \
+                or multiprocessing.current_process().daemon:  # a pool's worker may not start processes
+            yield from map(work, self)
+            return
+        tasks = iter([(i, n) for i, s in enumerate(self.sources) for n in range(len(s._starts))])
+        _PASS = (self, work)
+        try:
+            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+                ahead = [pool.submit(_work_on, task) for task in itertools.islice(tasks, 2 * workers)]
+                while ahead:  # a few blocks ahead, not all: the results wait in memory
+                    done = ahead.pop(0).result()
+                    ahead += [pool.submit(_work_on, task) for task in itertools.islice(tasks, 1)]
+                    yield done
+        finally:
+            _PASS = None
 
     def piece(self, source, part, block, before, number, start) -> Piece:
         Y = self.model.batch("regressor", block.q, block.qd, block.qdd)
@@ -192,8 +213,8 @@ class Blocks:
         else:  # contiguous stretches of equal duration: parts[0] of them
             u = (block.t - source.t0) / max(source.t1 - source.t0, 1e-300)
             at = np.minimum((u * part[0]).astype(int), part[0] - 1)
-        p = Piece(block, slice(None), np.ascontiguousarray(Y.transpose(1, 0, 2)), np.asarray(block.tau, dtype=float),
-                  at, {})
+        # Yj joint by joint as a view, not a copy: BLAS takes the rows of one joint at their stride
+        p = Piece(block, slice(None), Y.transpose(1, 0, 2), np.asarray(block.tau, dtype=float), at, {})
         p.source, p.start = source, start
         p.coulomb = lambda smoothing, lags: source.coulomb(block, before, start, smoothing, lags)
         coulomb = p.coulomb(self.smoothing, self.lags) if any(k == "coulomb" for k, _ in self.labels) else None
@@ -204,6 +225,21 @@ class Blocks:
             p.along = p.gravity @ self.along  # the hidden column of the tilt's rotation (normal.py: rotated)
         p.columns = {lab: p.column(lab, coulomb, tilted) for lab in self.labels}
         return p
+
+
+_PASS = None  # (Blocks, work) of the pass whose worker processes are forked (Blocks.each)
+
+
+def _work_on(task):
+    """In a worker process: the pass's work on block `number` of source i."""
+    blocks, work = _PASS
+    i, number = task
+    source = blocks.sources[i]
+    # the Coulomb column's lag (at most LAG_GRID's 40 ms) reaches into the block before: its last rows suffice
+    before = source.block(number - 1, last=BEFORE) if number else None
+    if before is not None and before.t[-1] - before.t[0] <= max(LAG_GRID):  # a fast recording: all of it
+        before = source.block(number - 1)
+    return work(blocks.piece(source, blocks.parts[i], source.block(number), before, number, source._starts[number]))
 
 
 def sources_of(recordings, block_rows: int = ROWS) -> list:

@@ -174,7 +174,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     if ks and options.smoothing is None:
         make = _at(dof, lambda v: v, lambda v: 0.0)
         swaps = Swaps(labels, r, parts, dof, ks, [lambda p, v=v: make(p, v) for v in SMOOTHING_GRID], int(with_tilt))
-    normal = Normal.build(blocks, labels, r, parts, dof, swaps.add if swaps else None, int(with_tilt))
+    normal = Normal.build(blocks, labels, r, parts, dof, swaps, int(with_tilt))
     smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof, swaps)
 
     # 3. noise per joint, weights; columns the data cannot separate

@@ -59,31 +59,48 @@ class Normal:
         self.n = np.zeros((parts, dof))
 
     @classmethod
-    def build(cls, pieces, labels, r: int, parts: int, dof: int, each=None, hidden: int = 0) -> "Normal":
-        """each(piece): also called on every piece (another sum of the same pass)."""
+    def build(cls, pieces, labels, r: int, parts: int, dof: int, swaps=None, hidden: int = 0) -> "Normal":
+        """swaps (Swaps): also summed in the same pass. Each block's sums are made on their own
+        (Blocks.each: in worker processes) and added here in block order: every entry gets the
+        same additions in the same order as in one process."""
         out = cls(r, labels, parts, dof, hidden)
-        for piece in pieces:
-            if each is not None:
-                each(piece)
-            for j in range(dof):
-                ks, idx = local_columns(labels, r, j, hidden)
-                A = joint_design(piece, labels, j, ks)
-                if hidden:
-                    A = np.hstack([A, piece.along[:, j:j + 1]])
-                b = piece.tau[:, j]
-                for p, sl in segments(piece.part):
-                    Am, bm = A[sl], b[sl]
-                    out.G[p, j][np.ix_(idx, idx)] += Am.T @ Am
-                    out.g[p, j][idx] += Am.T @ bm
-                    out.bb[p, j] += bm @ bm
-                    out.n[p, j] += bm.size
+
+        def of_block(piece):
+            own = cls(r, labels, parts, dof, hidden)
+            own.add(piece)
+            return own, None if swaps is None else swaps.of_block(piece)
+
+        for own, swapped in (pieces.each(of_block) if hasattr(pieces, "each") else map(of_block, pieces)):
+            out.G += own.G
+            out.g += own.g
+            out.bb += own.bb
+            out.n += own.n
+            if swapped is not None:
+                swaps.rows += swapped[0]
+                swaps.g += swapped[1]
         return out
 
-    def swapped(self, pieces, ks, makes) -> list["Normal"]:
-        """Per variant, self with the Coulomb columns ks those of makes[v] (Swaps), in one pass over the pieces."""
+    def add(self, piece) -> None:
+        r, labels, hidden = self.r, self.labels, self.hidden
+        for j in range(self.dof):
+            ks, idx = local_columns(labels, r, j, hidden)
+            A = joint_design(piece, labels, j, ks)
+            if hidden:
+                A = np.hstack([A, piece.along[:, j:j + 1]])
+            b = piece.tau[:, j]
+            for p, sl in segments(piece.part):
+                Am, bm = A[sl], b[sl]
+                self.G[p, j][np.ix_(idx, idx)] += Am.T @ Am
+                self.g[p, j][idx] += Am.T @ bm
+                self.bb[p, j] += bm @ bm
+                self.n[p, j] += bm.size
+
+    def swapped(self, blocks, ks, makes) -> list["Normal"]:
+        """Per variant, self with the Coulomb columns ks those of makes[v] (Swaps), in one pass over the blocks."""
         swaps = Swaps(self.labels, self.r, self.G.shape[0], self.dof, ks, makes, self.hidden)
-        for piece in pieces:
-            swaps.add(piece)
+        for rows, g in blocks.each(swaps.of_block):
+            swaps.rows += rows
+            swaps.g += g
         return swaps.normals(self)
 
     def _with(self, G, g) -> "Normal":
@@ -140,6 +157,12 @@ class Swaps:
         self.labels, self.r, self.ks, self.makes, self.hidden = labels, r, ks, makes, hidden
         self.rows = np.zeros((len(makes), parts, dof, r + len(labels) + hidden))
         self.g = np.zeros((len(makes), parts, dof))
+
+    def of_block(self, piece) -> tuple:
+        """(rows, g) of the piece alone."""
+        own = Swaps(self.labels, self.r, self.rows.shape[1], self.rows.shape[2], self.ks, self.makes, self.hidden)
+        own.add(piece)
+        return own.rows, own.g
 
     def add(self, piece) -> None:
         values = [make(piece) for make in self.makes]

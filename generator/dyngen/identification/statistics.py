@@ -38,24 +38,19 @@ MIN_BLOCKS = 10
 LAGS = 2048  # autocorrelation lags kept per recording and joint (the correlation time's sum)
 
 
-def _label_matrix(piece, labels, dof) -> np.ndarray:
-    """(T, N, L): every label's column in every joint's rows (zero where it does not enter)."""
-    out = np.zeros((piece.tau.shape[0], dof, len(labels)))
-    for k, label in enumerate(labels):
-        v = piece.columns[label]
-        if v.ndim == 2:
-            out[:, :, k] = v
-        else:
-            out[:, label[1], k] = v
-    return out
-
-
 def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int) -> list:
     """Per piece (T, N): measured less fitted torque for the values x of the columns keep."""
     full = np.zeros(r + len(labels))
     full[keep] = x
-    return [piece.tau - np.einsum("jtr,r->tj", piece.Yj, full[:r]) - _label_matrix(piece, labels, dof) @ full[r:]
-            for piece in pieces]
+    out = []
+    for piece in pieces:
+        e = piece.tau - (piece.Yj @ full[:r]).T  # one matrix-vector product per joint
+        for k in np.flatnonzero(full[r:]):  # a joint's label in its own rows, the arm's in every joint's
+            v = piece.columns[labels[k]]
+            rows = e if v.ndim == 2 else e[:, labels[k][1]]  # a view: subtracted in place
+            rows -= v * full[r + k]
+        out.append(e)
+    return out
 
 
 class _Correlation:
@@ -96,7 +91,14 @@ class _Correlation:
 def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
     """(T, c): per sample, sum over joints of a_t w_j^2 e_t (the fit's scores)."""
     we = weights ** 2 * e
-    return np.hstack([np.einsum("jtr,tj->tr", piece.Yj, we), np.einsum("tjk,tj->tk", _label_matrix(piece, labels, dof), we)])
+    out = np.empty((e.shape[0], r + len(labels)))
+    out[:, :r] = piece.Yj[0] * we[:, :1]
+    for j in range(1, dof):  # joint by joint: a sum of scaled rows, no (T, N, r) temporary
+        out[:, :r] += piece.Yj[j] * we[:, j:j + 1]
+    for k, label in enumerate(labels):
+        v = piece.columns[label]
+        out[:, r + k] = (v * we).sum(axis=1) if v.ndim == 2 else v * we[:, label[1]]
+    return out
 
 
 def _score_blocks(spilled, length: int):
@@ -148,13 +150,20 @@ def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     labels, r = normal.labels, normal.r
     sse, correlation, spilled = 0.0, {}, []
     folder = tempfile.TemporaryDirectory(prefix="dyngen-scores-")
-    for piece in blocks.fit_only(parts):
+
+    def scored(piece):  # the residuals of a block of the fit parts, its score rows written (blocks.each)
+        if not np.isin(piece.part, parts).all():
+            return None
         e = residuals([piece], labels, r, x, keep, dof)[0]
+        at = (next(i for i, s in enumerate(blocks.sources) if s is piece.source), piece.start)
+        np.save(os.path.join(folder.name, "%d-%d.npy" % at), _score_rows(piece, labels, r, weights, e, dof)[:, keep])
+        return at, e
+
+    for at, e in filter(None, blocks.each(scored)):
         sse += float(((e * weights) ** 2).sum())
         for j in range(dof):
-            correlation.setdefault((id(piece.source), j), _Correlation()).add(e[:, j])
-        spilled.append((piece.source, piece.start, os.path.join(folder.name, f"{len(spilled)}.npy")))
-        np.save(spilled[-1][2], _score_rows(piece, labels, r, weights, e, dof)[:, keep])
+            correlation.setdefault((at[0], j), _Correlation()).add(e[:, j])
+        spilled.append((blocks.sources[at[0]], at[1], os.path.join(folder.name, "%d-%d.npy" % at)))
     sigma2 = sse / max(rows - int(strong.sum()), 1)
     textbook = np.sqrt(np.maximum(sigma2 * np.diag(inverse), 0.0))
     times = [c.time() for c in correlation.values() if c.n > 8]

@@ -76,12 +76,13 @@ class Sums:
 def run(task: GapTask) -> Gap:
     from ..data import condition, read_recording
     from ..data.chunks import chunks
+    from ..data.log_quality import Streamed
 
     sums = Sums.start(_model(task.folder), task.p, task.dof)
     blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
     first = next(blocks)
     if _local(first, task.conditioning):
-        for piece in itertools.chain([first], blocks):  # one block at a time, never all
+        for piece in Streamed().blocks(itertools.chain([first], blocks)):  # one block at a time, repeats left out
             sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
         return sums.result(first.name, True)
     blocks.close()

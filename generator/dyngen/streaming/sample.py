@@ -90,6 +90,7 @@ def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window:
 
 def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> Sampled:
     from ..data.chunks import chunks
+    from ..data.log_quality import Streamed
 
     blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
     first = next(blocks)
@@ -97,7 +98,8 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
     model = _model(task.folder)
     sums = Sums.start(model, task.p, task.dof) if local else None
     spread = Spread(max_rows, window)
-    for piece in itertools.chain([first], blocks):  # one block at a time, and the windows kept
+    rows = Streamed().blocks(itertools.chain([first], blocks)) if local else itertools.chain([first], blocks)
+    for piece in rows:  # one block at a time (repeated rows left out as conditioning does), and the windows kept
         spread.add(piece)
         if sums is not None:
             sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
@@ -105,7 +107,10 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
     if spread.rows <= max_rows:
         return Sampled(spread.windows(first.name), spread.rows, seconds, None)
     gap = sums.result(first.name, True) if sums is not None else gap_run(task)  # the latter: read whole
-    return Sampled(spread.windows(first.name), spread.rows, seconds, gap)
+    windows = spread.windows(first.name)
+    for w in windows if local else ():
+        w.stream = task  # the diagnosis' final fit reads every row of it (diagnosis/pipeline.py every_row)
+    return Sampled(windows, spread.rows, seconds, gap)
 
 
 def _part(r, mask):

@@ -65,6 +65,7 @@ def _local(first, conditioning) -> bool:
 def run(task: Task) -> Sums:
     from ..data import condition, read_recording
     from ..data.chunks import chunks
+    from ..data.log_quality import Streamed
 
     model = _model(task.folder)
     need_tau = task.kind != "inertia"
@@ -81,9 +82,11 @@ def run(task: Task) -> Sums:
         samples += q.shape[0]
 
     if _local(first, task.conditioning):
-        for piece in itertools.chain([first], blocks):  # one block at a time, never all
+        log = Streamed()  # repeated rows left out as data.conditioning does
+        for piece in log.blocks(itertools.chain([first], blocks)):  # one block at a time, never all
             add(piece.q, piece.qd, piece.qdd, piece.tau, piece.extra)
-        return Sums(first.name, factors, samples, "qd, qdd as recorded, no filter", True)
+        note = "; ".join(log.report.notes + ["qd, qdd as recorded, no filter"])
+        return Sums(first.name, factors, samples, note, True, log.report.warnings)
     blocks.close()
     s = condition(read_recording(task.path, task.dof, need_tau, task.required, task.effort_topic),
                   task.conditioning)
