@@ -9,12 +9,13 @@ times the arm's own inertia about the joint (median M_jj; a reflected rotor iner
 ten times a wrist link's own); an offset or ripple amplitude above the measured torque's RMS on
 its joint (a term making up for another); a Coulomb lag or smoothing at the last value of its
 grid (options.LAG_GRID, SMOOTHING_GRID: a bound, not a finding; the lag grid is not widened,
-docs/measured-data.md says why). The simple model (terms/simple_model.py, fitted to the prior's
-residual on the fit data) and the identified model are both judged on the --select recordings,
-which neither fitted; where the simple model predicts better, the result predicts that joint by
-the prior's rigid body and the simple model's three values (Consistent.simple, `simple_model:`
-in the YAML), as the diagnosis does (diagnosis/joints.py), and a warning names it. Without
---select nothing held out exists, and the table says so.
+docs/measured-data.md says why), and the prior's weight at the last of REGULARISATION_GRID.
+The simple model (terms/simple_model.py, fitted to the prior's residual on the fit data) and the
+identified model are both judged on the --select recordings, which neither fitted; where the
+simple model predicts better, the result predicts that joint by the prior's rigid body and the
+simple model's three values (Consistent.simple, `simple_model:` in the YAML), as the diagnosis
+does (diagnosis/joints.py), and a warning names it. Without --select nothing held out exists,
+and the table says so.
 """
 
 from __future__ import annotations
@@ -75,6 +76,10 @@ def ranges(robot, model, c, fit) -> list[str]:
         if c.smoothing[j] >= SMOOTHING_GRID[-1] and np.nan_to_num(f["coulomb"][j]) > 0:
             out.append(f"joint {j + 1}: the Coulomb smoothing {c.smoothing[j]:.3g} rad/s is the last of its search grid: "
                        "a bound, not a finding")
+    tried = [x for x, _ in c.selection]
+    if len(tried) > 1 and c.regularisation >= max(tried):  # held-out data asked for the most prior tried
+        out.append(f"the prior's weight {c.regularisation:g}, chosen on held-out data, is the last of its search grid: "
+                   "a bound, the data determine the links poorly")
     return out
 
 
