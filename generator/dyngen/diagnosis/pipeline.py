@@ -192,18 +192,9 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
                               final.correlation_samples)
     claimed = [i for i, c in enumerate(final.chosen) if i not in flagged or c.joint in replaced]
-    if choice.reidentified is not None:
-        explained = across.explained_by_links(
-            final.context, choice.segments, reidentify.link_corrections(choice.reidentified, model, choice.segments),
-            settled.design, settled.chosen, min_gain)
-        why = (f"the re-identified links' rigid body explains them: beside it each gains less than {min_gain:g} of the "
-               "selection data's mean square")
-    else:  # not re-identified by default, the fit data do not determine it: a gain, payload or gravity scale on
-        # the joints whose leftover the rigid body's columns explain cannot be told from wrong link parameters
-        hint = {j + 1 for j in choice.links_hint} if choice.precision is not None else set()
-        explained = [i for i, c in enumerate(final.chosen) if c.effect.name in across.DIFFERS
-                     and hint & set(final.findings[i].joints)]
-        why = "they act on joints whose leftover the rigid body's own columns explain; see the next warning"
+    explained = [] if choice.reidentified is None else across.explained_by_links(
+        final.context, choice.segments, reidentify.link_corrections(choice.reidentified, model, choice.segments),
+        settled.design, settled.chosen, min_gain)
     explained = [i for i in explained if final.chosen[i].joint not in replaced]  # those are superseded anyway
     selected, superseded = reported([final.chosen[i] for i in claimed if i not in explained],
                                     [final.findings[i] for i in claimed if i not in explained], replaced)
@@ -213,7 +204,9 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     fit_signals = roles_of[0][1]
     selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
     if explained:
-        apart.append(f"not told apart from the link parameters being off ({why}), so not claimed: "
+        apart.append("not told apart from the link parameters being off (the re-identified links' rigid body explains "
+                     f"them: beside it each gains less than {min_gain:g} of the selection data's mean square), so not "
+                     "claimed: "
                      + "; ".join(final.chosen[i].effect.name + ("" if final.chosen[i].joint is None else
                                  f" on joint {final.chosen[i].joint + 1}") for i in explained)
                      + ("; a payload is a change of the last link's parameters: a control run without it (--control) "
