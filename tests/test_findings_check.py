@@ -87,8 +87,9 @@ def _command(folder, run, control, out):
     Table V, `control`'s Fourier excitation as the control run; diagnosis.json."""
     r = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--params", str(folder / "params.yaml"),
                         "--model", str(ROOT / "generated" / "lwr"), "-q", "--data", str(folder / f"{run}.fit.csv"),
-                        "--test", str(folder / f"{run}.holdout.csv"), "--control", str(folder / f"{control}.fit.csv"),
-                        "--out", str(out)], capture_output=True, text=True, timeout=900,
+                        "--test", str(folder / f"{run}.holdout.csv"), "--out", str(out),
+                        *(["--control", str(folder / f"{control}.fit.csv")] if control else [])],
+                       capture_output=True, text=True, timeout=900,
                        env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
     assert r.returncode == 0, r.stderr
     return json.loads((out / "diagnosis.json").read_text())
@@ -98,11 +99,15 @@ def test_a_control_run_finds_the_payload_only_where_it_is(pair, tmp_path):
     """`diagnose --control`, default options (the Fourier excitation excites the link parameters,
     so the re-identification runs): both runs say that the link parameters are off (link 3 moves
     joints 2 and 3) and claim no gain, friction or ripple for them; the loaded run's payload, which
-    its re-identified links alone cannot tell apart, is told apart by the unloaded control run and
-    claimed within 10 %; the unloaded run, with the loaded one as its control, claims none."""
+    its re-identified links alone cannot tell apart (without a control run it is not claimed), is
+    told apart by the unloaded control run and claimed within 10 %; the unloaded run, with the
+    loaded one as its control, claims none."""
     folder, _, _ = pair
     docs = {run: _command(folder, run, control, tmp_path / run)
             for run, control in (("loaded", "unloaded"), ("unloaded", "loaded"))}
+    alone = _command(folder, "loaded", None, tmp_path / "alone")  # no control: not told apart from link 7 off
+    assert not any(e["effect"] == "payload" for e in alone["selected"])
+    assert any(e["effect"] == "payload" and e["suspect"].startswith("not told apart") for e in alone["superseded"])
     for run, d in docs.items():
         assert {2, 3} <= set(d["link_parameters_off"]["joints"]), run
         assert any(w.startswith("link parameters off") for w in d["warnings"]), run
