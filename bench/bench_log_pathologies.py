@@ -146,6 +146,12 @@ def report(results, by_key, logs, args, seconds) -> str:
     if details:
         lines += ["", "Runs that did not pass:", "", "| log | case | fit on | outcome | below the torques | why |",
                   "|---|---|---|---|---|---|", *details]
+    # the out-of-scope cases are never counted, but what they claim beside their verdict is listed
+    outside = [f"| {log} | {r['case']} | {r['direction']} | {r['why'] or '-'} |" for log in logs
+               for r in results[log] if r["case"] in OUT_OF_SCOPE]
+    if outside:
+        lines += ["", "Out of scope, not counted (the whole verdict):", "", "| log | case | fit on | why |",
+                  "|---|---|---|---|", *outside]
     return "\n".join(lines) + "\n"
 
 

@@ -9,9 +9,14 @@ offsets (+0.3 Nm on joint 1, -0.25 Nm on joint 6) were injected, nothing is flag
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from conftest import ROOT
 
 from dyngen.data import condition, read_recording
@@ -55,43 +60,79 @@ def test_injected_offsets_are_not_flagged():
     assert not any("make up for each other" in w for w in d.warnings)
 
 
-def test_an_unloaded_and_loaded_pair_with_a_link_off(tmp_path):
+@pytest.fixture(scope="module")
+def pair(tmp_path_factory):
     """The LWR in MuJoCo with link 3's mass, first moments and inertia 10 % above the model's
     (tests/simulation/withheld_cases.py, 200 Hz, 20-bit encoder positions, 0.05 Nm torque noise),
-    once without and once with the 1.5 kg payload. With default options (the Fourier excitation
-    excites the link parameters, so the re-identification runs) the payload is found only where
-    it is (within 5 %), and both runs say that the link parameters are off instead of naming
-    a gain, friction or ripple for them; with --no-reidentify both warn that the link
-    parameters may be off (the re-identification's gate), and compared with the unloaded run as
-    its control (diagnosis/across.py, `dyngen diagnose --control`) every finding of the loaded
-    run that the unloaded run has too is reported as the model's error, the payload not."""
-    from dyngen.diagnosis.across import DIFFERS, compared
-
+    once without and once with the 1.5 kg payload; the model (params.yaml) is the nominal one."""
+    from dyngen.extraction.report import links_yaml
     from simulation.mujoco_measurements import Effects, Encoder
     from simulation.withheld_cases import PAYLOAD, Case, case_files, nominal_model, trajectories
 
-    robot, model = load_robot(LWR), load(ROOT / "generated" / "lwr")
+    folder = tmp_path_factory.mktemp("pair")
+    robot = load_robot(LWR)
     p_model = nominal_model(robot)
     p_true = p_model.copy()
     p_true[20:30] *= 1.10
     trajs = trajectories(robot, 200.0)
-    found, plain_runs = {}, {}
     for k, case in enumerate([Case("unloaded"), Case("loaded", Effects(payload=PAYLOAD))]):
         for name, text in case_files(case, k, robot, p_true, trajs, 0.05, 0, Encoder()).items():
-            (tmp_path / name).write_text(text)
-        fit, test = (condition(read_recording(tmp_path / f"{case.name}.{r}.csv", 7)) for r in ("fit", "holdout"))
+            (folder / name).write_text(text)
+    (folder / "params.yaml").write_text(f"robot: {robot.name}\nsolution:\n" + links_yaml(p_model))
+    return folder, robot, p_model
+
+
+def _command(folder, run, control, out):
+    """`dyngen diagnose` with default options: fit on `run`'s Fourier excitation, test on its
+    Table V, `control`'s Fourier excitation as the control run; diagnosis.json."""
+    r = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--params", str(folder / "params.yaml"),
+                        "--model", str(ROOT / "generated" / "lwr"), "-q", "--data", str(folder / f"{run}.fit.csv"),
+                        "--test", str(folder / f"{run}.holdout.csv"), "--out", str(out),
+                        *(["--control", str(folder / f"{control}.fit.csv")] if control else [])],
+                       capture_output=True, text=True, timeout=900,
+                       env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
+    assert r.returncode == 0, r.stderr
+    return json.loads((out / "diagnosis.json").read_text())
+
+
+def test_a_control_run_finds_the_payload_only_where_it_is(pair, tmp_path):
+    """`diagnose --control`, default options (the Fourier excitation excites the link parameters,
+    so the re-identification runs): both runs say that the link parameters are off (link 3 moves
+    joints 2 and 3) and claim no gain, friction or ripple for them; the loaded run's payload, which
+    its re-identified links alone cannot tell apart (without a control run it is not claimed), is
+    told apart by the unloaded control run and claimed within 10 %; the unloaded run, with the
+    loaded one as its control, claims none."""
+    folder, _, _ = pair
+    docs = {run: _command(folder, run, control, tmp_path / run)
+            for run, control in (("loaded", "unloaded"), ("unloaded", "loaded"))}
+    alone = _command(folder, "loaded", None, tmp_path / "alone")  # no control: not told apart from link 7 off
+    assert not any(e["effect"] == "payload" for e in alone["selected"])
+    assert any(e["effect"] == "payload" and e["suspect"].startswith("not told apart") for e in alone["superseded"])
+    for run, d in docs.items():
+        assert {2, 3} <= set(d["link_parameters_off"]["joints"]), run
+        assert any(w.startswith("link parameters off") for w in d["warnings"]), run
+        assert not any(e["effect"] in ("coulomb", "ripple", "gain") for e in d["selected"]), (run, d["selected"])
+        assert np.all(np.array(d["rms_after"]) < 0.05), (run, d["rms_after"])  # the noise is 0.05 Nm before filtering
+    assert not any(e["effect"] == "payload" for e in docs["unloaded"]["selected"])
+    (payload,) = [e for e in docs["loaded"]["selected"] if e["effect"] == "payload"]
+    assert abs(payload["values"]["m"] - 1.5) < 0.15 and "suspect" not in payload
+
+
+def test_an_unloaded_and_loaded_pair_without_the_reidentification(pair):
+    """With --no-reidentify both runs warn that the link parameters may be off (the
+    re-identification's gate), and compared with the unloaded run as its control
+    (diagnosis/across.py, `dyngen diagnose --control`) every finding of the loaded run that the
+    unloaded run has too is reported as the model's error, the payload not."""
+    from dyngen.diagnosis.across import DIFFERS, compared
+
+    folder, robot, p_model = pair
+    model = load(ROOT / "generated" / "lwr")
+    plain_runs = {}
+    for name in ("unloaded", "loaded"):
+        fit, test = (condition(read_recording(folder / f"{name}.{r}.csv", 7)) for r in ("fit", "holdout"))
         plain = diagnose(robot, model, p_model, [fit], None, Options(reidentify=False), test=[test])
-        assert any(w.startswith("the link parameters may be off") for w in plain.warnings), case.name
-        plain_runs[case.name] = plain
-        d = diagnose(robot, model, p_model, [fit], None, test=[test])
-        found[case.name] = d
-        assert d.consistent and {2, 3} <= set(d.consistent.joints), case.name
-        assert any(w.startswith("link parameters off") for w in d.warnings)
-        assert not any(e.effect in ("coulomb", "ripple", "gain") for e in d.selected), case.name
-        assert np.all(np.array(d.rms_after) < 0.05), (case.name, d.rms_after)  # the noise is 0.05 Nm before filtering
-    assert not any(e.effect == "payload" for e in found["unloaded"].selected)
-    payload = next(e for e in found["loaded"].selected if e.effect == "payload")
-    assert abs(payload.values["m"] - 1.5) < 0.075
+        assert any(w.startswith("the link parameters may be off") for w in plain.warnings), name
+        plain_runs[name] = plain
     loaded = compared(plain_runs["loaded"], plain_runs["unloaded"], "unloaded.fit.csv")
     shared = {(e.effect, e.joints) for e in plain_runs["unloaded"].selected}
     for e in loaded.selected:  # the unloaded run has no gain, payload or gravity scale here

@@ -106,3 +106,47 @@ def test_a_joint_the_simple_model_predicts_better_gets_it(case, tmp_path):
     rms = {k: float(np.sqrt(np.mean((sig.tau[keep, 5] - _joint_torque(doc, model, sig, 5, k)[keep]) ** 2)))
            for k in (True, False)}
     assert rms[True] < 0.7 * rms[False], rms
+
+
+def test_the_issue_values_are_each_named(case):
+    """The issue's joint 7 as identify once reported it on this case, each value put into the
+    true model in turn (sanity.ranges on the fit data): a rotor inertia of 0.121 kg m^2 (24 x the
+    simulated 0.005), an offset and a ripple (never simulated) of the joint's whole measured
+    torque and more, a 40 ms Coulomb lag (the last of its grid), and the prior's weight at the
+    last value of its grid are each named; the true values alone are not (nothing is flagged)."""
+    from types import SimpleNamespace
+
+    from dyngen.identification.identify_options import LAG_GRID, REGULARISATION_GRID, SMOOTHING_GRID
+    from dyngen.identification.sanity import ranges
+
+    folder, truth = case
+    robot, model = load_robot(LWR), load(ROOT / "generated" / "lwr")
+    fit = [condition(read_recording(folder / "fit.csv", robot.dof))]
+    tau7 = float(np.sqrt(np.mean(fit[0].tau[fit[0].inner(), 6] ** 2)))
+
+    def flagged(**change):
+        friction = {k: np.array([truth["friction"].get(k, {}).get(j + 1, np.nan) for j in range(7)])
+                    for k in ("coulomb", "viscous", "armature", "offset", "ripple_cos", "ripple_sin")}
+        lags, regularisation = np.zeros(7), REGULARISATION_GRID[1]
+        for key, value in change.items():
+            if key == "lag":
+                lags[6] = value
+            elif key == "regularisation":
+                regularisation = value
+            else:
+                friction[key][6] = value
+        c = SimpleNamespace(p=truth["p_true"], friction=friction, lags=lags, smoothing=np.full(7, SMOOTHING_GRID[1]),
+                            regularisation=regularisation, selection=[(x, 1.0) for x in REGULARISATION_GRID])
+        return ranges(robot, model, c, fit)
+
+    assert flagged() == []
+    (line,) = flagged(armature=0.121)
+    assert line.startswith("joint 7: rotor inertia 0.121 kg m^2") and "outside its physical range" in line
+    (line,) = flagged(offset=1.2 * tau7)
+    assert line.startswith("joint 7: offset")
+    (line,) = flagged(ripple_cos=tau7, ripple_sin=tau7)
+    assert line.startswith("joint 7: position ripple")
+    (line,) = flagged(lag=LAG_GRID[-1])
+    assert line.startswith("joint 7: the Coulomb lag 40 ms is the last of its search grid")
+    (line,) = flagged(regularisation=REGULARISATION_GRID[-1])
+    assert "the last of its search grid" in line and "prior" in line

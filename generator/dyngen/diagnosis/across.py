@@ -1,9 +1,12 @@
-"""A gain, a payload or a scaled gravity (DIFFERS) may be the nominal model's error: where the
-re-identified link parameters won joints (reidentify.py), one that gains less than min_gain of
-the selection data's mean square beside them, alone on what they leave, is explained by them:
-not told apart from the link parameters being off, so not claimed (explained_by_links). And a
-run is compared with a control run of the same arm without what is looked for (e.g. unloaded
-beside loaded):
+"""Effects that may be the nominal model's error rather than findings.
+
+Where the re-identified link parameters won joints (reidentify.py), every effect that gains less
+than min_gain of the selection data's mean square beside their rigid body alone (their friction,
+offsets, rotor inertias and tilt left out: those are the arm's own), fitted alone to what the
+re-identified links leave, is explained by them: not told apart from the link parameters being
+off, so not claimed (explained_by_links; a payload, a rotor inertia on joint 1 and a gain are
+all changes the links can make). And a run is compared with a control run of the same arm
+without what is looked for (e.g. unloaded beside loaded):
 
     result = compared(result, control, "unloaded.csv")
 
@@ -12,8 +15,11 @@ the control run's findings is not a sensor or payload finding: it appears with a
 differs between the runs, so it is the nominal model's error (wrong link parameters, most
 often). It is marked suspect with that reason and one warning names all such findings. What the
 arm carries in both runs (friction, rotor inertia, offsets, ripple, a tilt) is expected in both
-and stays as it is, as does a payload absent from the control run. The control run is diagnosed apart, with the same options
-(commands/diagnose.py --control); nothing of it enters the result's figures.
+and stays as it is. A payload that the run's re-identified links explain (superseded, LINKS) and
+that the control run has nowhere, neither claimed nor explained, is told apart by the control:
+it is what differs between the runs, and it is claimed again. The control run is diagnosed
+apart, with the same options (commands/diagnose.py --control); nothing of it enters the result's
+figures.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from .forward_selection import selection_gain, selection_mse
 from .refine import restricted
 
 DIFFERS = ("gain", "payload", "gravity_scale")
+LINKS = "not told apart from the link parameters being off"
 
 
 def _key(finding) -> tuple:
@@ -31,8 +38,9 @@ def _key(finding) -> tuple:
 
 
 def compared(result, control, control_name: str):
-    """result with the findings also found in `control` (a Diagnosis) marked suspect and one
-    warning naming them, or unchanged when none is."""
+    """result with the findings also found in `control` (a Diagnosis) marked suspect, a payload
+    its links explain that the control run lacks claimed again, and one warning for each; or
+    unchanged when neither happens."""
     seen = {_key(e) for e in control.selected}
     both, selected = [], []
     for e in result.selected:
@@ -43,21 +51,29 @@ def compared(result, control, control_name: str):
                       "sensor or a payload")
             e = replace(e, suspect=reason + (f"; {e.suspect}" if e.suspect else ""))
         selected.append(e)
-    if not both:
+    apart = [e for e in result.superseded if e.effect == "payload" and e.suspect == LINKS
+             and not any(c.effect == "payload" for c in [*control.selected, *control.superseded])]
+    warnings = [*result.warnings]
+    if both:
+        warnings.append(f"found also in the control run {control_name}, so the nominal model's error (wrong link "
+                        f"parameters, most often), not a sensor or payload finding: {'; '.join(both)}")
+    if apart:
+        warnings.append(f"payload: told apart from the link parameters by the control run {control_name}, which has "
+                        "none: claimed")
+    if not both and not apart:
         return result
-    line = (f"found also in the control run {control_name}, so the nominal model's error (wrong link parameters, most "
-            f"often), not a sensor or payload finding: {'; '.join(both)}")
-    return replace(result, selected=selected, warnings=[*result.warnings, line])
+    return replace(result, selected=selected + [replace(e, suspect="") for e in apart],
+                   superseded=[e for e in result.superseded if all(e is not a for a in apart)], warnings=warnings)
 
 
-def explained_by_links(context, segments, consistent, design, chosen, min_gain) -> list[int]:
-    """Indices of the chosen DIFFERS effects that gain less than min_gain on the selection
-    samples of the residual the re-identified model leaves (consistent: per segment its correction)."""
-    left = [replace(seg, residual=seg.residual - c) for seg, c in zip(segments, consistent)]
+def explained_by_links(context, segments, links, design, chosen, min_gain) -> list[int]:
+    """Indices of the chosen effects that gain less than min_gain on the selection samples of
+    the residual the re-identified links leave (links: per segment their rigid body's
+    correction, reidentify.link_corrections)."""
+    left = [replace(seg, residual=seg.residual - c) for seg, c in zip(segments, links)]
     out = []
     for i, c in enumerate(chosen):
-        if c.effect.name in DIFFERS:
-            alone, (one,) = restricted(context, left, design, [c])
-            if selection_gain(one, selection_mse(alone, []), selection_mse(alone, [one])) < min_gain:
-                out.append(i)
+        alone, (one,) = restricted(context, left, design, [c])
+        if selection_gain(one, selection_mse(alone, []), selection_mse(alone, [one])) < min_gain:
+            out.append(i)
     return out

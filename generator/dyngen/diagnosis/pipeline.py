@@ -235,23 +235,25 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
                               final.correlation_samples)
     claimed = [i for i, c in enumerate(final.chosen) if i not in flagged or c.joint in replaced]
-    explained = [] if choice.consistent is None else across.explained_by_links(
-        final.context, choice.segments, choice.consistent, settled.design, settled.chosen, min_gain)
-    links = [i for i in explained if final.chosen[i].effect.name != "payload"]  # a payload is told apart by --control
-    selected, superseded = reported([final.chosen[i] for i in claimed if i not in links],
-                                    [final.findings[i] for i in claimed if i not in links], replaced)
+    explained = [] if choice.reidentified is None else across.explained_by_links(
+        final.context, choice.segments, reidentify.link_corrections(choice.reidentified, model, choice.segments),
+        settled.design, settled.chosen, min_gain)
+    explained = [i for i in explained if final.chosen[i].joint not in replaced]  # those are superseded anyway
+    selected, superseded = reported([final.chosen[i] for i in claimed if i not in explained],
+                                    [final.findings[i] for i in claimed if i not in explained], replaced)
     unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed))]
-    superseded += [final.findings[i] for i in links if i in claimed]
+    superseded += [replace(final.findings[i], suspect=across.LINKS) for i in explained if i in claimed]
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
     fit_signals = roles_of[0][1]
     selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
     if explained:
-        apart.append("not told apart from the link parameters being off (the re-identified links explain them: beside "
-                     f"them each gains less than {min_gain:g} of the selection data's mean square): "
+        apart.append("not told apart from the link parameters being off (the re-identified links' rigid body explains "
+                     f"them: beside it each gains less than {min_gain:g} of the selection data's mean square), so not "
+                     "claimed: "
                      + "; ".join(final.chosen[i].effect.name + ("" if final.chosen[i].joint is None else
-                                 f" on joint {final.chosen[i].joint + 1}") + (": not claimed" if i in links else ": kept (a payload is a change "
-                                 "of the last link's parameters; a control run without it, --control, tells them apart)")
-                                 for i in explained))
+                                 f" on joint {final.chosen[i].joint + 1}") for i in explained)
+                     + ("; a payload is a change of the last link's parameters: a control run without it (--control) "
+                        "tells them apart" if any(final.chosen[i].effect.name == "payload" for i in explained) else ""))
     if choice.links_hint:
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in choice.links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "

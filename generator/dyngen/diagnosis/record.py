@@ -104,7 +104,7 @@ class Diagnosis:
     steps: list
     dropped: list  # selected forward, then dropped as not significant (correlated residual)
     refused: list[Refusal]  # selected, then refused: implausible values once fitted with the others
-    superseded: list[Finding]  # per-joint effects on joints the simple model won
+    superseded: list[Finding]  # per-joint effects on joints another model won; effects not told apart from wrong links (suspect)
     unstable: list[Unstable]  # selected, kept in the model, but not claimed: unstable across blocks
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
     warnings: list = field(default_factory=list)

@@ -135,6 +135,14 @@ def corrections(result, model, segments) -> list:
     return [result.predict(model, seg.signals) - seg.tau_model for seg in segments]
 
 
+def link_corrections(result, model, segments) -> list:
+    """Per segment (T, N): the re-identified links' rigid-body torque less the diagnosed model's
+    (the consistent model without its friction, offsets, rotor inertias and tilt: what wrong
+    link parameters alone make)."""
+    return [model.batch("regressor", seg.signals.q, seg.signals.qd, seg.signals.qdd) @ result.pi - seg.tau_model
+            for seg in segments]
+
+
 def finding(robot, result, joints: list) -> LinksOff:
     """The finding: joints where the consistent parameters won, and the parameters."""
     from ..parameters import PER_LINK

@@ -156,9 +156,13 @@ def markdown(d, sources: dict) -> str:
                   "without this effect (all other selected effects kept), on its joint (per-joint effects) or summed "
                   "over joints (arm-wide effects). Standard deviations "
                   f"are scaled for the residual's correlation in time ({d.correlation_samples:.0f} samples).", ""]
-    if d.superseded:
-        lines += ["Not kept (the simple model did better on these joints' selection data): "
-                  + ", ".join(f"{e.effect} on joint {e.joints[0]}" for e in d.superseded) + ".", ""]
+    beaten = [e for e in d.superseded if not e.suspect]  # the others: not told apart from wrong links (across.LINKS)
+    if beaten:
+        lines += ["Not kept (another model did better on these joints' selection data): "
+                  + ", ".join(_named(e) for e in beaten) + ".", ""]
+    if len(beaten) < len(d.superseded):
+        lines += ["Not claimed, not told apart from the link parameters being off (see the warnings): "
+                  + ", ".join(_named(e) for e in d.superseded if e.suspect) + ".", ""]
     if d.unstable:
         lines += ["Unstable across blocks, so not claimed (kept in the model): "
                   + "; ".join(f"{_named(u.finding)}: {u.reason}" for u in d.unstable) + ".", ""]

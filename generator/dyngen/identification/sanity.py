@@ -1,6 +1,6 @@
 """Identification sanity: every identified value inside its physical range (warnings; the
-values are kept), every search that ended at its grid's edge named (a bound, not a finding; the
-lag grid is not widened, docs/measured-data.md says why), and the result's prediction beside
+values are kept), every search that ended at its grid's edge named (the Coulomb lag and smoothing, the
+prior's weight: a bound, not a finding; the lag grid is not widened, docs/measured-data.md says why), and the result's prediction beside
 the simple model's on the --select recordings, which neither fitted. Where the simple model
 predicts a joint better, the result predicts it as the diagnosis does (diagnosis/joints.py):
 the prior's rigid body and the simple model's three values (Consistent.simple).
@@ -66,6 +66,10 @@ def ranges(robot, model, c, fit) -> list[str]:
         if c.smoothing[j] >= SMOOTHING_GRID[-1] and np.nan_to_num(f["coulomb"][j]) > 0:
             out.append(f"joint {j + 1}: the Coulomb smoothing {c.smoothing[j]:.3g} rad/s is the last of its search grid: "
                        "a bound, not a finding")
+    tried = [x for x, _ in c.selection]
+    if len(tried) > 1 and c.regularisation >= max(tried):  # held-out data asked for the most prior tried
+        out.append(f"the prior's weight {c.regularisation:g}, chosen on held-out data, is the last of its search grid: "
+                   "a bound, the data determine the links poorly")
     return out
 
 
