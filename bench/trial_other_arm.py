@@ -20,7 +20,7 @@ are written below, so the trial does not share the project's own assumptions abo
   0.7-8.8 ms.
 - Fit / select / test: the log cut by time into its first 60 %, the next 20 % and the last 20 %.
 
-    python bench/trial_other_arm.py [--out /tmp/trial_ur5]
+    python bench/trial_other_arm.py [--out /tmp/trial_ur5] [--tree GENERATOR_DIR] [--commands-only]
 
 prints the log's statistics, runs `dyngen identify` and `dyngen diagnose` (defaults) and prints
 what they said beside the truth. Seeds are fixed; the log is the same on every run.
@@ -86,7 +86,7 @@ def reference(path: Path):
     return data[:, 0], data[:, 1:7], data[:, 7:13], data[:, 13:19]
 
 
-def simulate(payload: bool, ref_path: Path, seed: int):
+def simulate(payload: bool, ref_path: Path):
     """The robot's published states: time, true q, applied torque (before the sensors)."""
     model = mujoco.MjModel.from_xml_string(arm_xml(payload))
     model.opt.timestep = SIM_DT
@@ -95,12 +95,11 @@ def simulate(payload: bool, ref_path: Path, seed: int):
     t_ref, q_ref, qd_ref, qdd_ref = reference(ref_path)
     steps = int(round(t_ref[-1] / SIM_DT))
     data.qpos[:] = q_ref[0]
+    t_sim = np.arange(steps + 1) * SIM_DT
+    wanted = [np.column_stack([np.interp(t_sim, t_ref, x[:, j]) for j in range(6)]) for x in (q_ref, qd_ref, qdd_ref)]
     ts, qs, taus = [], [], []
-    for k in range(steps + 1):
-        t = k * SIM_DT
-        qr = np.array([np.interp(t, t_ref, q_ref[:, j]) for j in range(6)])
-        vr = np.array([np.interp(t, t_ref, qd_ref[:, j]) for j in range(6)])
-        ar = np.array([np.interp(t, t_ref, qdd_ref[:, j]) for j in range(6)])
+    for k, t in enumerate(t_sim):
+        qr, vr, ar = wanted[0][k], wanted[1][k], wanted[2][k]
         ff.qpos[:], ff.qvel[:], ff.qacc[:] = qr, vr, ar
         mujoco.mj_inverse(nominal, ff)
         tau = ff.qfrc_inverse + KP * (qr - data.qpos) + KD * (vr - data.qvel)
@@ -143,7 +142,7 @@ def write_csv(path: Path, t, q, tau):
 
 def make_log(out: Path, payload: bool, ref: Path, seed: int) -> dict:
     rng = np.random.default_rng(seed)
-    t_state, q, tau = simulate(payload, ref, seed)
+    t_state, q, tau = simulate(payload, ref)
     q_meas, tau_meas = sensors(q, tau, rng)
     stamp, index = poll(t_state, rng)
     rows_q, rows_tau = q_meas[index], tau_meas[index]
@@ -161,8 +160,8 @@ def make_log(out: Path, payload: bool, ref: Path, seed: int) -> dict:
             "torque RMS (test)": [round(float(x), 3) for x in np.sqrt(np.mean(rows_tau[pieces["test"]] ** 2, axis=0))]}
 
 
-def run(command, out: Path, name: str) -> int:
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "generator"))
+def run(command, out: Path, name: str, tree: Path) -> int:
+    env = dict(os.environ, PYTHONPATH=str(tree))
     result = subprocess.run([sys.executable, "-m", "dyngen", *command], cwd=out, env=env, capture_output=True,
                             text=True)
     (out / f"{name}.txt").write_text(result.stdout + result.stderr)
@@ -174,24 +173,29 @@ def run(command, out: Path, name: str) -> int:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="/tmp/trial_ur5")
-    out = Path(parser.parse_args().out)
+    parser.add_argument("--tree", default=str(ROOT / "generator"),
+                        help="the dyngen tree the commands run (e.g. a patched copy); default this one's")
+    parser.add_argument("--commands-only", action="store_true", help="the logs in --out are already made")
+    args = parser.parse_args()
+    out, tree = Path(args.out), Path(args.tree)
     out.mkdir(parents=True, exist_ok=True)
     ref = out / "excitation.csv"
     if not ref.exists():
-        run(["excite", str(YAML), "-o", str(ref), "--rate", "500", "--periods", "18", "-q"], out, "excite")
-    stats = {name: make_log(out, name == "loaded", ref, seed) for name, seed in (("loaded", 1), ("unloaded", 2))}
-    print(json.dumps(stats, indent=1))
-    (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
+        run(["excite", str(YAML), "-o", str(ref), "--rate", "500", "--periods", "18", "-q"], out, "excite", tree)
+    if not args.commands_only:
+        stats = {name: make_log(out, name == "loaded", ref, seed) for name, seed in (("loaded", 1), ("unloaded", 2))}
+        print(json.dumps(stats, indent=1))
+        (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
     print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS.tolist(), "viscous", DAMPING.tolist(),
           "rotor inertia", ARMATURE.tolist())
     identified = out / "identified.yaml"
     run(["identify", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv", "-o", str(identified)],
-        out, "identify")
+        out, "identify", tree)
     run(["diagnose", str(YAML), "--params", str(identified), "--data", "loaded_fit.csv", "--select",
-         "loaded_select.csv", "--test", "loaded_test.csv", "--out", "diagnose_identified"], out, "diagnose_identified")
+         "loaded_select.csv", "--test", "loaded_test.csv", "--out", "diagnose_identified"], out, "diagnose_identified", tree)
     run(["diagnose", str(YAML), "--params", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv",
          "--test", "loaded_test.csv", "--control", "unloaded_fit.csv", "--out", "diagnose_nominal"], out,
-        "diagnose_nominal")
+        "diagnose_nominal", tree)
 
 
 if __name__ == "__main__":
