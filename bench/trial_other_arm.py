@@ -32,6 +32,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -170,6 +171,52 @@ def run(command, out: Path, name: str, tree: Path) -> int:
     return result.returncode
 
 
+TRUTH = {"coulomb": ("Fc", FRICTIONLOSS), "viscous": ("Fv", DAMPING), "armature": ("Ia", ARMATURE)}
+
+
+def expected(params: str, payload: bool) -> dict:
+    """(effect, joints) -> (value name, true value). Identified links carry the payload and the
+    rotor inertia of joints 1-2 (ZZ1 and link 2's inertia take them: not told apart)."""
+    out = {(effect, (j + 1,)): (name, float(values[j])) for effect, (name, values) in TRUTH.items() for j in range(6)}
+    if params == "identified":
+        del out[("armature", (1,))], out[("armature", (2,))]
+    elif payload:
+        out[("payload", (1, 2, 3, 4, 5, 6))] = ("m", PAYLOAD_KG)
+    return out
+
+
+def verdict(folder: Path, truth: dict) -> list[str]:
+    """Each claimed finding against the truth (within 20 %), what was missed, what was flagged."""
+    path = folder / "diagnosis.json"
+    if not path.exists():
+        return [f"{folder.name}: no diagnosis.json (the command failed)"]
+    result = json.loads(path.read_text())
+    lines, found = [], set()
+    for e in result["selected"]:
+        key = (e["effect"], tuple(e["joints"]))
+        found.add(key)
+        name, true = truth.get(key, (None, None))
+        value = e["values"].get(name) if name else None
+        flag = f" (flagged suspect: {e['suspect']})" if e.get("suspect") else ""
+        if name is None:
+            lines.append(f"  SPURIOUS {key[0]} on {key[1]}: {e['values']}{flag}")
+        elif abs(value - true) > 0.2 * abs(true):
+            lines.append(f"  WRONG VALUE {key[0]} on {key[1]}: {name} = {value:.4g}, truth {true:.4g}{flag}")
+        elif flag:
+            lines.append(f"  RIGHT BUT FLAGGED {key[0]} on {key[1]}: {name} = {value:.4g}, truth {true:.4g}{flag}")
+    for u in result["unstable"]:
+        key = (u["finding"]["effect"], tuple(u["finding"]["joints"]))
+        if key in truth:
+            lines.append(f"  TRUE BUT 'UNSTABLE, NOT CLAIMED' {key[0]} on {key[1]}: {u['reason']}")
+    missed = [k for k in truth if k not in found and k not in
+              {(u["finding"]["effect"], tuple(u["finding"]["joints"])) for u in result["unstable"]}]
+    lines += [f"  MISSED {k[0]} on {k[1]}" for k in missed]
+    worse = [j + 1 for j, (a, b) in enumerate(zip(result["rms_after"], result["rms_simple"])) if a > b]
+    lines.append(f"  test RMS after {[round(x, 3) for x in result['rms_after']]}, simple model "
+                 f"{[round(x, 3) for x in result['rms_simple']]}" + (f"; WORSE than simple on {worse}" if worse else ""))
+    return [f"{folder.name}: {len(result['selected'])} claimed"] + lines
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="/tmp/trial_ur5")
@@ -191,11 +238,22 @@ def main():
     identified = out / "identified.yaml"
     run(["identify", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv", "-o", str(identified)],
         out, "identify", tree)
-    run(["diagnose", str(YAML), "--params", str(identified), "--data", "loaded_fit.csv", "--select",
-         "loaded_select.csv", "--test", "loaded_test.csv", "--out", "diagnose_identified"], out, "diagnose_identified", tree)
-    run(["diagnose", str(YAML), "--params", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv",
-         "--test", "loaded_test.csv", "--control", "unloaded_fit.csv", "--out", "diagnose_nominal"], out,
-        "diagnose_nominal", tree)
+    roles = ["--select", "loaded_select.csv", "--test", "loaded_test.csv"]
+    runs = {  # folder: (arguments, params kind, payload in the data)
+        "diagnose_identified": (["--params", str(identified), "--data", "loaded_fit.csv", *roles], "identified", True),
+        "diagnose_nominal": (["--params", str(YAML), "--data", "loaded_fit.csv", *roles, "--control",
+                              "unloaded_fit.csv"], "nominal", True),
+        "diagnose_unloaded": (["--params", str(YAML), "--data", "unloaded_fit.csv", "--select", "unloaded_select.csv",
+                               "--test", "unloaded_test.csv"], "nominal", False),
+        "diagnose_split": (["--params", str(YAML), "--data", "loaded_all.csv", "--split", "0.6,0.2,0.2"], "nominal",
+                           True),
+    }
+    for folder, (arguments, _, _) in runs.items():
+        shutil.rmtree(out / folder, ignore_errors=True)  # a failed command must not leave the last run's result
+        run(["diagnose", str(YAML), *arguments, "--out", folder], out, folder, tree)
+    print("\nagainst the truth (values within 20 %):")
+    for folder, (_, params, payload) in runs.items():
+        print("\n".join(verdict(out / folder, expected(params, payload))))
 
 
 if __name__ == "__main__":
