@@ -8,7 +8,8 @@ are written below, so the trial does not share the project's own assumptions abo
   checks against Pinocchio), with what the YAML does not have: MuJoCo's frictionloss (dry friction
   that sticks at rest, not a tanh), viscous damping and a reflected rotor inertia on every joint,
   and the known effect, a 1.5 kg payload 4 cm beyond the flange. An unloaded run of the same arm
-  is the control.
+  is the control; a third log of the unloaded motion has the other known effect, joint 2's torque
+  read 3 % high (a sensor gain).
 - The motion: `dyngen excite examples/ur5.yaml --rate 500 --periods 18` (3 minutes), tracked by
   the nominal model's inverse dynamics plus PD at 2 kHz (so the arm never moves exactly along
   the reference and friction is the PD's to overcome).
@@ -57,6 +58,7 @@ FRICTIONLOSS = np.array([4.0, 4.0, 3.0, 1.2, 1.2, 1.0])  # Nm
 DAMPING = np.array([3.0, 3.0, 2.0, 0.6, 0.6, 0.5])  # Nm s / rad
 ARMATURE = np.array([0.20, 0.20, 0.10, 0.03, 0.03, 0.03])  # kg m^2
 PAYLOAD_KG, PAYLOAD_Z = 1.5, 0.04  # beyond the flange, along its z
+GAIN_JOINT, GAIN = 2, 0.03  # the other known effect, on the unloaded arm: joint 2's sensor reads 3 % high
 KP = np.array([800.0, 1600.0, 600.0, 300.0, 300.0, 200.0])
 KD = np.array([40.0, 80.0, 30.0, 8.0, 8.0, 5.0])
 
@@ -141,15 +143,16 @@ def write_csv(path: Path, t, q, tau):
     np.savetxt(path, np.column_stack([t, q, tau]), delimiter=",", header=header, comments="", fmt="%.9g")
 
 
-def make_log(out: Path, payload: bool, ref: Path, seed: int) -> dict:
+def make_log(out: Path, name: str, states, gain: np.ndarray, seed: int) -> dict:
+    """One log of simulated states (t, q, applied torque) through sensors (torque gain per joint)
+    and the logger, cut by time into fit, select and test."""
     rng = np.random.default_rng(seed)
-    t_state, q, tau = simulate(payload, ref)
-    q_meas, tau_meas = sensors(q, tau, rng)
+    t_state, q, tau = states
+    q_meas, tau_meas = sensors(q, tau * gain, rng)
     stamp, index = poll(t_state, rng)
     rows_q, rows_tau = q_meas[index], tau_meas[index]
     repeated = np.r_[False, index[1:] == index[:-1]]
     steps = np.diff(stamp)
-    name = "loaded" if payload else "unloaded"
     cut = stamp[0] + np.array([0.6, 0.8]) * (stamp[-1] - stamp[0])
     pieces = {"fit": stamp < cut[0], "select": (stamp >= cut[0]) & (stamp < cut[1]), "test": stamp >= cut[1]}
     for role, rows in pieces.items():
@@ -174,7 +177,7 @@ def run(command, out: Path, name: str, tree: Path) -> int:
 TRUTH = {"coulomb": ("Fc", FRICTIONLOSS), "viscous": ("Fv", DAMPING), "armature": ("Ia", ARMATURE)}
 
 
-def expected(params: str, payload: bool) -> dict:
+def expected(params: str, payload: bool, gain: bool = False) -> dict:
     """(effect, joints) -> (value name, true value). Identified links carry the payload and the
     rotor inertia of joints 1-2 (ZZ1 and link 2's inertia take them: not told apart)."""
     out = {(effect, (j + 1,)): (name, float(values[j])) for effect, (name, values) in TRUTH.items() for j in range(6)}
@@ -182,6 +185,8 @@ def expected(params: str, payload: bool) -> dict:
         del out[("armature", (1,))], out[("armature", (2,))]
     elif payload:
         out[("payload", (1, 2, 3, 4, 5, 6))] = ("m", PAYLOAD_KG)
+    if gain:
+        out[("gain", (GAIN_JOINT,))] = ("k-1", GAIN)
     return out
 
 
@@ -230,7 +235,11 @@ def main():
     if not ref.exists():
         run(["excite", str(YAML), "-o", str(ref), "--rate", "500", "--periods", "18", "-q"], out, "excite", tree)
     if not args.commands_only:
-        stats = {name: make_log(out, name == "loaded", ref, seed) for name, seed in (("loaded", 1), ("unloaded", 2))}
+        states = {payload: simulate(payload, ref) for payload in (True, False)}
+        gain = np.ones(6)
+        gain[GAIN_JOINT - 1] += GAIN
+        stats = {name: make_log(out, name, states[name == "loaded"], g, seed)
+                 for name, g, seed in (("loaded", np.ones(6), 1), ("unloaded", np.ones(6), 2), ("gain", gain, 3))}
         print(json.dumps(stats, indent=1))
         (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
     print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS.tolist(), "viscous", DAMPING.tolist(),
@@ -239,21 +248,24 @@ def main():
     run(["identify", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv", "-o", str(identified)],
         out, "identify", tree)
     roles = ["--select", "loaded_select.csv", "--test", "loaded_test.csv"]
-    runs = {  # folder: (arguments, params kind, payload in the data)
-        "diagnose_identified": (["--params", str(identified), "--data", "loaded_fit.csv", *roles], "identified", True),
+    runs = {  # folder: (arguments, expected findings)
+        "diagnose_identified": (["--params", str(identified), "--data", "loaded_fit.csv", *roles],
+                                expected("identified", True)),
         "diagnose_nominal": (["--params", str(YAML), "--data", "loaded_fit.csv", *roles, "--control",
-                              "unloaded_fit.csv"], "nominal", True),
+                              "unloaded_fit.csv"], expected("nominal", True)),
         "diagnose_unloaded": (["--params", str(YAML), "--data", "unloaded_fit.csv", "--select", "unloaded_select.csv",
-                               "--test", "unloaded_test.csv"], "nominal", False),
-        "diagnose_split": (["--params", str(YAML), "--data", "loaded_all.csv", "--split", "0.6,0.2,0.2"], "nominal",
-                           True),
+                               "--test", "unloaded_test.csv"], expected("nominal", False)),
+        "diagnose_split": (["--params", str(YAML), "--data", "loaded_all.csv", "--split", "0.6,0.2,0.2"],
+                           expected("nominal", True)),
+        "diagnose_gain": (["--params", str(YAML), "--data", "gain_fit.csv", "--select", "gain_select.csv", "--test",
+                           "gain_test.csv", "--control", "unloaded_fit.csv"], expected("nominal", False, gain=True)),
     }
-    for folder, (arguments, _, _) in runs.items():
+    for folder, (arguments, _) in runs.items():
         shutil.rmtree(out / folder, ignore_errors=True)  # a failed command must not leave the last run's result
         run(["diagnose", str(YAML), *arguments, "--out", folder], out, folder, tree)
     print("\nagainst the truth (values within 20 %):")
-    for folder, (_, params, payload) in runs.items():
-        print("\n".join(verdict(out / folder, expected(params, payload))))
+    for folder, (_, truth) in runs.items():
+        print("\n".join(verdict(out / folder, truth)))
 
 
 if __name__ == "__main__":
