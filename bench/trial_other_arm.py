@@ -54,9 +54,9 @@ PUBLISH_EVERY = 4  # state published every 4 steps: 500 Hz
 COUNTS = 2 ** 16  # encoder counts per turn
 TORQUE_NOISE = np.array([0.25, 0.25, 0.25, 0.08, 0.08, 0.08])  # Nm, 1 sigma
 # The truth the commands should find (per joint): dry (sticky) friction, viscous, rotor inertia.
-FRICTIONLOSS = np.array([4.0, 4.0, 3.0, 1.2, 1.2, 1.0])  # Nm
-DAMPING = np.array([3.0, 3.0, 2.0, 0.6, 0.6, 0.5])  # Nm s / rad
-ARMATURE = np.array([0.20, 0.20, 0.10, 0.03, 0.03, 0.03])  # kg m^2
+FRICTIONLOSS = (4.0, 4.0, 3.0, 1.2, 1.2, 1.0)  # Nm
+DAMPING = (3.0, 3.0, 2.0, 0.6, 0.6, 0.5)  # Nm s / rad
+ARMATURE = (0.20, 0.20, 0.10, 0.03, 0.03, 0.03)  # kg m^2
 PAYLOAD_KG, PAYLOAD_Z = 1.5, 0.04  # beyond the flange, along its z
 GAIN_JOINT, GAIN = 2, 0.03  # the other known effect, on the unloaded arm: joint 2's sensor reads 3 % high
 KP = np.array([800.0, 1600.0, 600.0, 300.0, 300.0, 200.0])
@@ -73,8 +73,8 @@ def arm_xml(payload: bool) -> str:
     """The exported nominal UR5 with the friction, rotor inertia and (optionally) the payload."""
     xml = to_mjcf(load_robot(YAML), nominal_vector())
     for j in range(6):
-        xml = re.sub(rf'(<joint name="joint_{j + 1}"[^>]*?)armature="0" damping="0" frictionloss="0"',
-                     rf'\1armature="{float(ARMATURE[j])!r}" damping="{float(DAMPING[j])!r}" frictionloss="{float(FRICTIONLOSS[j])!r}"',
+        values = f'armature="{ARMATURE[j]!r}" damping="{DAMPING[j]!r}" frictionloss="{FRICTIONLOSS[j]!r}"'
+        xml = re.sub(rf'(<joint name="joint_{j + 1}"[^>]*?)armature="0" damping="0" frictionloss="0"', rf"\1{values}",
                      xml)
     if payload:
         site = '<site name="dh_frame_6" pos="0.0 0.0 0.0823" quat="1.0 0.0 0.0 0.0"/>'
@@ -217,8 +217,8 @@ def verdict(folder: Path, truth: dict) -> list[str]:
               {(u["finding"]["effect"], tuple(u["finding"]["joints"])) for u in result["unstable"]}]
     lines += [f"  MISSED {k[0]} on {k[1]}" for k in missed]
     worse = [j + 1 for j, (a, b) in enumerate(zip(result["rms_after"], result["rms_simple"])) if a > b]
-    lines.append(f"  test RMS after {[round(x, 3) for x in result['rms_after']]}, simple model "
-                 f"{[round(x, 3) for x in result['rms_simple']]}" + (f"; WORSE than simple on {worse}" if worse else ""))
+    after, simple = ([round(x, 3) for x in result[key]] for key in ("rms_after", "rms_simple"))
+    lines.append(f"  test RMS after {after}, simple model {simple}" + (f"; WORSE than simple on {worse}" if worse else ""))
     return [f"{folder.name}: {len(result['selected'])} claimed"] + lines
 
 
@@ -242,8 +242,8 @@ def main():
                  for name, g, seed in (("loaded", np.ones(6), 1), ("unloaded", np.ones(6), 2), ("gain", gain, 3))}
         print(json.dumps(stats, indent=1))
         (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
-    print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS.tolist(), "viscous", DAMPING.tolist(),
-          "rotor inertia", ARMATURE.tolist())
+    print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS, "viscous", DAMPING, "rotor inertia",
+          ARMATURE, f"; on the gain log, joint {GAIN_JOINT}'s torque read {100 * GAIN:.0f} % high")
     identified = out / "identified.yaml"
     run(["identify", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv", "-o", str(identified)],
         out, "identify", tree)
