@@ -218,7 +218,8 @@ def verdict(folder: Path, truth: dict) -> list[str]:
     lines += [f"  MISSED {k[0]} on {k[1]}" for k in missed]
     worse = [j + 1 for j, (a, b) in enumerate(zip(result["rms_after"], result["rms_simple"])) if a > b]
     after, simple = ([round(x, 3) for x in result[key]] for key in ("rms_after", "rms_simple"))
-    lines.append(f"  test RMS after {after}, simple model {simple}" + (f"; WORSE than simple on {worse}" if worse else ""))
+    lines.append(f"  test RMS after {after}, simple model {simple}"
+                 + (f"; WORSE than simple on {worse}" if worse else ""))
     return [f"{folder.name}: {len(result['selected'])} claimed"] + lines
 
 
