@@ -216,6 +216,8 @@ def verdict(folder: Path, truth: dict) -> list[str]:
     missed = [k for k in truth if k not in found and k not in
               {(u["finding"]["effect"], tuple(u["finding"]["joints"])) for u in result["unstable"]}]
     lines += [f"  MISSED {k[0]} on {k[1]}" for k in missed]
+    said = ("link parameters", "control run", "cannot support")  # what the user is told about the model and data
+    lines += [f"  WARNING {w}" for w in result["warnings"] if any(x in w for x in said)]
     worse = [j + 1 for j, (a, b) in enumerate(zip(result["rms_after"], result["rms_simple"])) if a > b]
     after, simple = ([round(x, 3) for x in result[key]] for key in ("rms_after", "rms_simple"))
     lines.append(f"  test RMS after {after}, simple model {simple}"
