@@ -8,7 +8,8 @@ are written below, so the trial does not share the project's own assumptions abo
   checks against Pinocchio), with what the YAML does not have: MuJoCo's frictionloss (dry friction
   that sticks at rest, not a tanh), viscous damping and a reflected rotor inertia on every joint,
   and the known effect, a 1.5 kg payload 4 cm beyond the flange. An unloaded run of the same arm
-  is the control.
+  is the control; a third log of the unloaded motion has the other known effect, joint 2's torque
+  read 3 % high (a sensor gain).
 - The motion: `dyngen excite examples/ur5.yaml --rate 500 --periods 18` (3 minutes), tracked by
   the nominal model's inverse dynamics plus PD at 2 kHz (so the arm never moves exactly along
   the reference and friction is the PD's to overcome).
@@ -20,7 +21,7 @@ are written below, so the trial does not share the project's own assumptions abo
   0.7-8.8 ms.
 - Fit / select / test: the log cut by time into its first 60 %, the next 20 % and the last 20 %.
 
-    python bench/trial_other_arm.py [--out /tmp/trial_ur5]
+    python bench/trial_other_arm.py [--out /tmp/trial_ur5] [--tree GENERATOR_DIR] [--commands-only]
 
 prints the log's statistics, runs `dyngen identify` and `dyngen diagnose` (defaults) and prints
 what they said beside the truth. Seeds are fixed; the log is the same on every run.
@@ -32,6 +33,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -52,10 +54,11 @@ PUBLISH_EVERY = 4  # state published every 4 steps: 500 Hz
 COUNTS = 2 ** 16  # encoder counts per turn
 TORQUE_NOISE = np.array([0.25, 0.25, 0.25, 0.08, 0.08, 0.08])  # Nm, 1 sigma
 # The truth the commands should find (per joint): dry (sticky) friction, viscous, rotor inertia.
-FRICTIONLOSS = np.array([4.0, 4.0, 3.0, 1.2, 1.2, 1.0])  # Nm
-DAMPING = np.array([3.0, 3.0, 2.0, 0.6, 0.6, 0.5])  # Nm s / rad
-ARMATURE = np.array([0.20, 0.20, 0.10, 0.03, 0.03, 0.03])  # kg m^2
+FRICTIONLOSS = (4.0, 4.0, 3.0, 1.2, 1.2, 1.0)  # Nm
+DAMPING = (3.0, 3.0, 2.0, 0.6, 0.6, 0.5)  # Nm s / rad
+ARMATURE = (0.20, 0.20, 0.10, 0.03, 0.03, 0.03)  # kg m^2
 PAYLOAD_KG, PAYLOAD_Z = 1.5, 0.04  # beyond the flange, along its z
+GAIN_JOINT, GAIN = 2, 0.03  # the other known effect, on the unloaded arm: joint 2's sensor reads 3 % high
 KP = np.array([800.0, 1600.0, 600.0, 300.0, 300.0, 200.0])
 KD = np.array([40.0, 80.0, 30.0, 8.0, 8.0, 5.0])
 
@@ -70,8 +73,8 @@ def arm_xml(payload: bool) -> str:
     """The exported nominal UR5 with the friction, rotor inertia and (optionally) the payload."""
     xml = to_mjcf(load_robot(YAML), nominal_vector())
     for j in range(6):
-        xml = re.sub(rf'(<joint name="joint_{j + 1}"[^>]*?)armature="0" damping="0" frictionloss="0"',
-                     rf'\1armature="{float(ARMATURE[j])!r}" damping="{float(DAMPING[j])!r}" frictionloss="{float(FRICTIONLOSS[j])!r}"',
+        values = f'armature="{ARMATURE[j]!r}" damping="{DAMPING[j]!r}" frictionloss="{FRICTIONLOSS[j]!r}"'
+        xml = re.sub(rf'(<joint name="joint_{j + 1}"[^>]*?)armature="0" damping="0" frictionloss="0"', rf"\1{values}",
                      xml)
     if payload:
         site = '<site name="dh_frame_6" pos="0.0 0.0 0.0823" quat="1.0 0.0 0.0 0.0"/>'
@@ -86,7 +89,7 @@ def reference(path: Path):
     return data[:, 0], data[:, 1:7], data[:, 7:13], data[:, 13:19]
 
 
-def simulate(payload: bool, ref_path: Path, seed: int):
+def simulate(payload: bool, ref_path: Path):
     """The robot's published states: time, true q, applied torque (before the sensors)."""
     model = mujoco.MjModel.from_xml_string(arm_xml(payload))
     model.opt.timestep = SIM_DT
@@ -95,12 +98,11 @@ def simulate(payload: bool, ref_path: Path, seed: int):
     t_ref, q_ref, qd_ref, qdd_ref = reference(ref_path)
     steps = int(round(t_ref[-1] / SIM_DT))
     data.qpos[:] = q_ref[0]
+    t_sim = np.arange(steps + 1) * SIM_DT
+    wanted = [np.column_stack([np.interp(t_sim, t_ref, x[:, j]) for j in range(6)]) for x in (q_ref, qd_ref, qdd_ref)]
     ts, qs, taus = [], [], []
-    for k in range(steps + 1):
-        t = k * SIM_DT
-        qr = np.array([np.interp(t, t_ref, q_ref[:, j]) for j in range(6)])
-        vr = np.array([np.interp(t, t_ref, qd_ref[:, j]) for j in range(6)])
-        ar = np.array([np.interp(t, t_ref, qdd_ref[:, j]) for j in range(6)])
+    for k, t in enumerate(t_sim):
+        qr, vr, ar = wanted[0][k], wanted[1][k], wanted[2][k]
         ff.qpos[:], ff.qvel[:], ff.qacc[:] = qr, vr, ar
         mujoco.mj_inverse(nominal, ff)
         tau = ff.qfrc_inverse + KP * (qr - data.qpos) + KD * (vr - data.qvel)
@@ -141,15 +143,16 @@ def write_csv(path: Path, t, q, tau):
     np.savetxt(path, np.column_stack([t, q, tau]), delimiter=",", header=header, comments="", fmt="%.9g")
 
 
-def make_log(out: Path, payload: bool, ref: Path, seed: int) -> dict:
+def make_log(out: Path, name: str, states, gain: np.ndarray, seed: int) -> dict:
+    """One log of simulated states (t, q, applied torque) through sensors (torque gain per joint)
+    and the logger, cut by time into fit, select and test."""
     rng = np.random.default_rng(seed)
-    t_state, q, tau = simulate(payload, ref, seed)
-    q_meas, tau_meas = sensors(q, tau, rng)
+    t_state, q, tau = states
+    q_meas, tau_meas = sensors(q, tau * gain, rng)
     stamp, index = poll(t_state, rng)
     rows_q, rows_tau = q_meas[index], tau_meas[index]
     repeated = np.r_[False, index[1:] == index[:-1]]
     steps = np.diff(stamp)
-    name = "loaded" if payload else "unloaded"
     cut = stamp[0] + np.array([0.6, 0.8]) * (stamp[-1] - stamp[0])
     pieces = {"fit": stamp < cut[0], "select": (stamp >= cut[0]) & (stamp < cut[1]), "test": stamp >= cut[1]}
     for role, rows in pieces.items():
@@ -161,8 +164,8 @@ def make_log(out: Path, payload: bool, ref: Path, seed: int) -> dict:
             "torque RMS (test)": [round(float(x), 3) for x in np.sqrt(np.mean(rows_tau[pieces["test"]] ** 2, axis=0))]}
 
 
-def run(command, out: Path, name: str) -> int:
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "generator"))
+def run(command, out: Path, name: str, tree: Path) -> int:
+    env = dict(os.environ, PYTHONPATH=str(tree))
     result = subprocess.run([sys.executable, "-m", "dyngen", *command], cwd=out, env=env, capture_output=True,
                             text=True)
     (out / f"{name}.txt").write_text(result.stdout + result.stderr)
@@ -171,27 +174,101 @@ def run(command, out: Path, name: str) -> int:
     return result.returncode
 
 
+TRUTH = {"coulomb": ("Fc", FRICTIONLOSS), "viscous": ("Fv", DAMPING), "armature": ("Ia", ARMATURE)}
+
+
+def expected(params: str, payload: bool, gain: bool = False) -> dict:
+    """(effect, joints) -> (value name, true value). Identified links carry the payload and the
+    rotor inertia of joints 1-2 (ZZ1 and link 2's inertia take them: not told apart)."""
+    out = {(effect, (j + 1,)): (name, float(values[j])) for effect, (name, values) in TRUTH.items() for j in range(6)}
+    if params == "identified":
+        del out[("armature", (1,))], out[("armature", (2,))]
+    elif payload:
+        out[("payload", (1, 2, 3, 4, 5, 6))] = ("m", PAYLOAD_KG)
+    if gain:
+        out[("gain", (GAIN_JOINT,))] = ("k-1", GAIN)
+    return out
+
+
+def verdict(folder: Path, truth: dict) -> list[str]:
+    """Each claimed finding against the truth (within 20 %), what was missed, what was flagged."""
+    path = folder / "diagnosis.json"
+    if not path.exists():
+        return [f"{folder.name}: no diagnosis.json (the command failed)"]
+    result = json.loads(path.read_text())
+    lines, found = [], set()
+    for e in result["selected"]:
+        key = (e["effect"], tuple(e["joints"]))
+        found.add(key)
+        name, true = truth.get(key, (None, None))
+        value = e["values"].get(name) if name else None
+        flag = f" (flagged suspect: {e['suspect']})" if e.get("suspect") else ""
+        if name is None:
+            lines.append(f"  SPURIOUS {key[0]} on {key[1]}: {e['values']}{flag}")
+        elif abs(value - true) > 0.2 * abs(true):
+            lines.append(f"  WRONG VALUE {key[0]} on {key[1]}: {name} = {value:.4g}, truth {true:.4g}{flag}")
+        elif flag:
+            lines.append(f"  RIGHT BUT FLAGGED {key[0]} on {key[1]}: {name} = {value:.4g}, truth {true:.4g}{flag}")
+    for u in result["unstable"]:
+        key = (u["finding"]["effect"], tuple(u["finding"]["joints"]))
+        if key in truth:
+            lines.append(f"  TRUE BUT 'UNSTABLE, NOT CLAIMED' {key[0]} on {key[1]}: {u['reason']}")
+    missed = [k for k in truth if k not in found and k not in
+              {(u["finding"]["effect"], tuple(u["finding"]["joints"])) for u in result["unstable"]}]
+    lines += [f"  MISSED {k[0]} on {k[1]}" for k in missed]
+    said = ("link parameters", "control run", "cannot support")  # what the user is told about the model and data
+    lines += [f"  WARNING {w}" for w in result["warnings"] if any(x in w for x in said)]
+    worse = [j + 1 for j, (a, b) in enumerate(zip(result["rms_after"], result["rms_simple"])) if a > b]
+    after, simple = ([round(x, 3) for x in result[key]] for key in ("rms_after", "rms_simple"))
+    lines.append(f"  test RMS after {after}, simple model {simple}"
+                 + (f"; WORSE than simple on {worse}" if worse else ""))
+    return [f"{folder.name}: {len(result['selected'])} claimed"] + lines
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="/tmp/trial_ur5")
-    out = Path(parser.parse_args().out)
+    parser.add_argument("--tree", default=str(ROOT / "generator"),
+                        help="the dyngen tree the commands run (e.g. a patched copy); default this one's")
+    parser.add_argument("--commands-only", action="store_true", help="the logs in --out are already made")
+    args = parser.parse_args()
+    out, tree = Path(args.out), Path(args.tree)
     out.mkdir(parents=True, exist_ok=True)
     ref = out / "excitation.csv"
     if not ref.exists():
-        run(["excite", str(YAML), "-o", str(ref), "--rate", "500", "--periods", "18", "-q"], out, "excite")
-    stats = {name: make_log(out, name == "loaded", ref, seed) for name, seed in (("loaded", 1), ("unloaded", 2))}
-    print(json.dumps(stats, indent=1))
-    (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
-    print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS.tolist(), "viscous", DAMPING.tolist(),
-          "rotor inertia", ARMATURE.tolist())
+        run(["excite", str(YAML), "-o", str(ref), "--rate", "500", "--periods", "18", "-q"], out, "excite", tree)
+    if not args.commands_only:
+        states = {payload: simulate(payload, ref) for payload in (True, False)}
+        gain = np.ones(6)
+        gain[GAIN_JOINT - 1] += GAIN
+        stats = {name: make_log(out, name, states[name == "loaded"], g, seed)
+                 for name, g, seed in (("loaded", np.ones(6), 1), ("unloaded", np.ones(6), 2), ("gain", gain, 3))}
+        print(json.dumps(stats, indent=1))
+        (out / "log_stats.json").write_text(json.dumps(stats, indent=1))
+    print("truth: payload", PAYLOAD_KG, "kg; Coulomb (sticky)", FRICTIONLOSS, "viscous", DAMPING, "rotor inertia",
+          ARMATURE, f"; on the gain log, joint {GAIN_JOINT}'s torque read {100 * GAIN:.0f} % high")
     identified = out / "identified.yaml"
     run(["identify", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv", "-o", str(identified)],
-        out, "identify")
-    run(["diagnose", str(YAML), "--params", str(identified), "--data", "loaded_fit.csv", "--select",
-         "loaded_select.csv", "--test", "loaded_test.csv", "--out", "diagnose_identified"], out, "diagnose_identified")
-    run(["diagnose", str(YAML), "--params", str(YAML), "--data", "loaded_fit.csv", "--select", "loaded_select.csv",
-         "--test", "loaded_test.csv", "--control", "unloaded_fit.csv", "--out", "diagnose_nominal"], out,
-        "diagnose_nominal")
+        out, "identify", tree)
+    roles = ["--select", "loaded_select.csv", "--test", "loaded_test.csv"]
+    runs = {  # folder: (arguments, expected findings)
+        "diagnose_identified": (["--params", str(identified), "--data", "loaded_fit.csv", *roles],
+                                expected("identified", True)),
+        "diagnose_nominal": (["--params", str(YAML), "--data", "loaded_fit.csv", *roles, "--control",
+                              "unloaded_fit.csv"], expected("nominal", True)),
+        "diagnose_unloaded": (["--params", str(YAML), "--data", "unloaded_fit.csv", "--select", "unloaded_select.csv",
+                               "--test", "unloaded_test.csv"], expected("nominal", False)),
+        "diagnose_split": (["--params", str(YAML), "--data", "loaded_all.csv", "--split", "0.6,0.2,0.2"],
+                           expected("nominal", True)),
+        "diagnose_gain": (["--params", str(YAML), "--data", "gain_fit.csv", "--select", "gain_select.csv", "--test",
+                           "gain_test.csv", "--control", "unloaded_fit.csv"], expected("nominal", False, gain=True)),
+    }
+    for folder, (arguments, _) in runs.items():
+        shutil.rmtree(out / folder, ignore_errors=True)  # a failed command must not leave the last run's result
+        run(["diagnose", str(YAML), *arguments, "--out", folder], out, folder, tree)
+    print("\nagainst the truth (values within 20 %):")
+    for folder, (_, truth) in runs.items():
+        print("\n".join(verdict(out / folder, truth)))
 
 
 if __name__ == "__main__":
