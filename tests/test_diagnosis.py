@@ -190,6 +190,23 @@ def test_rotor_inertia_and_gain(lwr):
     assert value(d, "gain", 2)[0]["k-1"] == pytest.approx(0.05, rel=0.1)
 
 
+def test_a_rotor_inertia_from_fit_recordings_of_unequal_length(lwr):
+    """Two fit recordings of different lengths (or one long recording read in windows): the
+    rotor inertia's range check pools their accelerations (it once stacked them as rows and
+    crashed; found by bench/trial_other_arm.py)."""
+    model, robot, arm, p, trajectories = lwr
+    t, at, q, qd, qdd, tau = trajectories["fit"]
+    measured = noisy(tau + np.outer(0.3 * qdd[:, 3], np.eye(7)[3]), NOISE, 0)
+    cut = int(0.6 * len(t))
+    fit = [signals("fit-a", t[:cut], q[:cut], qd[:cut], qdd[:cut], measured[:cut]),
+           signals("fit-b", t[cut:], q[cut:], qd[cut:], qdd[cut:], measured[cut:])]
+    t, at, q, qd, qdd, tau = trajectories["held"]
+    held = signals("held", t, q, qd, qdd, noisy(tau + np.outer(0.3 * qdd[:, 3], np.eye(7)[3]), NOISE, 1))
+    d = diagnose(robot, model, p, fit, None, test=[held])
+    assert claims(d) == [("armature", (4,))]
+    assert value(d, "armature", 4)[0]["Ia"] == pytest.approx(0.3, rel=0.1)
+
+
 def test_direction_dependent_coulomb_and_position_ripple(lwr):
     """Joint 3: Coulomb 1.0 Nm moving forwards, 0.6 Nm backwards (plain sign); joint 7: a torque
     0.3 cos(2 q7) + 0.2 sin(3 q7). This trajectory never rests, so a direction-dependent level

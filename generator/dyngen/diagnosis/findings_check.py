@@ -58,7 +58,7 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
             if inertia is None:
                 inertia = inertia_about_joints(model, s, fit_signals)
             ia = e.values["Ia"]
-            qdd = np.sqrt(np.mean(np.vstack([sig.qdd[sig.inner(), j] for sig in fit_signals]) ** 2))
+            qdd = np.sqrt(np.mean(np.concatenate([sig.qdd[sig.inner(), j] for sig in fit_signals]) ** 2))
             if ia > ROTOR_RATIO * inertia[j]:
                 reason = (f"on joint {j + 1}, {ia:.3g} kg m^2 is {ia / inertia[j]:.0f} x the arm's own inertia about the joint "
                           f"({inertia[j]:.3g} kg m^2): outside a rotor inertia's range")
