@@ -116,6 +116,12 @@ def test_a_control_run_finds_the_payload_only_where_it_is(pair, tmp_path):
     assert not any(e["effect"] == "payload" for e in docs["unloaded"]["selected"])
     (payload,) = [e for e in docs["loaded"]["selected"] if e["effect"] == "payload"]
     assert abs(payload["values"]["m"] - 1.5) < 0.15 and "suspect" not in payload
+    # the comparison is reported, also where it found nothing to change (report.md and the json)
+    assert alone["control"] == ""
+    assert docs["loaded"]["control"].startswith("compared with the control run unloaded.fit.csv")
+    assert docs["loaded"]["control"].endswith("payload told apart from the link parameters")
+    assert "payload" not in docs["unloaded"]["control"]  # the loaded run alone does not claim its payload
+    assert "Control run: compared with the control run loaded.fit.csv" in (tmp_path / "unloaded" / "report.md").read_text()
 
 
 def test_an_unloaded_and_loaded_pair_without_the_reidentification(pair):

@@ -39,8 +39,8 @@ def _key(finding) -> tuple:
 
 def compared(result, control, control_name: str):
     """result with the findings also found in `control` (a Diagnosis) marked suspect, a payload
-    its links explain that the control run lacks claimed again, and one warning for each; or
-    unchanged when neither happens."""
+    its links explain that the control run lacks claimed again, one warning for each, and a note
+    of what the comparison found (also when it found nothing in common)."""
     seen = {_key(e) for e in control.selected}
     both, selected = [], []
     for e in result.selected:
@@ -60,10 +60,13 @@ def compared(result, control, control_name: str):
     if apart:
         warnings.append(f"payload: told apart from the link parameters by the control run {control_name}, which has "
                         "none: claimed")
-    if not both and not apart:
-        return result
+    own = ", ".join(f"{e.effect}" + (f" (joint {', '.join(map(str, e.joints))})" if e.joints else "")
+                    for e in control.selected) or "none"
+    note = (f"compared with the control run {control_name} (its own findings: {own}); in common: "
+            f"{'; '.join(both) or 'none'}" + ("; payload told apart from the link parameters" if apart else ""))
     return replace(result, selected=selected + [replace(e, suspect="") for e in apart],
-                   superseded=[e for e in result.superseded if all(e is not a for a in apart)], warnings=warnings)
+                   superseded=[e for e in result.superseded if all(e is not a for a in apart)], warnings=warnings,
+                   control=note)
 
 
 def explained_by_links(context, segments, links, design, chosen, min_gain) -> list[int]:

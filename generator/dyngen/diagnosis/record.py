@@ -117,3 +117,4 @@ class Diagnosis:
     within_fit_speeds: dict = field(default_factory=dict)
     consistent: LinksOff | None = None  # "link parameters off", where the consistent model won
     reidentified: object = None  # its identification.consistent.Consistent (for the written parameters)
+    control: str = ""  # what the comparison with a control run (--control) found, "" without one

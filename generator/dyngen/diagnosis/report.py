@@ -27,7 +27,7 @@ def to_json(d, sources: dict) -> str:
         "candidates": d.candidates, "steps": d.steps, "dropped": d.dropped, "warnings": d.warnings,
         "recordings": d.conditioning, "joint_models": d.joint_models,
         "completed": {str(j): values for j, values in d.completed.items()},
-        "link_parameters_off": d.consistent, "within_fit_speeds": d.within_fit_speeds,
+        "link_parameters_off": d.consistent, "within_fit_speeds": d.within_fit_speeds, "control": d.control,
     }
     return json.dumps(_plain(doc), indent=1) + "\n"
 
@@ -104,6 +104,8 @@ def markdown(d, sources: dict) -> str:
              f"Test (held out, used for nothing else): {', '.join(sources.get('test') or []) or 'none'}.", ""]
     lines += ["Conditioning:", ""] + [f"- {c.recording} ({c.role}): {c.note}; {c.trimmed_samples} samples "
                                       "trimmed at each end" for c in d.conditioning] + [""]
+    if d.control:
+        lines += [f"Control run: {d.control}.", ""]
     if d.warnings:
         lines += ["## Warnings", ""] + [f"- {w}" for w in d.warnings] + [""]
     simple = "simple model b + Fc tanh(qd/0.02) + Fv qd (fit data)"
@@ -237,5 +239,7 @@ def summary_lines(d) -> list[str]:
     if d.consistent:
         out.append(f"  link parameters off: consistent re-identified parameters used on joint(s) "
                    f"{', '.join(map(str, d.consistent.joints))} (consistent/identified.yaml)")
+    if d.control:
+        out.append(f"  control: {d.control}")
     out += [f"  warning: {w}" for w in d.warnings]
     return out
