@@ -259,7 +259,10 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)"
-                     + ("" if choice.precision is None else f"; not tried by default: the fit data do not determine the base "
+                     + ("" if choice.precision is None else
+                        f"; not tried by default: no base coefficient alone carries {reidentify.MOVED:g} of what the "
+                        "effects leave (a weak sign: the gain is spread over many)" if np.isinf(choice.precision) else
+                        f"; not tried by default: the fit data do not determine the base "
                         f"coefficients it would move (relative standard deviation up to {choice.precision:.3g}, above "
                         f"{reidentify.PRECISION:g})"))
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
