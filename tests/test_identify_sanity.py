@@ -150,3 +150,17 @@ def test_the_issue_values_are_each_named(case):
     assert line.startswith("joint 7: the Coulomb lag 40 ms is the last of its search grid")
     (line,) = flagged(regularisation=REGULARISATION_GRID[-1])
     assert "the last of its search grid" in line and "prior" in line
+
+
+def test_a_heavy_wrist_rotor_is_physical_unless_it_carries_the_torque():
+    """A UR-sized wrist (UR5 joint 6: link inertia about the joint 1.3e-4 kg m^2, a harmonic
+    drive's reflected rotor inertia 0.03 kg m^2, 230 x; found and flagged by the UR5 trial,
+    bench/trial_other_arm.py) is inside the range while friction carries the joint's torque
+    (0.045 Nm of 0.5 Nm RMS); the same value making most of a 0.06 Nm torque, or more than the
+    torque, is out of it."""
+    from dyngen.identification.sanity import rotor_inertia_range
+
+    assert rotor_inertia_range(5, 0.03, 1.3e-4, qdd=1.5, torque=0.5) is None
+    assert "outside its physical range" in rotor_inertia_range(5, 0.03, 1.3e-4, qdd=1.5, torque=0.06)
+    assert "more than the measured torque" in rotor_inertia_range(5, 0.03, 1.3e-4, qdd=1.5, torque=0.04)
+    assert rotor_inertia_range(5, 0.03, 1e-3, qdd=1.5, torque=0.06) is None  # 30 x: a gear's rotor

@@ -5,11 +5,9 @@ A per-joint effect explains part of its joint's nominal residual. A constant or 
 larger than that whole residual (its RMS on the selection data) is not a finding about the
 robot: it is making up for another term of the same joint (on the real LWR4+, joint 6 once got
 a +1.90 Nm offset beside a 2.31 Nm ripple where the whole nominal residual is 0.645 Nm). A
-rotor inertia is outside its physical range when its torque (Ia qdd_j, RMS over the fit data)
-is larger than LARGER x that whole residual, as for the offset, or when it is more than
-ROTOR_RATIO times the arm's own inertia about the joint (the median of M_jj over the fit data):
-a reflected rotor inertia (gear ratio squared times the rotor's) may well be ten times a wrist
-link's own inertia (identification/sanity.py uses the same two rules). Such entries are marked `suspect` (the
+rotor inertia is outside its physical range by identification/sanity.rotor_inertia_range (the
+same rule identify uses), or when its torque (Ia qdd_j, RMS over the fit data) is larger than
+LARGER x that whole residual, as for the offset. Such entries are marked `suspect` (the
 report prints them so, and the terminal and report.md carry the reason as a warning), and where
 two terms of one joint are both too large a warning says that the data cannot tell them apart.
 
@@ -23,10 +21,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..identification.sanity import inertia_about_joints
+from ..identification.sanity import inertia_about_joints, rotor_inertia_range
 
 LARGER = 1.5  # a term whose torque exceeds this many times its joint's whole nominal residual (RMS)
-ROTOR_RATIO = 100.0
 
 
 def _size(e) -> float | None:
@@ -58,10 +55,11 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
             if inertia is None:
                 inertia = inertia_about_joints(model, s, fit_signals)
             ia = e.values["Ia"]
-            qdd = np.sqrt(np.mean(np.concatenate([sig.qdd[sig.inner(), j] for sig in fit_signals]) ** 2))
-            if ia > ROTOR_RATIO * inertia[j]:
-                reason = (f"on joint {j + 1}, {ia:.3g} kg m^2 is {ia / inertia[j]:.0f} x the arm's own inertia about the joint "
-                          f"({inertia[j]:.3g} kg m^2): outside a rotor inertia's range")
+            qdd, torque = (np.sqrt(np.mean(np.concatenate([getattr(sig, x)[sig.inner(), j] for sig in fit_signals]) ** 2))
+                           for x in ("qdd", "tau"))
+            rotor = rotor_inertia_range(j, ia, inertia[j], qdd, torque)
+            if rotor:
+                reason = rotor
             elif ia * qdd > LARGER * before[j]:
                 reason = (f"on joint {j + 1}, its torque ({ia * qdd:.3g} Nm) is larger than the joint's whole nominal "
                           f"residual ({before[j]:.3g} Nm on the selection data): it makes up for another term")
