@@ -123,7 +123,8 @@ class Normal:
         M = np.eye(self.G.shape[-1])
         for k, beta in zip(ks, betas):
             M[self.r + len(self.labels), self.r + k] = -beta
-        return self._with(np.einsum("ai,pjab,bk->pjik", M, self.G, M), np.einsum("ai,pja->pji", M, self.g))
+        # two matrix products per block, not a four-index einsum (which loops over c^4 per block: 0.9 s)
+        return self._with(M.T @ self.G @ M, self.g @ M)
 
     def total(self, parts, weights=None, keep=None) -> tuple[np.ndarray, np.ndarray]:
         """(A^T W A, A^T W b) over the given parts, joint j's rows weighted by weights[j]^2,
