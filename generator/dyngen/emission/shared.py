@@ -1,0 +1,137 @@
+"""Each product formed once per emitted function: a product that two statements (or one twice)
+write is given its own statement, and both read it.
+
+Program.let shares identical expressions, not identical parts of different ones: the composite
+bodies turn h by one joint angle in the body's moment and again in the wrench carried down
+(s66 c7 - s68 s7 and s56 + s66 c7 - s68 s7), the standard parameters square a centre of mass
+coordinate in each of two inertia entries (m cx^2 in YY and ZZ), the factoring leaves
+0.5 (a + b) in J00 and in J11. gcc -O2 would merge some of them (identical operands in one basic
+block) but not the count, and a merge it cannot see (a product inside a longer one) costs an
+instruction. A product is a multiplication node of the factored statement (emission/factoring.py)
+with its factors as a set and its numeric coefficient by size: -2 a b and 2 b a are one product,
+read with its sign. The outermost repeated products go first, so a repeated product inside
+another one that is repeated whole is not split out; the loop ends when none repeats.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+import sympy as sp
+
+from ..derivation.program import Assignment
+
+
+def shared_products(assignments: list) -> list:
+    """assignments (expressions as written, factored) with every repeated product its own
+    assignment, placed before the first statement that reads it."""
+    made = 0
+    while True:
+        counts = Counter()
+        for a in assignments:
+            _collect(a.expr, counts)
+        repeated = {k for k, n in counts.items() if n > 1}
+        if not repeated:
+            _KEYS.clear()
+            return assignments
+        outermost = _outermost(assignments, repeated)
+        names, placed = {}, []
+        for a in assignments:  # numbered in the order of first use: deterministic output
+            needed = []
+            _keys_in(a.expr, outermost, needed)
+            for key in needed:
+                if key not in names:
+                    names[key] = sp.Symbol(f"shared{made}", real=True)
+                    made += 1
+                    placed.append(Assignment(names[key], _product(key), a.section))
+            placed.append(Assignment(a.symbol, _replaced(a.expr, names), a.section))
+        assignments = placed
+
+
+_KEYS: dict = {}
+
+
+def _key(node):
+    """Memoised _product_key (sympy nodes hash once; the loop revisits every node)."""
+    found = _KEYS.get(node)
+    if found is None:
+        found = _KEYS[node] = _product_key(node)
+    return found
+
+
+def _product_key(node):
+    """(size of the numeric coefficient, sorted other factors), sign; None if no product."""
+    if node.is_Pow and node.exp.is_Integer and 1 < node.exp <= 4 and not node.base.is_number:
+        return (sp.Integer(1), (node,)), 1
+    if not node.is_Mul:
+        return None, 1
+    numbers = sp.Mul(*(f for f in node.args if f.is_Number))
+    others = tuple(sorted((f for f in node.args if not f.is_Number), key=sp.default_sort_key))
+    if len(others) + (abs(numbers) != 1) < 2:
+        return None, 1
+    return (abs(numbers), others), (-1 if numbers < 0 else 1)
+
+
+def _product(key):
+    size, others = key
+    if len(others) == 1 and others[0].is_Pow:
+        return others[0]
+    return sp.Mul(*(([size] if size != 1 else []) + list(others)), evaluate=False)
+
+
+def _collect(node, counts):
+    key, _ = _key(node)
+    if key is not None:
+        counts[key] += 1
+    for arg in node.args:
+        if not arg.is_Atom:
+            _collect(arg, counts)
+
+
+def _outermost(assignments, repeated) -> set:
+    """The repeated products that no other repeated product contains."""
+    inner = set()
+
+    def visit(node, inside):
+        key, _ = _key(node)
+        here = key in repeated
+        if here and inside:
+            inner.add(key)
+        for arg in node.args:
+            if not arg.is_Atom:
+                visit(arg, inside or here)
+
+    for a in assignments:
+        visit(a.expr, False)
+    return repeated - inner
+
+
+def _keys_in(node, names, found):
+    """The keys of `names` that node holds, outermost first, each once."""
+    key, _ = _key(node)
+    if key in names:
+        if key not in found:
+            found.append(key)
+        return
+    for arg in node.args:
+        if not arg.is_Atom:
+            _keys_in(arg, names, found)
+
+
+def _replaced(node, names):
+    key, sign = _key(node)
+    if key in names:
+        return names[key] if sign > 0 else sp.Mul(-1, names[key], evaluate=False)
+    if node.is_Atom:
+        return node
+    args = [_replaced(a, names) for a in node.args]
+    if node.is_Mul:  # a factor turned -t: its sign joins the product's coefficient
+        sign, flat = 1, []
+        for a in args:
+            if a.is_Mul and len(a.args) == 2 and a.args[0] == -1:
+                sign, a = -sign, a.args[1]
+            flat.append(a)
+        numbers = sp.Mul(sign, *(f for f in flat if f.is_Number))
+        rest = [f for f in flat if not f.is_Number]
+        return sp.Mul(*([numbers] if numbers != 1 else []), *rest, evaluate=False)
+    return node.func(*args, evaluate=False)
