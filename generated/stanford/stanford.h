@@ -73,12 +73,23 @@ typedef double stanford_real;
  * for sin r and cos r, then the quadrant k mod 4: absolute error at most 2.3e-16 in double, 8e-8
  * in float (2e6 random angles against libm). Beyond |x| = 1e5 (double) or 8192 (float), and for
  * NaN, libm's sin and cos. A statement macro, so the library has no function of its own. */
+/* STANFORD_NEAREST(y, T, big): the integer nearest to y (|y| < 2^22), as a T. Where the compiler
+ * rounds every operation to its type (FLT_EVAL_METHOD 0, no -ffast-math), adding and subtracting
+ * big = 1.5 * 2^52 (1.5 * 2^23 in float) leaves y rounded to an integer: two additions, where the
+ * sign test, the +-0.5 and the conversions to int and back cost about five more instructions
+ * per angle. Elsewhere (x87 excess precision, or -ffast-math, which would cancel the two
+ * additions) the conversion through int. */
+#if defined(__FLT_EVAL_METHOD__) && __FLT_EVAL_METHOD__ == 0 && !defined(__FAST_MATH__)
+#define STANFORD_NEAREST(y, T, big) (((y) + (big)) - (big))
+#else
+#define STANFORD_NEAREST(y, T, big) ((T)(int)((y) + ((y) >= (T)0 ? (T)0.5 : (T)-0.5)))
+#endif
 #ifdef STANFORD_USE_FLOAT
 #define STANFORD_SINCOS(x, s, c) do { \
     const float x_ = (x); \
     if (!(x_ >= -8192.0f && x_ <= 8192.0f)) { *(s) = sinf(x_); *(c) = cosf(x_); break; } \
-    const int k_ = (int)(x_ * 0.63661977236758134f + (x_ >= 0.0f ? 0.5f : -0.5f)); \
-    const float kf_ = (float)k_; \
+    const float kf_ = STANFORD_NEAREST(x_ * 0.63661977236758134f, float, 12582912.0f); \
+    const int k_ = (int)kf_; \
     const float r_ = ((x_ - kf_ * 1.5703125f) - kf_ * 4.837512969970703125e-4f) - kf_ * 7.54978995489188216e-8f; \
     const float z_ = r_ * r_; \
     const float s_ = ((-1.9515295891e-4f * z_ + 8.3321608736e-3f) * z_ - 1.6666654611e-1f) * z_ * r_ + r_; \
@@ -90,8 +101,8 @@ typedef double stanford_real;
 #define STANFORD_SINCOS(x, s, c) do { \
     const double x_ = (x); \
     if (!(x_ >= -1e5 && x_ <= 1e5)) { *(s) = sin(x_); *(c) = cos(x_); break; } \
-    const int k_ = (int)(x_ * 0.63661977236758134 + (x_ >= 0.0 ? 0.5 : -0.5)); \
-    const double kd_ = (double)k_; \
+    const double kd_ = STANFORD_NEAREST(x_ * 0.63661977236758134, double, 6755399441055744.0); \
+    const int k_ = (int)kd_; \
     const double r_ = ((x_ - kd_ * 1.57079625129699707031) - kd_ * 7.54978941586159635336e-8) \
                       - kd_ * 5.39030285815811905290e-15; \
     const double z_ = r_ * r_; \
