@@ -22,9 +22,30 @@ import sympy as sp
 from ..derivation.program import Assignment
 
 
-def shared_products(assignments: list) -> list:
+def shared_products(assignments: list, outputs_free: set) -> list:
     """assignments (expressions as written, factored) with every repeated product its own
-    assignment, placed before the first statement that reads it."""
+    assignment, placed before the first statement that reads it; then the statements left
+    copying or negating one value (x12 = x10, x20 = -x18: a product that was a whole statement)
+    are read through in their readers, unless an output reads them."""
+    return _read_through(_products_once(assignments), outputs_free)
+
+
+def _read_through(assignments: list, outputs_free: set) -> list:
+    """A copy x = y or negation x = -y is a move or a sign flip (xorpd) that the reader can do
+    for free: a - (-y) is a + y, and a sign in a product joins its coefficient."""
+    through, kept = {}, []
+    for a in assignments:
+        expr = _replaced(a.expr, lambda node: through.get(node) if node.is_Symbol else None)
+        single = expr.is_Symbol or (expr.is_Mul and len(expr.args) == 2 and expr.args[0] == -1
+                                    and expr.args[1].is_Symbol)
+        if single and a.symbol not in outputs_free:
+            through[a.symbol] = expr
+        else:
+            kept.append(Assignment(a.symbol, expr, a.section))
+    return kept
+
+
+def _products_once(assignments: list) -> list:
     made = 0
     while True:
         counts = Counter()
@@ -44,7 +65,7 @@ def shared_products(assignments: list) -> list:
                     names[key] = sp.Symbol(f"shared{made}", real=True)
                     made += 1
                     placed.append(Assignment(names[key], _product(key), a.section))
-            placed.append(Assignment(a.symbol, _replaced(a.expr, names), a.section))
+            placed.append(Assignment(a.symbol, _replaced(a.expr, lambda node: _named(node, names)), a.section))
         assignments = placed
 
 
@@ -118,13 +139,22 @@ def _keys_in(node, names, found):
             _keys_in(arg, names, found)
 
 
-def _replaced(node, names):
+def _named(node, names):
+    """The shared symbol standing for node (with node's sign), or None."""
     key, sign = _key(node)
-    if key in names:
-        return names[key] if sign > 0 else sp.Mul(-1, names[key], evaluate=False)
+    if key not in names:
+        return None
+    return names[key] if sign > 0 else sp.Mul(-1, names[key], evaluate=False)
+
+
+def _replaced(node, lookup):
+    """node with each part for which lookup gives an expression replaced by it, outermost first."""
+    found = lookup(node)
+    if found is not None:
+        return found
     if node.is_Atom:
         return node
-    args = [_replaced(a, names) for a in node.args]
+    args = [_replaced(a, lookup) for a in node.args]
     if node.is_Mul:  # a factor turned -t: its sign joins the product's coefficient
         sign, flat = 1, []
         for a in args:
