@@ -23,9 +23,9 @@
  *   lwr_pi_gravity               19 mul, 13 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity_jacobian      0 mul, 2 add, 0 div, 0 sin/cos
  *   lwr_pi_inertia               97 mul, 96 add, 0 div, 0 sin/cos
- *   lwr_pi_inertia_jacobian      105 mul, 35 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia_jacobian      87 mul, 35 add, 0 div, 0 sin/cos
  *   lwr_pi_full                  98 mul, 100 add, 0 div, 0 sin/cos
- *   lwr_pi_full_jacobian         100 mul, 33 add, 0 div, 0 sin/cos
+ *   lwr_pi_full_jacobian         82 mul, 33 add, 0 div, 0 sin/cos
  *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 6 sin/cos
  *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 6 sin/cos
  *   lwr_regressor                669 mul, 420 add, 0 div, 6 sin/cos
@@ -169,7 +169,7 @@ void lwr_pi_inertia(const lwr_real *p, lwr_real *pi);
 /* Jacobian d pi_inertia / d p (for gradient-based extraction).
  *   p        [70]  dynamic parameters, 10 per link
  *   J        [39 x 70]  row-major (written)
- * 105 mul, 35 add, 0 div, 0 sin/cos
+ * 87 mul, 35 add, 0 div, 0 sin/cos
  */
 void lwr_pi_inertia_jacobian(const lwr_real *p, lwr_real *J);
 
@@ -183,7 +183,7 @@ void lwr_pi_full(const lwr_real *p, lwr_real *pi);
 /* Jacobian d pi_full / d p (for gradient-based extraction).
  *   p        [70]  dynamic parameters, 10 per link
  *   J        [43 x 70]  row-major (written)
- * 100 mul, 33 add, 0 div, 0 sin/cos
+ * 82 mul, 33 add, 0 div, 0 sin/cos
  */
 void lwr_pi_full_jacobian(const lwr_real *p, lwr_real *J);
 

@@ -1016,7 +1016,7 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x44 = s[68]*c7;
     const lwr_real x45 = s[58] + x43 + x44;
     const lwr_real x46 = -s[69] + x35;
-    const lwr_real x47 = LWR_K(0.5)*(s[69] + x35);
+    const lwr_real x47 = LWR_K(0.5)*(-s[69] - x35);
     /* column 7: to joint 6 */
     const lwr_real x48 = x39 - x40;
     const lwr_real x49 = qd[6]*(x39 - x40);
@@ -1049,9 +1049,9 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x73 = s[44] - s[49] + s[59];
     const lwr_real x74 = c6*s6;
     const lwr_real x75 = x71*x46 + x74*x42;
-    const lwr_real x76 = x47 + (x73 + x75);
+    const lwr_real x76 = -x47 + (x73 + x75);
     const lwr_real x77 = s[47] + s[59];
-    const lwr_real x78 = x47 + (x77 - x75);
+    const lwr_real x78 = -x47 + (x77 - x75);
     const lwr_real x79 = -x71*x42 + x74*x46;
     const lwr_real x80 = s[45] + x79;
     const lwr_real x81 = s6*x45;
@@ -1065,7 +1065,7 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x88 = s[48] - x82 - x84;
     const lwr_real x89 = -x82 - x84;
     const lwr_real x90 = -x37 + x76;
-    const lwr_real x91 = LWR_K(0.5)*(x37 + x76);
+    const lwr_real x91 = LWR_K(0.5)*(-x37 - x76);
     const lwr_real x92 = x37 + LWR_K(0.39)*x67;
     /* column 7: to joint 5 */
     const lwr_real x93 = -c6*x21;
@@ -1125,15 +1125,15 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x143 = LWR_K(0.78)*x67;
     const lwr_real x144 = c5*s5;
     const lwr_real x145 = x141*x90 + x144*x87;
-    const lwr_real x146 = x91 + (x143 + x13 + x145);
-    const lwr_real x147 = x91 + (x143 + x14 - x145);
+    const lwr_real x146 = -x91 + (x143 + x13 + x145);
+    const lwr_real x147 = -x91 + (x143 + x14 - x145);
     const lwr_real x148 = -x141*x87 + x144*x90;
     const lwr_real x149 = s[35] + x148;
     const lwr_real x150 = s[36] + c5*x80 + s5*x88 - LWR_K(0.39)*x137;
     const lwr_real x151 = s[38] - c5*x88 + s5*x80 - LWR_K(0.39)*x138;
     const lwr_real x152 = 2*x150;
     const lwr_real x153 = -x78 + x146;
-    const lwr_real x154 = LWR_K(0.5)*(x78 + x146);
+    const lwr_real x154 = LWR_K(0.5)*(-x78 - x146);
     /* column 5: to joint 4 */
     const lwr_real x155 = c5*x124 + s5*x122;
     const lwr_real x156 = -c5*x122 + s5*x124;
@@ -1163,7 +1163,7 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x178 = s[31] + x137;
     const lwr_real x179 = qd[3]*x178;
     const lwr_real x180 = -x110 + x173;
-    const lwr_real x181 = LWR_K(0.5)*(x110 + x173);
+    const lwr_real x181 = LWR_K(0.5)*(-x110 - x173);
     const lwr_real x182 = qd[3]*x151;
     const lwr_real x183 = qd[3]*x149;
     const lwr_real x184 = qd[2]*x139;
@@ -1191,9 +1191,9 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x203 = s[24] - s[29] + s[39];
     const lwr_real x204 = c4*s4;
     const lwr_real x205 = x201*x153 + x204*x152;
-    const lwr_real x206 = x154 + (x203 + x205);
+    const lwr_real x206 = -x154 + (x203 + x205);
     const lwr_real x207 = s[27] + s[39];
-    const lwr_real x208 = x154 + (x207 - x205);
+    const lwr_real x208 = -x154 + (x207 - x205);
     const lwr_real x209 = -x201*x152 + x204*x153;
     const lwr_real x210 = c4*x149;
     const lwr_real x211 = -c4*x151 + s4*x149;
@@ -1229,13 +1229,13 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x237 = -qd[3]*s4*x236;
     const lwr_real x238 = x237*x153 + x202*x152 + x180*x201 + x177*x204;
     const lwr_real x239 = -x237*x152 + x202*x153 + x180*x204 - x177*x201;
-    const lwr_real x240 = x181 + x238;
-    const lwr_real x241 = x181 - x238;
+    const lwr_real x240 = -x181 + x238;
+    const lwr_real x241 = -x181 - x238;
     const lwr_real x242 = c4*(x182 + x171) + s4*(-x183 + x176);
     const lwr_real x243 = c4*(x183 - x176) + s4*(x182 + x171);
     const lwr_real x244 = qd[2]*x199;
     const lwr_real x245 = -x174 + x240;
-    const lwr_real x246 = LWR_K(0.5)*(x174 + x240);
+    const lwr_real x246 = LWR_K(0.5)*(-x174 - x240);
     const lwr_real x247 = LWR_K(0.8)*x235;
     const lwr_real x248 = x174 - LWR_K(0.4)*x235;
     const lwr_real x249 = qd[2]*x209;
@@ -1299,8 +1299,8 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
     const lwr_real x296 = c2*c2;
     const lwr_real x297 = x296 + LWR_K(-0.5);
     const lwr_real x298 = qd[1]*(-s2*s2 + x296);
-    const lwr_real x299 = x246 + (-x247 + x293);
-    const lwr_real x300 = x246 + (-x247 - x293);
+    const lwr_real x299 = -x246 + (-x247 + x293);
+    const lwr_real x300 = -x246 + (-x247 - x293);
     const lwr_real x301 = 2*c2;
     const lwr_real x302 = -qd[1]*s2*x301;
     const lwr_real x303 = c2*s2;

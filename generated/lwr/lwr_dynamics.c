@@ -693,7 +693,7 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x39 = s[58] + x37 + x38;
     const lwr_real x40 = x37 + x38;
     const lwr_real x41 = -s[69] + x28;
-    const lwr_real x42 = LWR_K(0.5)*(s[69] + x28);
+    const lwr_real x42 = LWR_K(0.5)*(-s[69] - x28);
     const lwr_real x43 = s[53] + s[63];
     const lwr_real x44 = s[51] + x18;
     lwr_real s6, c6;
@@ -707,9 +707,9 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x50 = x48*x41 + x49*x36;
     const lwr_real x51 = -x48*x36 + x49*x41;
     const lwr_real x52 = s[44] - s[49] + s[59];
-    const lwr_real x53 = x42 + (x52 + x50);
+    const lwr_real x53 = -x42 + (x52 + x50);
     const lwr_real x54 = s[47] + s[59];
-    const lwr_real x55 = x42 + (x54 - x50);
+    const lwr_real x55 = -x42 + (x54 - x50);
     const lwr_real x56 = s[45] + x51;
     const lwr_real x57 = s6*x39;
     const lwr_real x58 = c6*x39;
@@ -722,7 +722,7 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x64 = s[48] - x58 - x60;
     const lwr_real x65 = -x58 - x60;
     const lwr_real x66 = -x30 + x53;
-    const lwr_real x67 = LWR_K(0.5)*(x30 + x53);
+    const lwr_real x67 = LWR_K(0.5)*(-x30 - x53);
     const lwr_real x68 = s[41] + x45;
     /* column 5: composite wrench */
     const lwr_real x69 = -LWR_K(0.39)*x68 + x56;
@@ -746,14 +746,14 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x83 = x81*x66 + x82*x63;
     const lwr_real x84 = -x81*x63 + x82*x66;
     const lwr_real x85 = LWR_K(0.78)*x46;
-    const lwr_real x86 = x67 + (x85 + x14 + x83);
-    const lwr_real x87 = x67 + (x85 + x15 - x83);
+    const lwr_real x86 = -x67 + (x85 + x14 + x83);
+    const lwr_real x87 = -x67 + (x85 + x15 - x83);
     const lwr_real x88 = s[35] + x84;
     const lwr_real x89 = s[36] + c5*x56 + s5*x64 - LWR_K(0.39)*x78;
     const lwr_real x90 = s[38] - c5*x64 + s5*x56 - LWR_K(0.39)*x79;
     const lwr_real x91 = 2*x89;
     const lwr_real x92 = -x55 + x86;
-    const lwr_real x93 = LWR_K(0.5)*(x55 + x86);
+    const lwr_real x93 = LWR_K(0.5)*(-x55 - x86);
     /* column 5: to joint 4 */
     const lwr_real x94 = c5*x69 + s5*x70;
     const lwr_real x95 = -c5*x70 + s5*x69;
@@ -779,9 +779,9 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x110 = x108*x92 + x109*x91;
     const lwr_real x111 = -x108*x91 + x109*x92;
     const lwr_real x112 = s[24] - s[29] + s[39];
-    const lwr_real x113 = x93 + (x112 + x110);
+    const lwr_real x113 = -x93 + (x112 + x110);
     const lwr_real x114 = s[27] + s[39];
-    const lwr_real x115 = x93 + (x114 - x110);
+    const lwr_real x115 = -x93 + (x114 - x110);
     const lwr_real x116 = c4*x88;
     const lwr_real x117 = -c4*x90 + s4*x88;
     const lwr_real x118 = s4*x90;
@@ -791,7 +791,7 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     /* link 2: composite body */
     const lwr_real x121 = -2*x119;
     const lwr_real x122 = -x87 + x113;
-    const lwr_real x123 = LWR_K(0.5)*(x87 + x113);
+    const lwr_real x123 = LWR_K(0.5)*(-x87 - x113);
     const lwr_real x124 = LWR_K(0.8)*x106;
     const lwr_real x125 = x87 - LWR_K(0.4)*x106;
     /* column 3: composite wrench */
@@ -826,8 +826,8 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M)
     const lwr_real x149 = c3*s3;
     const lwr_real x150 = x148*x122 + x149*x121;
     const lwr_real x151 = -x148*x121 + x149*x122;
-    const lwr_real x152 = x123 + (-x124 + x3 + x150);
-    const lwr_real x153 = x123 + (-x124 + x4 - x150);
+    const lwr_real x152 = -x123 + (-x124 + x3 + x150);
+    const lwr_real x153 = -x123 + (-x124 + x4 - x150);
     const lwr_real x154 = s[15] + x151;
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);

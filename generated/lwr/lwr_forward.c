@@ -52,7 +52,7 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x33 = s[58] + x31 + x32;
     const lwr_real x34 = x31 + x32;
     const lwr_real x35 = -s[69] + x23;
-    const lwr_real x36 = LWR_K(0.5)*(s[69] + x23);
+    const lwr_real x36 = LWR_K(0.5)*(-s[69] - x23);
     const lwr_real x37 = s[53] + s[63];
     const lwr_real x38 = c7*s[61] - s[62]*s7;
     const lwr_real x39 = s[51] + x38;
@@ -66,9 +66,9 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x45 = -x42*x30 + x43*x35;
     const lwr_real x46 = s[45] + x45;
     const lwr_real x47 = s[44] - s[49] + s[59];
-    const lwr_real x48 = x36 + (x47 + x44);
+    const lwr_real x48 = -x36 + (x47 + x44);
     const lwr_real x49 = s[47] + s[59];
-    const lwr_real x50 = x36 + (x49 - x44);
+    const lwr_real x50 = -x36 + (x49 - x44);
     const lwr_real x51 = s6*x33;
     const lwr_real x52 = c6*x33;
     const lwr_real x53 = c6*x20;
@@ -82,7 +82,7 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x59 = -x52 - x54;
     const lwr_real x60 = x9 + x41;
     const lwr_real x61 = -x25 + x48;
-    const lwr_real x62 = LWR_K(0.5)*(x25 + x48);
+    const lwr_real x62 = LWR_K(0.5)*(-x25 - x48);
     const lwr_real x63 = s[41] + x40;
     /* column 5: composite wrench */
     const lwr_real x64 = -LWR_K(0.39)*x63 + x46;
@@ -108,8 +108,8 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x81 = -x78*x57 + x79*x61;
     const lwr_real x82 = s[35] + x81;
     const lwr_real x83 = LWR_K(0.78)*x41;
-    const lwr_real x84 = x62 + (x83 + x12 + x80);
-    const lwr_real x85 = x62 + (x83 + x13 - x80);
+    const lwr_real x84 = -x62 + (x83 + x12 + x80);
+    const lwr_real x85 = -x62 + (x83 + x13 - x80);
     const lwr_real x86 = s[36] + c5*x46 + s5*x58 - LWR_K(0.39)*x76;
     const lwr_real x87 = s[38] - c5*x58 + s5*x46 - LWR_K(0.39)*x77;
     /* link 3: composite body */
@@ -117,7 +117,7 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x89 = s[32] + s[23];
     const lwr_real x90 = x77 + x89;
     const lwr_real x91 = -x50 + x84;
-    const lwr_real x92 = LWR_K(0.5)*(x50 + x84);
+    const lwr_real x92 = LWR_K(0.5)*(-x50 - x84);
     /* column 5: to joint 4 */
     const lwr_real x93 = c5*x64 + s5*x68;
     const lwr_real x94 = -c5*x68 + s5*x64;
@@ -144,9 +144,9 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x110 = -x107*x88 + x108*x91;
     const lwr_real x111 = s[25] + x110;
     const lwr_real x112 = s[24] - s[29] + s[39];
-    const lwr_real x113 = x92 + (x109 + x112);
+    const lwr_real x113 = -x92 + (x109 + x112);
     const lwr_real x114 = s[27] + s[39];
-    const lwr_real x115 = x92 + (x114 - x109);
+    const lwr_real x115 = -x92 + (x114 - x109);
     const lwr_real x116 = c4*x82;
     const lwr_real x117 = s4*x82;
     const lwr_real x118 = s4*x87;
@@ -159,7 +159,7 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x123 = s[28] + x117 - x119;
     const lwr_real x124 = x117 - x119;
     const lwr_real x125 = -x85 + x113;
-    const lwr_real x126 = LWR_K(0.5)*(x85 + x113);
+    const lwr_real x126 = LWR_K(0.5)*(-x85 - x113);
     const lwr_real x127 = LWR_K(0.8)*x105;
     const lwr_real x128 = x85 - LWR_K(0.4)*x105;
     /* column 3: composite wrench */
@@ -195,8 +195,8 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
     const lwr_real x153 = x151*x125 + x152*x122;
     const lwr_real x154 = -x151*x122 + x152*x125;
     const lwr_real x155 = s[15] + x154;
-    const lwr_real x156 = x126 + (-x127 + x5 + x153);
-    const lwr_real x157 = x126 + (-x127 + x6 - x153);
+    const lwr_real x156 = -x126 + (-x127 + x5 + x153);
+    const lwr_real x157 = -x126 + (-x127 + x6 - x153);
     lwr_real s2, c2;
     LWR_SINCOS(q[1], &s2, &c2);
     const lwr_real x158 = -c2*x149 - s2*x155;

@@ -23,9 +23,9 @@
  *   stanford_pi_gravity          14 mul, 9 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity_jacobian 0 mul, 1 add, 0 div, 0 sin/cos
  *   stanford_pi_inertia          85 mul, 80 add, 0 div, 0 sin/cos
- *   stanford_pi_inertia_jacobian 95 mul, 31 add, 0 div, 0 sin/cos
+ *   stanford_pi_inertia_jacobian 80 mul, 31 add, 0 div, 0 sin/cos
  *   stanford_pi_full             83 mul, 78 add, 0 div, 0 sin/cos
- *   stanford_pi_full_jacobian    85 mul, 28 add, 0 div, 0 sin/cos
+ *   stanford_pi_full_jacobian    70 mul, 28 add, 0 div, 0 sin/cos
  *   stanford_regressor_gravity   59 mul, 23 add, 0 div, 4 sin/cos
  *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 4 sin/cos
  *   stanford_regressor           373 mul, 259 add, 0 div, 4 sin/cos
@@ -169,7 +169,7 @@ void stanford_pi_inertia(const stanford_real *p, stanford_real *pi);
 /* Jacobian d pi_inertia / d p (for gradient-based extraction).
  *   p        [60]  dynamic parameters, 10 per link
  *   J        [31 x 60]  row-major (written)
- * 95 mul, 31 add, 0 div, 0 sin/cos
+ * 80 mul, 31 add, 0 div, 0 sin/cos
  */
 void stanford_pi_inertia_jacobian(const stanford_real *p, stanford_real *J);
 
@@ -183,7 +183,7 @@ void stanford_pi_full(const stanford_real *p, stanford_real *pi);
 /* Jacobian d pi_full / d p (for gradient-based extraction).
  *   p        [60]  dynamic parameters, 10 per link
  *   J        [33 x 60]  row-major (written)
- * 85 mul, 28 add, 0 div, 0 sin/cos
+ * 70 mul, 28 add, 0 div, 0 sin/cos
  */
 void stanford_pi_full_jacobian(const stanford_real *p, stanford_real *J);
 

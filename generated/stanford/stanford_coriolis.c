@@ -658,7 +658,7 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
     const stanford_real x42 = qd[5]*(-x39 - x40) - STANFORD_K(0.263)*x19;
     const stanford_real x43 = 2*x42;
     const stanford_real x44 = -s[59] + x31;
-    const stanford_real x45 = STANFORD_K(0.5)*(s[59] + x31);
+    const stanford_real x45 = STANFORD_K(0.5)*(-s[59] - x31);
     /* column 6: composite wrench */
     const stanford_real x46 = s[56] - STANFORD_K(0.263)*s[51];
     /* column 6: to joint 5 */
@@ -707,9 +707,9 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
     const stanford_real x85 = s[34] - s[39] + s[49];
     const stanford_real x86 = c5*s5;
     const stanford_real x87 = x83*x44 + x86*x38;
-    const stanford_real x88 = x45 + (x85 + x87);
+    const stanford_real x88 = -x45 + (x85 + x87);
     const stanford_real x89 = s[37] + s[49];
-    const stanford_real x90 = x45 + (x89 - x87);
+    const stanford_real x90 = -x45 + (x89 - x87);
     const stanford_real x91 = -x83*x38 + x86*x44;
     const stanford_real x92 = s[35] + x91;
     const stanford_real x93 = c5*x33;

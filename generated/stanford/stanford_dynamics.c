@@ -526,7 +526,7 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x31 = 2*x30;
     const stanford_real x32 = s[56]*s6 + s[48] + s[58]*c6 - STANFORD_K(0.263)*x19;
     const stanford_real x33 = -s[59] + x26;
-    const stanford_real x34 = STANFORD_K(0.5)*(s[59] + x26);
+    const stanford_real x34 = STANFORD_K(0.5)*(-s[59] - x26);
     /* column 6: composite wrench */
     const stanford_real x35 = s[56] - STANFORD_K(0.263)*s[51];
     const stanford_real x36 = s[58] - STANFORD_K(0.263)*s[52];
@@ -549,9 +549,9 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x48 = x46*x33 + x47*x31;
     const stanford_real x49 = -x46*x31 + x47*x33;
     const stanford_real x50 = s[34] - s[39] + s[49];
-    const stanford_real x51 = x34 + (x50 + x48);
+    const stanford_real x51 = -x34 + (x50 + x48);
     const stanford_real x52 = s[37] + s[49];
-    const stanford_real x53 = x34 + (x52 - x48);
+    const stanford_real x53 = -x34 + (x52 - x48);
     const stanford_real x54 = s[35] + x49;
     const stanford_real x55 = c5*x28;
     const stanford_real x56 = s5*x28;
@@ -564,7 +564,7 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x62 = s[38] + x56 - x58;
     const stanford_real x63 = x56 - x58;
     const stanford_real x64 = -x27 + x51;
-    const stanford_real x65 = STANFORD_K(0.5)*(x27 + x51);
+    const stanford_real x65 = STANFORD_K(0.5)*(-x27 - x51);
     /* column 6: to joint 4 */
     const stanford_real x66 = -c5*x19;
     const stanford_real x67 = -s5*x19;
@@ -583,8 +583,8 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
     const stanford_real x78 = -x75*x61 + x76*x64;
     /* column 2: composite wrench */
     const stanford_real x79 = -x78 - STANFORD_K(0.154)*x74;
-    const stanford_real x80 = x65 + x77;
-    const stanford_real x81 = x65 - x77;
+    const stanford_real x80 = -x65 + x77;
+    const stanford_real x81 = -x65 - x77;
     const stanford_real x82 = s[14] + s[27] - s[19] - s[29] + s[39];
     const stanford_real x83 = q[2]*q[2]*x9;
     const stanford_real x84 = x83 + x45 + x81 + x82;

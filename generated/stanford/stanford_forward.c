@@ -41,7 +41,7 @@ void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x23 = c6*s[52] + s[51]*s6;
     const stanford_real x24 = x22 + x23;
     const stanford_real x25 = -s[59] + x17;
-    const stanford_real x26 = STANFORD_K(0.5)*(s[59] + x17);
+    const stanford_real x26 = STANFORD_K(0.5)*(-s[59] - x17);
     /* column 6: composite wrench */
     const stanford_real x27 = s[56] - STANFORD_K(0.263)*s[51];
     const stanford_real x28 = s[58] - STANFORD_K(0.263)*s[52];
@@ -59,9 +59,9 @@ void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x37 = -x34*x21 + x35*x25;
     const stanford_real x38 = s[35] + x37;
     const stanford_real x39 = s[34] - s[39] + s[49];
-    const stanford_real x40 = x26 + (x39 + x36);
+    const stanford_real x40 = -x26 + (x39 + x36);
     const stanford_real x41 = s[37] + s[49];
-    const stanford_real x42 = x26 + (x41 - x36);
+    const stanford_real x42 = -x26 + (x41 - x36);
     const stanford_real x43 = c5*x15;
     const stanford_real x44 = s5*x15;
     const stanford_real x45 = s[56]*s6 + s[48] + s[58]*c6 - STANFORD_K(0.263)*x23;
@@ -75,7 +75,7 @@ void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x51 = s[38] + x44 - x47;
     const stanford_real x52 = x44 - x47;
     const stanford_real x53 = -x18 + x40;
-    const stanford_real x54 = STANFORD_K(0.5)*(x18 + x40);
+    const stanford_real x54 = STANFORD_K(0.5)*(-x18 - x40);
     const stanford_real x55 = s[20] + s[30] + s[40] + s[50];
     const stanford_real x56 = -s[32] + s[23];
     const stanford_real x57 = -x33 + x56;
@@ -99,8 +99,8 @@ void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, 
     const stanford_real x71 = -x68*x50 + x69*x53;
     const stanford_real x72 = s[15] - s[25];
     const stanford_real x73 = x72 - x71;
-    const stanford_real x74 = x54 + x70;
-    const stanford_real x75 = x54 - x70;
+    const stanford_real x74 = -x54 + x70;
+    const stanford_real x75 = -x54 - x70;
     const stanford_real x76 = s[14] + s[27] - s[19] - s[29] + s[39];
     const stanford_real x77 = q[2]*q[2]*x55;
     const stanford_real x78 = x77 + x59 + x76 + x75;

@@ -87,10 +87,30 @@ def _product_key(node):
     if not node.is_Mul:
         return None, 1
     numbers = sp.Mul(*(f for f in node.args if f.is_Number))
-    others = tuple(sorted((f for f in node.args if not f.is_Number), key=sp.default_sort_key))
+    signed = [_signed_factor(f) for f in node.args if not f.is_Number]
+    others = tuple(sorted((f for f, _ in signed), key=sp.default_sort_key))
     if len(others) + (abs(numbers) != 1) < 2:
         return None, 1
-    return (abs(numbers), others), (-1 if numbers < 0 else 1)
+    sign = (-1 if numbers < 0 else 1) * sp.prod(s for _, s in signed)
+    return (abs(numbers), others), sign
+
+
+def _signed_factor(f):
+    """(f or -f, sign): a sum and its negation are one factor (c (a - b) and c (b - a))."""
+    if not f.is_Add:
+        return f, 1
+    negated = sp.Add(*(_negated(a) for a in f.args), evaluate=False)
+    return (f, 1) if sp.default_sort_key(f) <= sp.default_sort_key(negated) else (negated, -1)
+
+
+def _negated(term):
+    """-term without re-evaluating it (a number times a sum would be multiplied out)."""
+    if term.is_Symbol:
+        return -term
+    if term.is_Mul and term.args[0].is_Number:
+        c, rest = -term.args[0], list(term.args[1:])
+        return rest[0] if c == 1 and len(rest) == 1 else sp.Mul(*([c] if c != 1 else []), *rest, evaluate=False)
+    return sp.Mul(-1, term, evaluate=False)
 
 
 def _product(key):
@@ -100,10 +120,24 @@ def _product(key):
     return sp.Mul(*(([size] if size != 1 else []) + list(others)), evaluate=False)
 
 
+def _rest_key(node):
+    """The product inside c x y (|c| != 1): the printer writes c*(x*y), so x*y is formed first."""
+    if not node.is_Mul:
+        return None
+    numbers = [f for f in node.args if f.is_Number]
+    others = tuple(sorted((f for f in node.args if not f.is_Number), key=sp.default_sort_key))
+    if not numbers or abs(sp.Mul(*numbers)) == 1 or len(others) < 2:
+        return None
+    return sp.Integer(1), others
+
+
 def _collect(node, counts):
     key, _ = _key(node)
     if key is not None:
         counts[key] += 1
+    rest = _rest_key(node)
+    if rest is not None:
+        counts[rest] += 1
     for arg in node.args:
         if not arg.is_Atom:
             _collect(arg, counts)
@@ -118,6 +152,9 @@ def _outermost(assignments, repeated) -> set:
         here = key in repeated
         if here and inside:
             inner.add(key)
+        rest = _rest_key(node)
+        if rest in repeated and (inside or here):
+            inner.add(rest)
         for arg in node.args:
             if not arg.is_Atom:
                 visit(arg, inside or here)
@@ -134,6 +171,9 @@ def _keys_in(node, names, found):
         if key not in found:
             found.append(key)
         return
+    rest = _rest_key(node)
+    if rest in names and rest not in found:
+        found.append(rest)
     for arg in node.args:
         if not arg.is_Atom:
             _keys_in(arg, names, found)
@@ -142,9 +182,12 @@ def _keys_in(node, names, found):
 def _named(node, names):
     """The shared symbol standing for node (with node's sign), or None."""
     key, sign = _key(node)
-    if key not in names:
-        return None
-    return names[key] if sign > 0 else sp.Mul(-1, names[key], evaluate=False)
+    if key in names:
+        return names[key] if sign > 0 else sp.Mul(-1, names[key], evaluate=False)
+    rest = _rest_key(node)
+    if rest in names:  # c x y -> c t
+        return sp.Mul(sp.Mul(*(f for f in node.args if f.is_Number)), names[rest], evaluate=False)
+    return None
 
 
 def _replaced(node, lookup):
