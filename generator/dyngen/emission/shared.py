@@ -46,6 +46,8 @@ def _read_through(assignments: list, outputs_free: set) -> list:
 
 
 def _products_once(assignments: list) -> list:
+    """Rounds until no product repeats: each round names the outermost repeated products
+    (shared0, shared1, ... in the order of first use) and rewrites the statements to read them."""
     made = 0
     while True:
         counts = Counter()
