@@ -685,8 +685,11 @@ def bench(args, work: Path) -> int:
     cas_rows = casadi_table(arms, times, irs, libm if irs else None)
 
     cc_v, cxx_v = compiler_version(cc), compiler_version(cxx)
+    import dyngen  # which generator wrote the C: this checkout's (common.on_path puts it first)
+
     info = [
         f"- machine: {machine()}",
+        f"- generator: dyngen from `{Path(dyngen.__file__).resolve().parent}`",
         f"- C compiler: `{cc}` ({cc_v}), `-std=c99 {args.flags}` (generated C)",
         f"- C++ compiler: `{cxx}` ({cxx_v}), `-std=c++17 {args.flags}` (harness and Pinocchio)",
         (f"- Pinocchio {tool['version']} (pip wheel `pin`), PRECOMPILED: the algorithms "

@@ -19,34 +19,34 @@
  *   pi_full: 43 coefficients of the inverse dynamics tau = Y(q, qd, qdd) pi_full
  *
  * Operation counts (multiplications, additions, divisions, sin/cos):
- *   lwr_standard_from_dynamic    126 mul, 63 add, 0 div, 0 sin/cos
+ *   lwr_standard_from_dynamic    105 mul, 63 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity               19 mul, 13 add, 0 div, 0 sin/cos
  *   lwr_pi_gravity_jacobian      0 mul, 2 add, 0 div, 0 sin/cos
- *   lwr_pi_inertia               119 mul, 102 add, 0 div, 0 sin/cos
- *   lwr_pi_inertia_jacobian      123 mul, 35 add, 0 div, 0 sin/cos
- *   lwr_pi_full                  120 mul, 106 add, 0 div, 0 sin/cos
- *   lwr_pi_full_jacobian         118 mul, 33 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia               97 mul, 96 add, 0 div, 0 sin/cos
+ *   lwr_pi_inertia_jacobian      87 mul, 35 add, 0 div, 0 sin/cos
+ *   lwr_pi_full                  98 mul, 100 add, 0 div, 0 sin/cos
+ *   lwr_pi_full_jacobian         82 mul, 33 add, 0 div, 0 sin/cos
  *   lwr_regressor_gravity        130 mul, 58 add, 0 div, 6 sin/cos
  *   lwr_regressor_inertia        1383 mul, 757 add, 0 div, 6 sin/cos
- *   lwr_regressor                696 mul, 420 add, 0 div, 6 sin/cos
- *   lwr_rnea                     299 mul, 339 add, 0 div, 6 sin/cos
- *   lwr_rnea_nominal             256 mul, 249 add, 0 div, 6 sin/cos
+ *   lwr_regressor                669 mul, 420 add, 0 div, 6 sin/cos
+ *   lwr_rnea                     297 mul, 339 add, 0 div, 6 sin/cos
+ *   lwr_rnea_nominal             253 mul, 249 add, 0 div, 6 sin/cos
  *   lwr_gravity                  66 mul, 51 add, 0 div, 6 sin/cos
- *   lwr_mass_matrix              243 mul, 193 add, 0 div, 6 sin/cos
- *   lwr_inverse_dynamics         293 mul, 301 add, 0 div, 6 sin/cos
+ *   lwr_mass_matrix              186 mul, 188 add, 0 div, 6 sin/cos
+ *   lwr_inverse_dynamics         291 mul, 301 add, 0 div, 6 sin/cos
  *   lwr_link_poses               68 mul, 31 add, 0 div, 7 sin/cos
  *   lwr_flange_pose              68 mul, 31 add, 0 div, 7 sin/cos
  *   lwr_jacobian                 72 mul, 44 add, 0 div, 6 sin/cos
  *   lwr_link_jacobians           82 mul, 48 add, 0 div, 6 sin/cos
  *   lwr_jacobian_dot_qd          149 mul, 93 add, 0 div, 6 sin/cos
- *   lwr_control                  586 mul, 511 add, 0 div, 6 sin/cos
- *   lwr_control_with_jacobian    757 mul, 626 add, 0 div, 7 sin/cos
+ *   lwr_control                  529 mul, 506 add, 0 div, 6 sin/cos
+ *   lwr_control_with_jacobian    700 mul, 621 add, 0 div, 7 sin/cos
  *   lwr_coriolis_matrix          1304 mul, 1161 add, 0 div, 6 sin/cos
- *   lwr_mass_matrix_derivative   664 mul, 440 add, 0 div, 6 sin/cos
- *   lwr_regressor_slotine_li     773 mul, 465 add, 0 div, 6 sin/cos
- *   lwr_forward_dynamics         654 mul, 583 add, 7 div, 6 sin/cos
- *   lwr_rnea_derivatives         2161 mul, 1845 add, 0 div, 6 sin/cos
- *   lwr_forward_dynamics_derivatives 3365 mul, 2901 add, 7 div, 6 sin/cos
+ *   lwr_mass_matrix_derivative   438 mul, 395 add, 0 div, 6 sin/cos
+ *   lwr_regressor_slotine_li     744 mul, 465 add, 0 div, 6 sin/cos
+ *   lwr_forward_dynamics         595 mul, 578 add, 7 div, 6 sin/cos
+ *   lwr_rnea_derivatives         1984 mul, 1845 add, 0 div, 6 sin/cos
+ *   lwr_forward_dynamics_derivatives 3061 mul, 2873 add, 7 div, 6 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define LWR_USE_FLOAT before including (and when compiling the sources) for float.
@@ -73,12 +73,23 @@ typedef double lwr_real;
  * for sin r and cos r, then the quadrant k mod 4: absolute error at most 2.3e-16 in double, 8e-8
  * in float (2e6 random angles against libm). Beyond |x| = 1e5 (double) or 8192 (float), and for
  * NaN, libm's sin and cos. A statement macro, so the library has no function of its own. */
+/* LWR_NEAREST(y, T, big): the integer nearest to y (|y| < 2^22), as a T. Where the compiler
+ * rounds every operation to its type (FLT_EVAL_METHOD 0, no -ffast-math), adding and subtracting
+ * big = 1.5 * 2^52 (1.5 * 2^23 in float) leaves y rounded to an integer: two additions, where the
+ * sign test, the +-0.5 and the conversions to int and back cost about five more instructions
+ * per angle. Elsewhere (x87 excess precision, or -ffast-math, which would cancel the two
+ * additions) the conversion through int. */
+#if defined(__FLT_EVAL_METHOD__) && __FLT_EVAL_METHOD__ == 0 && !defined(__FAST_MATH__)
+#define LWR_NEAREST(y, T, big) (((y) + (big)) - (big))
+#else
+#define LWR_NEAREST(y, T, big) ((T)(int)((y) + ((y) >= (T)0 ? (T)0.5 : (T)-0.5)))
+#endif
 #ifdef LWR_USE_FLOAT
 #define LWR_SINCOS(x, s, c) do { \
     const float x_ = (x); \
     if (!(x_ >= -8192.0f && x_ <= 8192.0f)) { *(s) = sinf(x_); *(c) = cosf(x_); break; } \
-    const int k_ = (int)(x_ * 0.63661977236758134f + (x_ >= 0.0f ? 0.5f : -0.5f)); \
-    const float kf_ = (float)k_; \
+    const float kf_ = LWR_NEAREST(x_ * 0.63661977236758134f, float, 12582912.0f); \
+    const int k_ = (int)kf_; \
     const float r_ = ((x_ - kf_ * 1.5703125f) - kf_ * 4.837512969970703125e-4f) - kf_ * 7.54978995489188216e-8f; \
     const float z_ = r_ * r_; \
     const float s_ = ((-1.9515295891e-4f * z_ + 8.3321608736e-3f) * z_ - 1.6666654611e-1f) * z_ * r_ + r_; \
@@ -90,18 +101,18 @@ typedef double lwr_real;
 #define LWR_SINCOS(x, s, c) do { \
     const double x_ = (x); \
     if (!(x_ >= -1e5 && x_ <= 1e5)) { *(s) = sin(x_); *(c) = cos(x_); break; } \
-    const int k_ = (int)(x_ * 0.63661977236758134 + (x_ >= 0.0 ? 0.5 : -0.5)); \
-    const double kd_ = (double)k_; \
+    const double kd_ = LWR_NEAREST(x_ * 0.63661977236758134, double, 6755399441055744.0); \
+    const int k_ = (int)kd_; \
     const double r_ = ((x_ - kd_ * 1.57079625129699707031) - kd_ * 7.54978941586159635336e-8) \
                       - kd_ * 5.39030285815811905290e-15; \
     const double z_ = r_ * r_; \
     const double s_ = r_ + r_ * z_ * (((((1.58962301576546568060e-10 * z_ - 2.50507477628578072866e-8) * z_ \
                       + 2.75573136213857245213e-6) * z_ - 1.98412698295895385996e-4) * z_ \
                       + 8.33333333332211858878e-3) * z_ - 1.66666666666666307295e-1); \
-    const double c_ = 1.0 - 0.5 * z_ + z_ * z_ * (((((-1.13585365213876817300e-11 * z_ \
+    const double c_ = 1.0 - z_ * (0.5 - z_ * (((((-1.13585365213876817300e-11 * z_ \
                       + 2.08757008419747316778e-9) * z_ - 2.75573141792967388112e-7) * z_ \
                       + 2.48015872888517045348e-5) * z_ - 1.38888888888730564116e-3) * z_ \
-                      + 4.16666666666665929218e-2); \
+                      + 4.16666666666665929218e-2)); \
     LWR_QUADRANT(k_, s_, c_, s, c); \
 } while (0)
 #endif
@@ -130,7 +141,7 @@ extern "C" {
 /* Standard parameters s from dynamic parameters p.
  *   p        [70]  dynamic parameters, 10 per link
  *   s        [70]  standard parameters (written)
- * 126 mul, 63 add, 0 div, 0 sin/cos
+ * 105 mul, 63 add, 0 div, 0 sin/cos
  */
 void lwr_standard_from_dynamic(const lwr_real *p, lwr_real *s);
 
@@ -151,28 +162,28 @@ void lwr_pi_gravity_jacobian(const lwr_real *p, lwr_real *J);
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [39]  pi_inertia (written)
- * 119 mul, 102 add, 0 div, 0 sin/cos
+ * 97 mul, 96 add, 0 div, 0 sin/cos
  */
 void lwr_pi_inertia(const lwr_real *p, lwr_real *pi);
 
 /* Jacobian d pi_inertia / d p (for gradient-based extraction).
  *   p        [70]  dynamic parameters, 10 per link
  *   J        [39 x 70]  row-major (written)
- * 123 mul, 35 add, 0 div, 0 sin/cos
+ * 87 mul, 35 add, 0 div, 0 sin/cos
  */
 void lwr_pi_inertia_jacobian(const lwr_real *p, lwr_real *J);
 
 /* Base coefficients pi_full(p) of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  *   p        [70]  dynamic parameters, 10 per link
  *   pi       [43]  pi_full (written)
- * 120 mul, 106 add, 0 div, 0 sin/cos
+ * 98 mul, 100 add, 0 div, 0 sin/cos
  */
 void lwr_pi_full(const lwr_real *p, lwr_real *pi);
 
 /* Jacobian d pi_full / d p (for gradient-based extraction).
  *   p        [70]  dynamic parameters, 10 per link
  *   J        [43 x 70]  row-major (written)
- * 118 mul, 33 add, 0 div, 0 sin/cos
+ * 82 mul, 33 add, 0 div, 0 sin/cos
  */
 void lwr_pi_full_jacobian(const lwr_real *p, lwr_real *J);
 
@@ -195,7 +206,7 @@ void lwr_regressor_inertia(const lwr_real *q, lwr_real *Y);
  *   qd       [7]  joint velocities
  *   qdd      [7]  joint accelerations
  *   Y        [7 x 43]  row-major (written)
- * 696 mul, 420 add, 0 div, 6 sin/cos
+ * 669 mul, 420 add, 0 div, 6 sin/cos
  */
 void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *Y);
 
@@ -205,7 +216,7 @@ void lwr_regressor(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, l
  *   qdd      [7]  joint accelerations
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   tau      [7]  joint torques/forces (written)
- * 299 mul, 339 add, 0 div, 6 sin/cos
+ * 297 mul, 339 add, 0 div, 6 sin/cos
  */
 void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *tau);
 
@@ -214,7 +225,7 @@ void lwr_rnea(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const 
  *   qd       [7]  joint velocities
  *   qdd      [7]  joint accelerations
  *   tau      [7]  joint torques/forces (written)
- * 256 mul, 249 add, 0 div, 6 sin/cos
+ * 253 mul, 249 add, 0 div, 6 sin/cos
  */
 void lwr_rnea_nominal(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, lwr_real *tau);
 
@@ -230,7 +241,7 @@ void lwr_gravity(const lwr_real *q, const lwr_real *s, lwr_real *g);
  *   q        [7]  joint positions [rad or m]
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [7 x 7]  row-major, symmetric (written)
- * 243 mul, 193 add, 0 div, 6 sin/cos
+ * 186 mul, 188 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
 
@@ -240,7 +251,7 @@ void lwr_mass_matrix(const lwr_real *q, const lwr_real *s, lwr_real *M);
  *   qdd      [7]  joint accelerations
  *   pi_full  [43]  base coefficients pi_full (e.g. identified; from p: pi_full())
  *   tau      [7]  joint torques/forces (written)
- * 293 mul, 301 add, 0 div, 6 sin/cos
+ * 291 mul, 301 add, 0 div, 6 sin/cos
  */
 void lwr_inverse_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *pi_full, lwr_real *tau);
 
@@ -287,7 +298,7 @@ void lwr_jacobian_dot_qd(const lwr_real *q, const lwr_real *qd, lwr_real *jdot_q
  *   g        [7]  gravity torques (written)
  *   M        [7 x 7]  inertia matrix, row-major, symmetric (written)
  *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
- * 586 mul, 511 add, 0 div, 6 sin/cos
+ * 529 mul, 506 add, 0 div, 6 sin/cos
  */
 void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c);
 
@@ -300,7 +311,7 @@ void lwr_control(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_r
  *   c        [7]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
  *   J        [6 x 7]  flange Jacobian, row-major, rows [v; w] (written)
  *   jdot_qd  [6]  Jdot qd of the flange (written)
- * 757 mul, 626 add, 0 div, 7 sin/cos
+ * 700 mul, 621 add, 0 div, 7 sin/cos
  */
 void lwr_control_with_jacobian(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *g, lwr_real *M, lwr_real *c, lwr_real *J, lwr_real *jdot_qd);
 
@@ -318,7 +329,7 @@ void lwr_coriolis_matrix(const lwr_real *q, const lwr_real *qd, const lwr_real *
  *   qd       [7]  joint velocities
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   Mdot     [7 x 7]  row-major, symmetric (written)
- * 664 mul, 440 add, 0 div, 6 sin/cos
+ * 438 mul, 395 add, 0 div, 6 sin/cos
  */
 void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr_real *s, lwr_real *Mdot);
 
@@ -328,7 +339,7 @@ void lwr_mass_matrix_derivative(const lwr_real *q, const lwr_real *qd, const lwr
  *   qr_d     [7]  reference velocities (Slotine-Li: qd_d - Lambda e)
  *   qr_dd    [7]  reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)
  *   Y        [7 x 43]  row-major (written)
- * 773 mul, 465 add, 0 div, 6 sin/cos
+ * 744 mul, 465 add, 0 div, 6 sin/cos
  */
 void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_real *qr_d, const lwr_real *qr_dd, lwr_real *Y);
 
@@ -338,7 +349,7 @@ void lwr_regressor_slotine_li(const lwr_real *q, const lwr_real *qd, const lwr_r
  *   tau      [7]  joint torques/forces
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   qdd      [7]  joint accelerations (written)
- * 654 mul, 583 add, 7 div, 6 sin/cos
+ * 595 mul, 578 add, 7 div, 6 sin/cos
  */
 void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *qdd);
 
@@ -348,7 +359,7 @@ void lwr_forward_dynamics(const lwr_real *q, const lwr_real *qd, const lwr_real 
  *   qdd      [7]  joint accelerations
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [7 x 14]  row-major, [d tau / d q | d tau / d qd] (written)
- * 2161 mul, 1845 add, 0 div, 6 sin/cos
+ * 1984 mul, 1845 add, 0 div, 6 sin/cos
  */
 void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *qdd, const lwr_real *s, lwr_real *D);
 
@@ -358,7 +369,7 @@ void lwr_rnea_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real 
  *   tau      [7]  joint torques/forces
  *   s        [70]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [7 x 14]  row-major, [d qdd / d q | d qdd / d qd] (written)
- * 3365 mul, 2901 add, 7 div, 6 sin/cos
+ * 3061 mul, 2873 add, 7 div, 6 sin/cos
  */
 void lwr_forward_dynamics_derivatives(const lwr_real *q, const lwr_real *qd, const lwr_real *tau, const lwr_real *s, lwr_real *D);
 

@@ -19,34 +19,34 @@
  *   pi_full: 33 coefficients of the inverse dynamics tau = Y(q, qd, qdd) pi_full
  *
  * Operation counts (multiplications, additions, divisions, sin/cos):
- *   stanford_standard_from_dynamic 108 mul, 54 add, 0 div, 0 sin/cos
+ *   stanford_standard_from_dynamic 90 mul, 54 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity          14 mul, 9 add, 0 div, 0 sin/cos
  *   stanford_pi_gravity_jacobian 0 mul, 1 add, 0 div, 0 sin/cos
- *   stanford_pi_inertia          102 mul, 80 add, 0 div, 0 sin/cos
- *   stanford_pi_inertia_jacobian 110 mul, 31 add, 0 div, 0 sin/cos
- *   stanford_pi_full             100 mul, 78 add, 0 div, 0 sin/cos
- *   stanford_pi_full_jacobian    100 mul, 28 add, 0 div, 0 sin/cos
+ *   stanford_pi_inertia          85 mul, 80 add, 0 div, 0 sin/cos
+ *   stanford_pi_inertia_jacobian 80 mul, 31 add, 0 div, 0 sin/cos
+ *   stanford_pi_full             83 mul, 78 add, 0 div, 0 sin/cos
+ *   stanford_pi_full_jacobian    70 mul, 28 add, 0 div, 0 sin/cos
  *   stanford_regressor_gravity   59 mul, 23 add, 0 div, 4 sin/cos
  *   stanford_regressor_inertia   912 mul, 519 add, 0 div, 4 sin/cos
- *   stanford_regressor           402 mul, 259 add, 0 div, 4 sin/cos
- *   stanford_rnea                237 mul, 270 add, 0 div, 4 sin/cos
- *   stanford_rnea_nominal        134 mul, 102 add, 0 div, 4 sin/cos
+ *   stanford_regressor           373 mul, 259 add, 0 div, 4 sin/cos
+ *   stanford_rnea                235 mul, 270 add, 0 div, 4 sin/cos
+ *   stanford_rnea_nominal        132 mul, 102 add, 0 div, 4 sin/cos
  *   stanford_gravity             46 mul, 34 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix         154 mul, 135 add, 0 div, 4 sin/cos
- *   stanford_inverse_dynamics    232 mul, 239 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix         121 mul, 134 add, 0 div, 4 sin/cos
+ *   stanford_inverse_dynamics    230 mul, 239 add, 0 div, 4 sin/cos
  *   stanford_link_poses          46 mul, 22 add, 0 div, 5 sin/cos
  *   stanford_flange_pose         46 mul, 22 add, 0 div, 5 sin/cos
  *   stanford_jacobian            50 mul, 43 add, 0 div, 4 sin/cos
  *   stanford_link_jacobians      56 mul, 47 add, 0 div, 4 sin/cos
- *   stanford_jacobian_dot_qd     128 mul, 85 add, 0 div, 4 sin/cos
- *   stanford_control             416 mul, 370 add, 0 div, 4 sin/cos
- *   stanford_control_with_jacobian 566 mul, 485 add, 0 div, 5 sin/cos
- *   stanford_coriolis_matrix     752 mul, 648 add, 0 div, 4 sin/cos
- *   stanford_mass_matrix_derivative 388 mul, 259 add, 0 div, 4 sin/cos
- *   stanford_regressor_slotine_li 456 mul, 290 add, 0 div, 4 sin/cos
- *   stanford_forward_dynamics    459 mul, 416 add, 6 div, 4 sin/cos
- *   stanford_rnea_derivatives    1253 mul, 1123 add, 0 div, 4 sin/cos
- *   stanford_forward_dynamics_derivatives 2048 mul, 1815 add, 6 div, 4 sin/cos
+ *   stanford_jacobian_dot_qd     122 mul, 85 add, 0 div, 4 sin/cos
+ *   stanford_control             383 mul, 369 add, 0 div, 4 sin/cos
+ *   stanford_control_with_jacobian 527 mul, 484 add, 0 div, 5 sin/cos
+ *   stanford_coriolis_matrix     750 mul, 648 add, 0 div, 4 sin/cos
+ *   stanford_mass_matrix_derivative 262 mul, 238 add, 0 div, 4 sin/cos
+ *   stanford_regressor_slotine_li 425 mul, 290 add, 0 div, 4 sin/cos
+ *   stanford_forward_dynamics    426 mul, 415 add, 6 div, 4 sin/cos
+ *   stanford_rnea_derivatives    1159 mul, 1123 add, 0 div, 4 sin/cos
+ *   stanford_forward_dynamics_derivatives 1856 mul, 1799 add, 6 div, 4 sin/cos
  *
  * All functions: flat caller-owned arrays, no heap, no globals, no I/O, only <math.h>.
  * Define STANFORD_USE_FLOAT before including (and when compiling the sources) for float.
@@ -73,12 +73,23 @@ typedef double stanford_real;
  * for sin r and cos r, then the quadrant k mod 4: absolute error at most 2.3e-16 in double, 8e-8
  * in float (2e6 random angles against libm). Beyond |x| = 1e5 (double) or 8192 (float), and for
  * NaN, libm's sin and cos. A statement macro, so the library has no function of its own. */
+/* STANFORD_NEAREST(y, T, big): the integer nearest to y (|y| < 2^22), as a T. Where the compiler
+ * rounds every operation to its type (FLT_EVAL_METHOD 0, no -ffast-math), adding and subtracting
+ * big = 1.5 * 2^52 (1.5 * 2^23 in float) leaves y rounded to an integer: two additions, where the
+ * sign test, the +-0.5 and the conversions to int and back cost about five more instructions
+ * per angle. Elsewhere (x87 excess precision, or -ffast-math, which would cancel the two
+ * additions) the conversion through int. */
+#if defined(__FLT_EVAL_METHOD__) && __FLT_EVAL_METHOD__ == 0 && !defined(__FAST_MATH__)
+#define STANFORD_NEAREST(y, T, big) (((y) + (big)) - (big))
+#else
+#define STANFORD_NEAREST(y, T, big) ((T)(int)((y) + ((y) >= (T)0 ? (T)0.5 : (T)-0.5)))
+#endif
 #ifdef STANFORD_USE_FLOAT
 #define STANFORD_SINCOS(x, s, c) do { \
     const float x_ = (x); \
     if (!(x_ >= -8192.0f && x_ <= 8192.0f)) { *(s) = sinf(x_); *(c) = cosf(x_); break; } \
-    const int k_ = (int)(x_ * 0.63661977236758134f + (x_ >= 0.0f ? 0.5f : -0.5f)); \
-    const float kf_ = (float)k_; \
+    const float kf_ = STANFORD_NEAREST(x_ * 0.63661977236758134f, float, 12582912.0f); \
+    const int k_ = (int)kf_; \
     const float r_ = ((x_ - kf_ * 1.5703125f) - kf_ * 4.837512969970703125e-4f) - kf_ * 7.54978995489188216e-8f; \
     const float z_ = r_ * r_; \
     const float s_ = ((-1.9515295891e-4f * z_ + 8.3321608736e-3f) * z_ - 1.6666654611e-1f) * z_ * r_ + r_; \
@@ -90,18 +101,18 @@ typedef double stanford_real;
 #define STANFORD_SINCOS(x, s, c) do { \
     const double x_ = (x); \
     if (!(x_ >= -1e5 && x_ <= 1e5)) { *(s) = sin(x_); *(c) = cos(x_); break; } \
-    const int k_ = (int)(x_ * 0.63661977236758134 + (x_ >= 0.0 ? 0.5 : -0.5)); \
-    const double kd_ = (double)k_; \
+    const double kd_ = STANFORD_NEAREST(x_ * 0.63661977236758134, double, 6755399441055744.0); \
+    const int k_ = (int)kd_; \
     const double r_ = ((x_ - kd_ * 1.57079625129699707031) - kd_ * 7.54978941586159635336e-8) \
                       - kd_ * 5.39030285815811905290e-15; \
     const double z_ = r_ * r_; \
     const double s_ = r_ + r_ * z_ * (((((1.58962301576546568060e-10 * z_ - 2.50507477628578072866e-8) * z_ \
                       + 2.75573136213857245213e-6) * z_ - 1.98412698295895385996e-4) * z_ \
                       + 8.33333333332211858878e-3) * z_ - 1.66666666666666307295e-1); \
-    const double c_ = 1.0 - 0.5 * z_ + z_ * z_ * (((((-1.13585365213876817300e-11 * z_ \
+    const double c_ = 1.0 - z_ * (0.5 - z_ * (((((-1.13585365213876817300e-11 * z_ \
                       + 2.08757008419747316778e-9) * z_ - 2.75573141792967388112e-7) * z_ \
                       + 2.48015872888517045348e-5) * z_ - 1.38888888888730564116e-3) * z_ \
-                      + 4.16666666666665929218e-2); \
+                      + 4.16666666666665929218e-2)); \
     STANFORD_QUADRANT(k_, s_, c_, s, c); \
 } while (0)
 #endif
@@ -130,7 +141,7 @@ extern "C" {
 /* Standard parameters s from dynamic parameters p.
  *   p        [60]  dynamic parameters, 10 per link
  *   s        [60]  standard parameters (written)
- * 108 mul, 54 add, 0 div, 0 sin/cos
+ * 90 mul, 54 add, 0 div, 0 sin/cos
  */
 void stanford_standard_from_dynamic(const stanford_real *p, stanford_real *s);
 
@@ -151,28 +162,28 @@ void stanford_pi_gravity_jacobian(const stanford_real *p, stanford_real *J);
 /* Base coefficients pi_inertia(p) of the stacked inertia matrix m~(q) = Y_m(q) pi_inertia.
  *   p        [60]  dynamic parameters, 10 per link
  *   pi       [31]  pi_inertia (written)
- * 102 mul, 80 add, 0 div, 0 sin/cos
+ * 85 mul, 80 add, 0 div, 0 sin/cos
  */
 void stanford_pi_inertia(const stanford_real *p, stanford_real *pi);
 
 /* Jacobian d pi_inertia / d p (for gradient-based extraction).
  *   p        [60]  dynamic parameters, 10 per link
  *   J        [31 x 60]  row-major (written)
- * 110 mul, 31 add, 0 div, 0 sin/cos
+ * 80 mul, 31 add, 0 div, 0 sin/cos
  */
 void stanford_pi_inertia_jacobian(const stanford_real *p, stanford_real *J);
 
 /* Base coefficients pi_full(p) of the inverse dynamics tau = Y(q, qd, qdd) pi_full.
  *   p        [60]  dynamic parameters, 10 per link
  *   pi       [33]  pi_full (written)
- * 100 mul, 78 add, 0 div, 0 sin/cos
+ * 83 mul, 78 add, 0 div, 0 sin/cos
  */
 void stanford_pi_full(const stanford_real *p, stanford_real *pi);
 
 /* Jacobian d pi_full / d p (for gradient-based extraction).
  *   p        [60]  dynamic parameters, 10 per link
  *   J        [33 x 60]  row-major (written)
- * 100 mul, 28 add, 0 div, 0 sin/cos
+ * 70 mul, 28 add, 0 div, 0 sin/cos
  */
 void stanford_pi_full_jacobian(const stanford_real *p, stanford_real *J);
 
@@ -195,7 +206,7 @@ void stanford_regressor_inertia(const stanford_real *q, stanford_real *Y);
  *   qd       [6]  joint velocities
  *   qdd      [6]  joint accelerations
  *   Y        [6 x 33]  row-major (written)
- * 402 mul, 259 add, 0 div, 4 sin/cos
+ * 373 mul, 259 add, 0 div, 4 sin/cos
  */
 void stanford_regressor(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *Y);
 
@@ -205,7 +216,7 @@ void stanford_regressor(const stanford_real *q, const stanford_real *qd, const s
  *   qdd      [6]  joint accelerations
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   tau      [6]  joint torques/forces (written)
- * 237 mul, 270 add, 0 div, 4 sin/cos
+ * 235 mul, 270 add, 0 div, 4 sin/cos
  */
 void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *tau);
 
@@ -214,7 +225,7 @@ void stanford_rnea(const stanford_real *q, const stanford_real *qd, const stanfo
  *   qd       [6]  joint velocities
  *   qdd      [6]  joint accelerations
  *   tau      [6]  joint torques/forces (written)
- * 134 mul, 102 add, 0 div, 4 sin/cos
+ * 132 mul, 102 add, 0 div, 4 sin/cos
  */
 void stanford_rnea_nominal(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, stanford_real *tau);
 
@@ -230,7 +241,7 @@ void stanford_gravity(const stanford_real *q, const stanford_real *s, stanford_r
  *   q        [6]  joint positions [rad or m]
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   M        [6 x 6]  row-major, symmetric (written)
- * 154 mul, 135 add, 0 div, 4 sin/cos
+ * 121 mul, 134 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanford_real *M);
 
@@ -240,7 +251,7 @@ void stanford_mass_matrix(const stanford_real *q, const stanford_real *s, stanfo
  *   qdd      [6]  joint accelerations
  *   pi_full  [33]  base coefficients pi_full (e.g. identified; from p: pi_full())
  *   tau      [6]  joint torques/forces (written)
- * 232 mul, 239 add, 0 div, 4 sin/cos
+ * 230 mul, 239 add, 0 div, 4 sin/cos
  */
 void stanford_inverse_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *pi_full, stanford_real *tau);
 
@@ -276,7 +287,7 @@ void stanford_link_jacobians(const stanford_real *q, stanford_real *J);
  *   q        [6]  joint positions [rad or m]
  *   qd       [6]  joint velocities
  *   jdot_qd  [6]  [linear; angular] acceleration at qdd = 0 (written)
- * 128 mul, 85 add, 0 div, 4 sin/cos
+ * 122 mul, 85 add, 0 div, 4 sin/cos
  */
 void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, stanford_real *jdot_qd);
 
@@ -287,7 +298,7 @@ void stanford_jacobian_dot_qd(const stanford_real *q, const stanford_real *qd, s
  *   g        [6]  gravity torques (written)
  *   M        [6 x 6]  inertia matrix, row-major, symmetric (written)
  *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
- * 416 mul, 370 add, 0 div, 4 sin/cos
+ * 383 mul, 369 add, 0 div, 4 sin/cos
  */
 void stanford_control(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c);
 
@@ -300,7 +311,7 @@ void stanford_control(const stanford_real *q, const stanford_real *qd, const sta
  *   c        [6]  velocity torques c(q, qd) = rnea(q, qd, 0) - g(q) (written)
  *   J        [6 x 6]  flange Jacobian, row-major, rows [v; w] (written)
  *   jdot_qd  [6]  Jdot qd of the flange (written)
- * 566 mul, 485 add, 0 div, 5 sin/cos
+ * 527 mul, 484 add, 0 div, 5 sin/cos
  */
 void stanford_control_with_jacobian(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *g, stanford_real *M, stanford_real *c, stanford_real *J, stanford_real *jdot_qd);
 
@@ -309,7 +320,7 @@ void stanford_control_with_jacobian(const stanford_real *q, const stanford_real 
  *   qd       [6]  joint velocities
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   C        [6 x 6]  row-major (written)
- * 752 mul, 648 add, 0 div, 4 sin/cos
+ * 750 mul, 648 add, 0 div, 4 sin/cos
  */
 void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *C);
 
@@ -318,7 +329,7 @@ void stanford_coriolis_matrix(const stanford_real *q, const stanford_real *qd, c
  *   qd       [6]  joint velocities
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   Mdot     [6 x 6]  row-major, symmetric (written)
- * 388 mul, 259 add, 0 div, 4 sin/cos
+ * 262 mul, 238 add, 0 div, 4 sin/cos
  */
 void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real *qd, const stanford_real *s, stanford_real *Mdot);
 
@@ -328,7 +339,7 @@ void stanford_mass_matrix_derivative(const stanford_real *q, const stanford_real
  *   qr_d     [6]  reference velocities (Slotine-Li: qd_d - Lambda e)
  *   qr_dd    [6]  reference accelerations (Slotine-Li: qdd_d - Lambda e_dot)
  *   Y        [6 x 33]  row-major (written)
- * 456 mul, 290 add, 0 div, 4 sin/cos
+ * 425 mul, 290 add, 0 div, 4 sin/cos
  */
 void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *qd, const stanford_real *qr_d, const stanford_real *qr_dd, stanford_real *Y);
 
@@ -338,7 +349,7 @@ void stanford_regressor_slotine_li(const stanford_real *q, const stanford_real *
  *   tau      [6]  joint torques/forces
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   qdd      [6]  joint accelerations (written)
- * 459 mul, 416 add, 6 div, 4 sin/cos
+ * 426 mul, 415 add, 6 div, 4 sin/cos
  */
 void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *qdd);
 
@@ -348,7 +359,7 @@ void stanford_forward_dynamics(const stanford_real *q, const stanford_real *qd, 
  *   qdd      [6]  joint accelerations
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [6 x 12]  row-major, [d tau / d q | d tau / d qd] (written)
- * 1253 mul, 1123 add, 0 div, 4 sin/cos
+ * 1159 mul, 1123 add, 0 div, 4 sin/cos
  */
 void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *qdd, const stanford_real *s, stanford_real *D);
 
@@ -358,7 +369,7 @@ void stanford_rnea_derivatives(const stanford_real *q, const stanford_real *qd, 
  *   tau      [6]  joint torques/forces
  *   s        [60]  standard parameters, 10 per link (docs/conventions.md)
  *   D        [6 x 12]  row-major, [d qdd / d q | d qdd / d qd] (written)
- * 2048 mul, 1815 add, 6 div, 4 sin/cos
+ * 1856 mul, 1799 add, 6 div, 4 sin/cos
  */
 void stanford_forward_dynamics_derivatives(const stanford_real *q, const stanford_real *qd, const stanford_real *tau, const stanford_real *s, stanford_real *D);
 

@@ -47,9 +47,41 @@ def composite_bodies(chain: Chain, params) -> list:
             m = program.let(m + cm)
             h = program.let_vector(add(h, hR, [cm * x for x in p]))
             J = J + RJ + shift
+            if geo.revolute:
+                J = _in_double_angles(program, J, chain.angle(i + 1))
         J = sp.Matrix(3, 3, lambda r, c: program.let(J[min(r, c), max(r, c)]))
         bodies[i] = (m, h, J)
     return bodies
+
+
+def _in_double_angles(program, J, angle) -> sp.Matrix:
+    """J (symmetric, quadratic in the joint's cosine c and sine s, as R cJ R^T and the shift by
+    p(c, s) make it) with c^2 = 1/2 + d, s^2 = 1/2 - d and c s = e, where d = c^2 - 1/2 and
+    e = c s are formed once per joint (cos 2q / 2 and sin 2q / 2). Why: c^2 a - 2 c s b + s^2 e'
+    is 6 products, (a + e')/2 + d (a - e') - 2 e b is 3, and the factoring (emission/factoring.py)
+    then shares d and e across the entries. Exact, as c^2 + s^2 = 1; in float d and e are
+    within an ulp of their values, as c^2 and c s were."""
+    c, s = angle
+    d, e = program.let(c * c - sp.Rational(1, 2)), program.let(c * s)
+    def rewritten(x):
+        rest, along_d, along_e = [], [], []
+        for term in sp.Add.make_args(sp.expand(x)):
+            powers = term.as_powers_dict()
+            i, j = int(powers.get(c, 0)), int(powers.get(s, 0))
+            other = term / (c ** i * s ** j)
+            if (i, j) == (1, 1):
+                along_e.append(other)
+            elif (i, j) in ((2, 0), (0, 2)):
+                sign = 1 if i == 2 else -1
+                rest.append(other / 2)
+                along_d.append(sign * other)
+            else:
+                rest.append(term)
+        # the turn B d + C e is one variable: J[1, 1] reads the same with both signs flipped
+        turn = program.let(program.let(sp.Add(*along_d)) * d + program.let(sp.Add(*along_e)) * e)
+        return sp.Add(*rest) + turn
+
+    return sp.Matrix(3, 3, lambda r, k: rewritten(J[r, k]) if r <= k else 0)
 
 
 def mass_matrix_columns(chain: Chain, params) -> sp.Matrix:

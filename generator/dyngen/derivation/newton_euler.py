@@ -70,6 +70,11 @@ class Chain:
             else:
                 self.geometry.append(joint_geometry(model, None, None, program.let(model.offset + symbols.q[i])))
 
+    def angle(self, i) -> tuple:
+        """(cos, sin) symbols of revolute joint i's full angle."""
+        by_fn = {fn: sym for sym, (joint, fn) in self.symbols.trig.items() if joint == i}
+        return by_fn["cos"], by_fn["sin"]
+
     # ---- forward ---------------------------------------------------------------------
 
     def forward(self, qd, qdd, gravity, then=None) -> list[Motion]:

@@ -11,9 +11,11 @@ from dataclasses import dataclass, field
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
+from ..derivation.program import Assignment
 from .factoring import factored
 from .opcount import OpCount, count_all
 from .schedule import scheduled
+from .shared import shared_products
 
 
 @dataclass
@@ -125,7 +127,8 @@ class StraightLine:
 def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     """Declarations of everything `outputs` (expressions of the model's program) need."""
     outputs_free = set().union(*(sp.sympify(o).free_symbols for o in outputs))
-    pruned = scheduled(model.program.pruned(outputs), outputs_free, model.trig)
+    written = [Assignment(a.symbol, factored(a.expr), a.section) for a in model.program.pruned(outputs)]
+    pruned = scheduled(shared_products(written, outputs_free), outputs_free, model.trig)
     names = input_names(model)
     names.update({a.symbol: f"x{k}" for k, a in enumerate(pruned)})  # dense numbering: stable diffs
     printer = Printer(prefix, names)
@@ -146,7 +149,7 @@ def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
         for s in a.expr.free_symbols & set(trig_used):
             first_use.setdefault(model.trig[s][0], k)
     seen = set()
-    written = [factored(a.expr) for a in pruned]
+    written = [a.expr for a in pruned]
     for k, (a, expr) in enumerate(zip(pruned, written)):
         if a.section not in seen:  # statements are scheduled (schedule.py): a section's comment marks its start
             seen.add(a.section)

@@ -42,8 +42,6 @@ def scheduled(assignments: list, outputs_free: set, trig: dict) -> list:
     for k, deps in enumerate(reads):
         for d in deps:
             readers[d].append(k)
-    ready = {k for k in range(n) if not reads[k]}
-    order = []
 
     def score(k):
         ended = sum(1 for d in reads[k] if users[d] == 1)
@@ -51,6 +49,8 @@ def scheduled(assignments: list, outputs_free: set, trig: dict) -> list:
         started = (1 if users[k] else 0) + sum(2 for j in angles[k] if opened.get(j) is None)
         return (ended - started, -k)
 
+    ready = {k for k in range(n) if not reads[k]}
+    order = []
     opened: dict = {}
     while ready:
         k = max(ready, key=score)
@@ -65,4 +65,32 @@ def scheduled(assignments: list, outputs_free: set, trig: dict) -> list:
             waiting[r] -= 1
             if waiting[r] == 0:
                 ready.add(r)
-    return order
+    return _sunk(order, outputs_free, set(trig))
+
+
+def _sunk(order: list, outputs_free: set, trig: set) -> list:
+    """order with each statement moved down to just before its first reader when every value
+    it reads stays alive there anyway (an input, or a value read again at or after that point):
+    its result is then live for a shorter stretch and no other value for a longer one. The
+    greedy order places a statement that reads only inputs (a product of two parameters, a
+    sum of a joint's rate and acceleration) as early as it can, where it holds a register over
+    statements that do not need it. Processed from the end, so a chain of such statements
+    sinks together; dependencies are kept (a statement only moves to before its first reader)."""
+    values = {a.symbol for a in order} | trig
+    readers: dict = {}
+    for k, a in enumerate(order):
+        for s in a.expr.free_symbols & values:
+            readers.setdefault(s, []).append(k)
+    # a position is a tuple: statement k starts at (k, 0); one sunk to before the statement at
+    # (..., 0) gets (..., -m, 0), m counting the moves, so later moves to the same place come first
+    key = [(k, 0) for k in range(len(order))]
+    for m, k in enumerate(reversed(range(len(order)))):
+        a = order[k]
+        if a.symbol in outputs_free or a.symbol not in readers:
+            continue
+        first = min((key[r] for r in readers[a.symbol]), default=None)
+        alive = all(s in outputs_free or any(r != k and key[r] >= first for r in readers[s])
+                    for s in a.expr.free_symbols & values)
+        if alive:
+            key[k] = first[:-1] + (-(m + 1), 0)
+    return [order[k] for k in sorted(range(len(order)), key=key.__getitem__)]
