@@ -86,7 +86,7 @@ def _product_key(node):
     """(size of the numeric coefficient, sorted other factors), sign; None if no product."""
     if node.is_Pow and node.exp.is_Integer and 1 < node.exp <= 4 and not node.base.is_number:
         return (sp.Integer(1), (node,)), 1
-    if not node.is_Mul:
+    if not node.is_Mul or node.is_number:  # sqrt(2)/20 is a constant the printer writes as one literal
         return None, 1
     numbers = sp.Mul(*(f for f in node.args if f.is_Number))
     signed = [_signed_factor(f) for f in node.args if not f.is_Number]
@@ -117,7 +117,7 @@ def _negated(term):
 
 def _product(key):
     size, others = key
-    if len(others) == 1 and others[0].is_Pow:
+    if size == 1 and len(others) == 1 and others[0].is_Pow:  # x**2; with a size (c sqrt(2) x) it is a Mul
         return others[0]
     return sp.Mul(*(([size] if size != 1 else []) + list(others)), evaluate=False)
 
