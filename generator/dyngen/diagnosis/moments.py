@@ -174,28 +174,3 @@ def accumulate(moments: Moments, A: np.ndarray, slots: np.ndarray, r: np.ndarray
 
 def empty(n_joints: int, size: int) -> Moments:
     return Moments(np.zeros((n_joints, size, size)), np.zeros((n_joints, size)), np.zeros(n_joints), 0)
-
-
-def accumulate_every_joint(moments: Moments, candidates, columns: dict, residual: np.ndarray) -> None:
-    """accumulate on every joint at once, for a block of rows (T, N residual): the candidates'
-    columns laid into one (N, T, k) array over the slots they use, zero where a candidate does not
-    act on a joint (so it adds nothing there, as leaving it out does), and its A^T A and A^T r
-    as one batched matrix product, not a Python loop of joint_matrix copies per joint."""
-    moments.c += np.einsum("tj,tj->j", residual, residual)
-    moments.count += residual.shape[0]
-    if not candidates:
-        return
-    used = np.concatenate([c.slots for c in candidates])
-    A = np.zeros((residual.shape[1], residual.shape[0], used.size))
-    start = 0
-    for c in candidates:
-        x = columns[c.effect.key]
-        where = slice(start, start + c.size)
-        if c.joint is None:
-            A[:, :, where] = x.transpose(1, 0, 2)
-        else:
-            A[c.joint, :, where] = x[:, c.joint, :]
-        start += c.size
-    At = A.transpose(0, 2, 1)
-    moments.G[:, used[:, None], used[None, :]] += At @ A
-    moments.b[:, used] += (At @ residual.T[:, :, None])[:, :, 0]

@@ -216,7 +216,12 @@ def every_row(context, chosen, tasks, size: int) -> dz.Moments:
             every = np.ones(block.t.size, dtype=bool)
             seg = roles.Segment(signals, tau_model, signals.tau - tau_model, every, ~every, ~every)
             columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
-            dz.accumulate_every_joint(out, chosen, columns, seg.residual)
+            for j in range(out.G.shape[0]):
+                acting = [c for c in chosen if c.joint is None or c.joint == j]
+                A, slots = dz.joint_matrix(acting, columns, j) if acting else (np.zeros((block.t.size, 0)),
+                                                                               np.zeros(0, dtype=int))
+                dz.accumulate(out, A, slots, seg.residual[:, j], j)
+            out.count += block.t.size
     return out
 
 
