@@ -57,10 +57,8 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
             ia = e.values["Ia"]
             qdd, torque = (np.sqrt(np.mean(np.concatenate([getattr(sig, x)[sig.inner(), j] for sig in fit_signals]) ** 2))
                            for x in ("qdd", "tau"))
-            rotor = rotor_inertia_range(j, ia, inertia[j], qdd, torque)
-            if rotor:
-                reason = rotor
-            elif ia * qdd > LARGER * before[j]:
+            reason = rotor_inertia_range(j, ia, inertia[j], qdd, torque)
+            if not reason and ia * qdd > LARGER * before[j]:
                 reason = (f"on joint {j + 1}, its torque ({ia * qdd:.3g} Nm) is larger than the joint's whole nominal "
                           f"residual ({before[j]:.3g} Nm on the selection data): it makes up for another term")
         if reason:

@@ -225,6 +225,17 @@ def every_row(context, chosen, tasks, size: int) -> dz.Moments:
     return out
 
 
+def _why_not_tried(precision) -> str:
+    """Why the gate's re-identification did not run by default ("" where it was asked not to)."""
+    if precision is None:
+        return ""
+    if np.isinf(precision):
+        return (f"; not tried by default: no base coefficient alone carries {reidentify.MOVED:g} of what the effects "
+                "leave (a weak sign: the gain is spread over many)")
+    return (f"; not tried by default: the fit data do not determine the base coefficients it would move (relative "
+            f"standard deviation up to {precision:.3g}, above {reidentify.PRECISION:g})")
+
+
 def _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
             roles_of, min_gain) -> Diagnosis:
     """The record: the findings (those on joints another model won superseded; those outside
@@ -259,12 +270,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)"
-                     + ("" if choice.precision is None else
-                        f"; not tried by default: no base coefficient alone carries {reidentify.MOVED:g} of what the "
-                        "effects leave (a weak sign: the gain is spread over many)" if np.isinf(choice.precision) else
-                        f"; not tried by default: the fit data do not determine the base "
-                        f"coefficients it would move (relative standard deviation up to {choice.precision:.3g}, above "
-                        f"{reidentify.PRECISION:g})"))
+                     + _why_not_tried(choice.precision))
     rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
                                                     ("effects", judged.effects), ("simple", judged.simple))}
     reid = final.reidentified
