@@ -1,26 +1,11 @@
 """The low-pass cutoff for differentiating recorded positions, decided from the recording.
 
-Encoders give positions with noise (and quantisation) of about 1e-5 rad; central differences
-turn it into accelerations noisy by tens of rad/s^2 at 500 Hz. A zero-phase low-pass of
-cutoff fc leaves, for white position noise sigma_q at sampling rate fs, an acceleration noise
-
-    sigma_qdd(fc) = sigma_q (2 pi)^2 sqrt(fc^5 / (5 fs / 2))        (ideal low-pass)
-
-so the cutoff is the largest one whose acceleration noise stays below NOISE_SHARE of the
-motion's own acceleration (RMS over the joints): higher would let noise into the model
-torques, lower would throw away motion that the diagnosis can use. Both numbers come from the
-recording:
-
-  - sigma_q per joint from the third differences of q (white noise of sigma gives differences
-    of sigma sqrt(20); the motion's third difference is negligible at these rates), with a
-    robust (median) scale so that steps of the motion do not count as noise;
-  - the motion's acceleration RMS from q differentiated through the cutoff itself (the
-    noise part, predicted by the formula, removed), iterated a few times from fs / 20.
-
-The motion's band (the frequency under which 99 % of its velocity power lies, from the
-spectrum of the differentiated positions) is reported beside it: a cutoff below twice the band
-means that the position noise limits what can be seen, and the diagnosis says so.
-"""
+A zero-phase low-pass of cutoff fc leaves, for white position noise sigma_q at rate fs, an
+acceleration noise sigma_qdd(fc) = sigma_q (2 pi)^2 sqrt(fc^5 / (5 fs / 2)) (ideal low-pass); the
+cutoff is the largest whose noise stays below NOISE_SHARE of the motion's acceleration RMS
+(iterated from fs / 20), sigma_q from robust third differences (white noise of sigma gives
+sigma sqrt(20)). The motion's band (99 % of its velocity power) is reported beside it: a cutoff
+below twice the band means the noise limits what can be seen."""
 
 from __future__ import annotations
 
@@ -46,9 +31,8 @@ class Decision:
 
 
 def position_noise(q: np.ndarray) -> np.ndarray:
-    """Per joint sigma of white noise on q, from robust third differences; where the spectrum
-    shows clearly more broadband error than that (a logger's late or repeated samples, a coarse
-    encoder's steps: noise_floor.py), the spectrum's."""
+    """Per joint sigma of white noise on q from robust third differences, or the spectrum's where it
+    shows clearly more broadband error (noise_floor.py)."""
     if q.shape[0] < 8:
         return np.zeros(q.shape[1])
     d3 = np.diff(q, n=3, axis=0)
@@ -75,8 +59,8 @@ def motion_band(qd: np.ndarray, rate: float) -> float:
 
 
 def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision:
-    """lowpass_of(cutoff) -> a function filtering (T, ...) arrays along time. order 1: q are
-    recorded velocities, differentiated once (their noise measured the same way)."""
+    """lowpass_of(cutoff) -> a filter of (T, ...) arrays along time. order 1: q are recorded
+    velocities, differentiated once."""
     rate = 1.0 / float(np.median(np.diff(t)))
     sigma = position_noise(q)
 

@@ -1,20 +1,10 @@
 """Signal conditioning: what the models take from a recording.
 
-Velocities and accelerations are the recording's own columns when it has them (the
-controller's estimates), otherwise central differences of the positions. How positions are
-filtered before differentiation is decided from the recording by default
-(data/automatic.py: position noise against the motion's acceleration), or set by the user
-(`cutoff` in Hz, or None for no filter at all).
-
-The low-pass is a zero-phase Butterworth (scipy sosfiltfilt), applied alike to positions and
-torques so that no signal is shifted or smoothed against another; it is kept on the Signals
-(`lowpass`) so that whatever is compared with the filtered torque (a model torque, an effect's
-columns) can be passed through the very same filter. The filter's start-up at both ends is
-not data: `trim` samples at each end are to be left out of every fit and every figure.
-Rows as a logger wrote them are made samples of one regular clock first (log_quality.py: repeated
-rows left out, held columns interpolated, jittered stamps replaced by the clock (timeline.py),
-uneven ones interpolated onto a regular grid); the sampling rate is the median rate.
-"""
+Velocities and accelerations are the recording's own when it has them, else central differences
+of the positions through a zero-phase Butterworth low-pass whose cutoff is decided from the
+recording (automatic.py) or given. The same filter (kept as Signals.lowpass) passes positions,
+torques and whatever is compared with the torque; `trim` samples at each end are its start-up.
+Rows as a logger wrote them are first made samples of one regular clock (log_quality.py)."""
 
 from __future__ import annotations
 
@@ -45,7 +35,7 @@ def cutoff_of(text: str):
 
 @dataclass(frozen=True)
 class Conditioning:
-    """The signal conditioning options of the commands that read recordings (dyngen.options)."""
+    """The signal conditioning options of the commands that read recordings."""
 
     cutoff: float | str | None = option(
         AUTO, "override: zero-phase Butterworth low-pass on positions and torques alike, in Hz, or 'none'. "
@@ -91,7 +81,7 @@ class Signals:
         return self.lowpass(np.asarray(x, dtype=float).reshape(shape[0], -1)).reshape(shape)
 
     def of_joint(self, j: int) -> "Signals":
-        """The signals of joint j alone (columns j: j + 1), filtered the same way."""
+        """The signals of joint j alone, filtered the same way."""
         one = slice(j, j + 1)
         return dataclasses.replace(self, q=self.q[:, one], qd=self.qd[:, one], qdd=self.qdd[:, one],
                                    tau=None if self.tau is None else self.tau[:, one], extra={})

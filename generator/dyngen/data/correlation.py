@@ -1,10 +1,6 @@
-"""How many independent samples a correlated residual is worth.
-
-Filtered signals are correlated in time, so the textbook least-squares deviations (which
-assume independent residuals) are too small. They are scaled by sqrt(tau), the integrated
-autocorrelation time in samples, tau = 1 + 2 sum_k rho_k, summed until rho first drops
-below 0.05 (a standard truncation; Sokal's 'initial positive sequence' in spirit).
-"""
+"""How many independent samples a correlated residual is worth: least-squares deviations are scaled
+by sqrt(tau), the integrated autocorrelation time tau = 1 + 2 sum_k rho_k in samples, summed until
+rho first drops below 0.05."""
 
 from __future__ import annotations
 

@@ -1,29 +1,10 @@
-"""A recording as a logger wrote it, made into samples of one regular clock.
+"""A recording as a logger wrote it, made into samples of one regular clock before filtering:
+repeated rows (every value equal to the row before while the arm moves) left out, held columns
+(a block updated only every k-th row) interpolated between their updates, jittered stamps
+replaced by the clock (timeline.py) and what is still uneven interpolated onto the grid of the
+median step by cubic splines (the zero-phase filter assumes equal steps).
 
-Controllers sample on a regular clock; loggers write rows at their own, irregular times, each
-row the latest sample they have, stamped when written. What that does to a log, and what is
-done about it here (before filtering and differentiation, data/conditioning.py):
-
-  repeated rows   the same sample written twice: every value equal to the row before while the
-                  arm moves (torque-sensor noise alone makes an exact repeat of all torques
-                  impossible otherwise). The copy is left out (the first write is the nearer to
-                  when the sample was taken). Rows equal while the positions stand still (a
-                  noise-free recording at rest) are kept.
-  held columns    a block (positions, velocities or torques) updated only every k-th row (mixed
-                  rates): between its updates it is interpolated over the update times instead
-                  of held (a held torque lags the motion by up to k rows, in steps).
-  dropped samples, irregular stamps
-                  the stamps are replaced by a regular clock when they jitter around one
-                  (timeline.py); whatever is then not on one regular grid (gaps left by dropped or
-                  repeated samples, stamps that are not jitter) is interpolated onto the grid of
-                  the median step by cubic splines, so that the zero-phase filter, which assumes
-                  equal steps, sees equal steps.
-
-    recording, report = regular_samples(recording)
-
-`report.notes` say in words what was done (for report.md); `report.warnings` what a user must
-know (a long gap filled by interpolation, many repeated rows).
-"""
+    recording, report = regular_samples(recording)      # report.notes, report.warnings"""
 
 from __future__ import annotations
 
@@ -49,8 +30,6 @@ class LogReport:
     filled: int = 0  # samples interpolated onto the grid where the log had none
     longest_gap: float = 0.0  # s
     clock: str | None = None  # timeline.regular's note, when the stamps were replaced by a clock
-    regridded: bool = False  # the samples were interpolated onto a regular grid
-    step_range: tuple = (0.0, 0.0)  # smallest and largest step between stamps as written [s]
     notes: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
 
@@ -78,8 +57,7 @@ def _mapped(r: Recording, t: np.ndarray, f) -> Recording:
 
 
 def repeated_rows(r: Recording) -> np.ndarray:
-    """Boolean (T,): rows that repeat the row before in every column while the positions move
-    (the row after the repeats has other positions than the repeated sample)."""
+    """Boolean (T,): rows repeating the row before in every column while the positions move."""
     repeats, _ = _repeats(_all_columns(r), r.q)
     return repeats
 
@@ -174,13 +152,10 @@ def _unheld(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogReport]:
-    """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are
-    exact, a filter over them is not)."""
+    """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are exact)."""
     report = LogReport()
     if r.t.size < 16:
         return r, report
-    steps = np.diff(r.t)
-    report.step_range = (float(steps.min()), float(steps.max()))
     repeats = repeated_rows(r)
     if repeats.any():
         report.repeated = int(repeats.sum())
@@ -207,7 +182,6 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
         grid = grid[grid <= r.t[-1] + 1e-9 * period]
         report.filled = max(grid.size - r.t.size, 0)
         report.longest_gap = float(steps.max())
-        report.regridded = True
         r = _mapped(r, grid, lambda x, t=r.t: CubicSpline(t, x, axis=0)(grid))
         report.notes.append(f"stamps uneven (steps {1e3 * float(steps.min()):.3g}-{1e3 * float(steps.max()):.3g} ms): "
                             f"interpolated onto a regular {1e3 * period:.4g} ms grid ({report.filled} samples filled)")

@@ -1,17 +1,9 @@
 """Position noise from the spectrum: the errors a robust scale does not see.
 
-automatic.position_noise takes the median absolute third difference: right for an encoder's
-white noise, and blind, by design, to a few large errors. A logger's errors are such: a sample
-stamped a millisecond late sits qd * 1 ms off the motion (1e-3 rad at 1 rad/s, a hundred times
-an encoder's noise) on a few per cent of the rows, and those rows decide the acceleration noise
-after differentiation. Their energy is broadband, so the spectrum sees it: the third difference
-of the positions (where the motion is negligible) has, for white noise of sigma, the power
-density sigma^2 (2 sin(pi f / fs))^6 per sample; the median over the upper half of the band
-(robust to the motion's lines), divided by that shape, is sigma^2 whatever the errors' shape in
-time.
-
-    sigma = spectral_noise(q)      # per joint [rad]
-"""
+A logger's late samples sit qd * delay off the motion on a few per cent of the rows: invisible to
+the median of the third differences, decisive after differentiation. Their energy is broadband:
+for white noise of sigma the third difference has the power density sigma^2 (2 sin(pi f / fs))^6,
+so the median over the upper band divided by that shape is sigma^2 whatever the errors' shape."""
 
 from __future__ import annotations
 

@@ -1,9 +1,5 @@
-"""Which files a `--data` value names: the file itself, or every file a glob matches.
-
-A glob is expanded by dyngen (sorted, so that the order, and with it every result, does not
-depend on the file system), so that it works quoted (`--data 'logs/*.csv'`), where a shell
-would not expand it, and on a command line too long for thousands of names.
-"""
+"""Which files a `--data` value names: the file, or every file a glob matches, expanded by dyngen
+(sorted, so no result depends on the file system; works quoted and for thousands of names)."""
 
 from __future__ import annotations
 

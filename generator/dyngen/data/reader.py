@@ -12,9 +12,7 @@ from .rosbag import read_bag
 
 def read_recording(path, dof: int, require_torques: bool = True, required: tuple = (),
                    effort_topic: str | None = None) -> Recording:
-    """Read and check `path` for a robot of `dof` joints. `required` names further columns
-    (e.g. the stacked inertia entries) that must be present; `effort_topic`: a bag's topic of
-    commanded efforts (data/rosbag.py)."""
+    """Read and check `path` for `dof` joints (`required`: further columns; `effort_topic`: a bag's)."""
     kind = format_of(Path(path))
     if kind == "parquet":
         return read_parquet(path, dof, require_torques, required)

@@ -1,10 +1,5 @@
-"""Read one CSV recording and check it: header `t, q1..qN, tau1..tauN`, optional `qd*`, `qdd*`
-(and any other columns, e.g. the stacked inertia matrix `M11, M12, ...` for identification).
-
-Every problem is an InputError naming the file, the line and the column, for example
-`run.csv: line 17, column tau3: not a number ("abc")` or
-`run.csv: line 1 (header): the robot has 7 joints but the file has q1..q6`.
-"""
+"""Read one CSV recording and check it: header `t, q1..qN, tau1..tauN`, optional `qd*`, `qdd*` and
+other columns (e.g. `M11, M12, ...`); every problem is an InputError naming file, line and column."""
 
 from __future__ import annotations
 
@@ -47,8 +42,7 @@ class Recording:
 
 
 def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
-    """Read and check the CSV `path` for a robot of `dof` joints. `required` names further columns
-    (e.g. the stacked inertia entries) that must be present. (Any format: data/reader.py.)"""
+    """Read and check the CSV `path` for `dof` joints; `required`: further columns that must be present."""
     path = Path(path)
     name = printable(path.name)  # the name reaches comments of written files and the terminal
     text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
@@ -67,8 +61,7 @@ def csv_line(row: int) -> str:
 
 
 def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
-    """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a
-    data row in messages (a CSV line, a Parquet row)."""
+    """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a row."""
     _check_values(name, header, data, where)
     _check_time(name, data[:, columns["t"]], where)
     return as_recording(name, columns, data, dof)
@@ -212,8 +205,7 @@ def _check_time(name, t, where=csv_line) -> None:
 
 
 def check_informative(recordings, need_motion: bool = True) -> None:
-    """Refuse recordings that hold nothing to fit, naming them: every torque zero, or (when
-    motion is needed) every joint standing still in every recording."""
+    """Refuse recordings that hold nothing to fit: every torque zero, or every joint still everywhere."""
     names = ", ".join(r.name for r in recordings)
     if recordings and all(r.tau is not None and not np.any(r.tau) for r in recordings):
         raise InputError(names, "columns tau*", "every torque is zero: nothing to fit (a recording of a robot "

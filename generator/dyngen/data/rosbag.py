@@ -1,18 +1,9 @@
-"""A ROS 2 bag's joint states as a Recording (through rosbags, the optional extra `formats`).
-
-The bag is its folder (metadata.yaml beside the .db3 or .mcap storage; a storage file given
-instead stands for its folder). Read from it: the sensor_msgs/JointState topic (the one whose
-name ends in joint_states, or the only one), its header stamps as t, positions as q, velocities
-as qd (when every message has them) and efforts as tau, the measured effort. With
-`effort_topic`, tau is the effort of that topic instead (a JointState's effort or a
-std_msgs/Float64MultiArray's data, such as ros2_control's effort command), the latest message
-at or before each joint state by the bag's clock (a controller holds its command); joint states
-before the first command are left out. Joints are in the order of the first message's names;
-every message must name the same joints.
-
-Messages are decoded by rosbags' CDR reader for these fixed message types only (the bag's own
-type definitions are not used): nothing in the bag is executed.
-"""
+"""A ROS 2 bag's joint states as a Recording (through rosbags, the optional extra `formats`): its
+sensor_msgs/JointState topic (the one ending in joint_states, or the only one), header stamps as
+t, positions, velocities (when every message has them) and measured efforts; with
+`effort_topic`, tau is the latest effort of that topic at or before each joint state. Format and
+rules: docs/many-recordings.md. Messages are decoded by rosbags' CDR reader for these fixed
+types only: nothing in the bag is executed."""
 
 from __future__ import annotations
 

@@ -1,22 +1,12 @@
-"""Sample times as the recording's clock took them, not as a logger stamped them.
-
-Loggers often stamp a sample when they write it, not when the controller took it: the stamps
-then jitter around a regular clock while positions, velocities and torques were all sampled
-on that clock. The real LWR4+ recordings (examples/lwr4-real) are like this: 5 ms steps with
-pairs of 6.5 + 3.4 ms here and there. Differentiating positions over such stamps puts a spike
-into the acceleration at every pair; on measurement 3 the nominal model's residual on joint 1
-grows from 1.13 Nm (recorded qd, qdd) to 1.54 Nm (qd, qdd from q over the stamps), and is
-1.13 Nm again over the clock.
+"""Sample times as the recording's clock took them, not as a logger stamped them (a logger stamps a
+sample when it writes it: the real LWR4+ recordings have 5 ms steps with pairs of 6.5 + 3.4 ms,
+which differentiated put a spike into the acceleration at every pair).
 
     t, note = regular(t, q)
 
-returns the clock t0 + k T (k counted from the stamps, so that a dropped sample stays a gap)
-when every stamp lies within JITTER_SHARE of a step from it, the stamps differ from it, and the
-positions are smoother over the clock: their jerk (third derivative, where a mis-stamped sample
-stands out most against a smooth motion) carries less than ROUGHER of the energy it carries
-over the stamps (on the LWR4+ recordings under 0.3 %). Otherwise the stamps, and note None. Exact stamps (every
-simulated recording) are left alone: over them the positions are already as smooth.
-"""
+returns the clock t0 + k T (k counted from the stamps: a dropped sample stays a gap) when every
+stamp lies within JITTER_SHARE of a step from it, the stamps differ from it, and the positions'
+jerk over it carries less than ROUGHER of its energy over the stamps; otherwise the stamps and None."""
 
 from __future__ import annotations
 

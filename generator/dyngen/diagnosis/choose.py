@@ -16,10 +16,8 @@ from .forward_selection import solve
 
 
 def on_folds(context, segments, design, chosen, final, options) -> list[str]:
-    """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS ways of
-    cutting the fit recordings into fit and selection blocks, each model refitted per fold. One
-    cut selects on one phase of the motion only (on a periodic trajectory, the same stretch
-    every period); every sample judges once this way."""
+    """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS cuts of the fit
+    recordings into fit and selection blocks, refitted per cut: every sample judges once."""
     totals = None
     for phase in range(roles.FOLDS):
         cut = [replace(seg, **dict(zip(("fit", "select"), roles.blocks(seg.signals, options.block_seconds, phase))))
@@ -38,9 +36,8 @@ def on_folds(context, segments, design, chosen, final, options) -> list[str]:
 
 
 def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain, flagged):
-    """(Consistent result, its corrections per segment, modes) where the consistent link
-    parameters win a joint on selection data, else (None, None, modes) (reidentify.py); only
-    on the joints `flagged` by reidentify.gate."""
+    """(Consistent result, its corrections per segment, modes) where the consistent link parameters win
+    a joint `flagged` by reidentify.gate on selection data, else (None, None, modes)."""
     if not flagged:
         return None, None, modes
     result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
@@ -55,9 +52,8 @@ def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, m
 
 
 def refit(robot, model, p, segments, reid, consistent):
-    """The consistent model refitted on every fit sample (selection blocks included), its
-    regularisation as chosen; kept only if it fits about as well as the model from the fit
-    blocks alone (reidentify.REFIT_WORSE), else that model stays."""
+    """The consistent model refitted on every fit sample, kept if it fits about as well as the one from
+    the fit blocks alone (reidentify.REFIT_WORSE)."""
     refit = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"), regularisation=reid.regularisation)
     if np.all(refit.residual_rms <= reidentify.REFIT_WORSE * reid.residual_rms):
         return refit, reidentify.corrections(refit, model, segments)

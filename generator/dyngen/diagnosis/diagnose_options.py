@@ -1,5 +1,4 @@
-"""The diagnosis step's options (dyngen.options): `dyngen diagnose`'s flags come from this
-class; the fields without option(...) are the method's own settings."""
+"""The diagnosis's options: `dyngen diagnose`'s flags, and without option(...) the method's settings."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""Figures like the paper's Figs. 4 and 5 (PNG, matplotlib Agg): measured against model torque
-per joint, and the residual before and after the selected effects, on test data, with
-the phases where the residual stands out shaded."""
+"""The paper's Figs. 4 and 5 (PNG): measured against model torque, and the residual before and after
+the selected effects, on the judged data, reversals and standstill shaded."""
 
 from __future__ import annotations
 
@@ -49,8 +48,7 @@ def _save(fig, path, title) -> Path:
 
 
 def figures(d, out_dir, robot_name: str) -> dict:
-    """torques.png (Fig. 4 style) and residuals.png (Fig. 5 style) of the first judged segment
-    (test data, or selection data when there are none)."""
+    """torques.png and residuals.png of the first judged segment (test data, else selection data)."""
     role = "test" if d.judged_on == "test" else "select"
     seg = next(s for s in d.segments if getattr(s, role).any())
     m = np.flatnonzero(getattr(seg, role))

@@ -53,8 +53,7 @@ def _torque_rms(design, cand, x) -> float:
 
 
 def identifiable(design, chosen) -> np.ndarray:
-    """Per value of the chosen (in their order), whether the data determine it: not in the null
-    space of the weighted normal matrix."""
+    """Per value of the chosen, whether the data determine it (not in the weighted normal matrix's null space)."""
     slots = np.concatenate([c.slots for c in chosen])
     H = design.H[np.ix_(slots, slots)]
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
@@ -65,8 +64,8 @@ def identifiable(design, chosen) -> np.ndarray:
 
 
 def reported(chosen, described, replaced) -> tuple[list[Finding], list[Finding]]:
-    """(selected, superseded): the findings reported, and the per-joint ones on joints another
-    model won (replaced, 0-based); an arm-wide finding keeps only the joints not replaced."""
+    """(selected, superseded): superseded are per-joint findings on joints another model won (replaced,
+    0-based); an arm-wide finding keeps the other joints."""
     selected, superseded = [], []
     for c, e in zip(chosen, described):
         if c.joint is not None and c.joint in replaced:

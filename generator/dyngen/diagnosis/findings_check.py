@@ -1,19 +1,9 @@
-"""A finding is physical or it is flagged: per-joint values against the scale of what they
-explain, checked on the diagnosis's result before it is reported.
+"""A finding is physical or it is flagged: a per-joint offset or ripple whose torque exceeds LARGER
+times its joint's whole nominal residual (RMS, selection data), or a rotor inertia outside
+identify's range (sanity.rotor_inertia_range) or as large, is marked `suspect`; two such terms
+on one joint are named as not told apart (docs/measured-data.md, "A finding is physical").
 
-A per-joint effect explains part of its joint's nominal residual. A constant or a ripple
-larger than that whole residual (its RMS on the selection data) is not a finding about the
-robot: it is making up for another term of the same joint (on the real LWR4+, joint 6 once got
-a +1.90 Nm offset beside a 2.31 Nm ripple where the whole nominal residual is 0.645 Nm). A
-rotor inertia is outside its physical range by identification/sanity.rotor_inertia_range (the
-same rule identify uses), or when its torque (Ia qdd_j, RMS over the fit data) is larger than
-LARGER x that whole residual, as for the offset. Such entries are marked `suspect` (the
-report prints them so, and the terminal and report.md carry the reason as a warning), and where
-two terms of one joint are both too large a warning says that the data cannot tell them apart.
-
-    selected, warnings = check(selected, selection_before, model, s, fit_signals)
-    # the findings, those out of range marked suspect; warnings: what could not be told apart
-"""
+    selected, warnings = check(selected, selection_before, model, s, fit_signals)"""
 
 from __future__ import annotations
 
@@ -27,7 +17,7 @@ LARGER = 1.5  # a term whose torque exceeds this many times its joint's whole no
 
 
 def _size(e) -> float | None:
-    """The RMS-like size [Nm] of a per-joint finding's torque, where it has a scale of its own."""
+    """The size [Nm] of a per-joint finding's torque, where it has one of its own."""
     if e.effect == "offset" and e.values.get("b") is not None:
         return abs(e.values["b"])
     if e.effect == "ripple":

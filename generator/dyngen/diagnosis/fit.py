@@ -15,8 +15,7 @@ from . import roles
 
 @dataclass
 class CandidateMoments:
-    """Every candidate's moments on each role's samples, weighted per joint (the diagnosis's
-    design; not the excitation's, excitation/design.py)."""
+    """Every candidate's moments on each role's samples, weighted per joint (the diagnosis's design)."""
     candidates: list
     fit: dz.Moments
     select: dz.Moments
@@ -71,17 +70,15 @@ def predict(context, chosen, x, segment) -> np.ndarray:
 
 
 def corrected(context, chosen, x, segments) -> list:
-    """The segments with their correction: the chosen candidates' torques at values x (zero
-    without any)."""
+    """The segments with their correction: the chosen candidates' torques at values x (zero without)."""
     return [dataclasses.replace(seg, correction=predict(context, chosen, x, seg) if chosen else
                                 np.zeros_like(seg.residual)) for seg in segments]
 
 
 def reweighted(design, final) -> CandidateMoments:
-    """The design with each joint weighted by 1 / the RMS its residual keeps after the chosen
-    effects (on the fit samples). The selection's weights come from the nominal residual, which
-    holds the very effects sought: a payload's 9 Nm on joint 2 would weigh joint 2 down as if
-    it were noise, and the arm-wide values would be set by the other joints alone."""
+    """The design with each joint weighted by 1 / the RMS its residual keeps after the chosen effects:
+    the nominal residual holds the very effects sought (a payload's 9 Nm on joint 2 would weigh it
+    down as if it were noise)."""
     rms = np.sqrt(design.fit.mse(final.slots, final.x))
     weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
     return CandidateMoments(design.candidates, design.fit, design.select, design.test, weights, design.groups)
@@ -97,8 +94,8 @@ def correlation_time(segments, weights) -> float:
 
 
 def ranged(context, segments, chosen):
-    """The context with the positions the segments' fit samples cover (Context.q_range), if a
-    chosen effect depends on them (Term.ranged); else the context itself (and its cache)."""
+    """The context with the positions the fit samples cover (Context.q_range) if a chosen effect needs
+    them (Term.ranged); else the context itself."""
     if not any(c.effect.ranged for c in chosen):
         return context
     q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])

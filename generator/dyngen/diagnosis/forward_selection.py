@@ -1,38 +1,12 @@
-"""Forward selection of effects by what they do on selection data (not the fit's samples).
+"""Forward selection of effects by what they do on selection data (never on the fit's samples), and
+prune(), backward elimination once their settings are refined (settle.py).
 
-Fit: weighted least squares on the fit samples, every joint's rows divided by the RMS of
-its nominal residual there (so a joint with a large residual does not drown the others).
-Gain: on the selection samples, the decrease of the residual's mean square relative to its
-value before the step (an increase relative to its value after: undoing a step scores minus
-the step), on the candidate's own joint (per-joint effects) or summed over joints (arm-wide
-effects). A step adds the candidate with the largest selection gain if
-
-  - the gain is at least `min_gain` per fitted value (default 0.05: 5 % of one joint's current
-    selection mean square for a one-value effect, 30 % for the six values of a position
-    ripple), so an effect must generalise, not merely fit, and pay for its values, and
-  - its fitted values are significant on the fit data (chi-square test of x_c^T Cov_cc^-1 x_c,
-    p < `alpha`), so noise alone does not qualify, and
-  - they are physically plausible (friction opposes motion, a rotor inertia is positive, a
-    sensor gain lies within 50 % of one: Term.plausible), so a column that merely happens
-    to resemble the residual is not claimed as that effect.
-
-An arm-wide effect must gain `min_gain` on at least two joints' selection data: a time shift,
-tilt or payload loads every joint, and one joint's gain is that joint's own business.
-
-An effect that only adds to another on its joint (Term.extends: Stribeck's static friction
-above the Coulomb level) is tried once that one is selected, and goes when it goes.
-
-Then prune() drops, one by one, selected effects that no longer pay their way with all the
-others in (settings refined, settle.py): first those whose selection gain has fallen below the
-price they paid to enter, then those whose values are not significant once the deviations are
-scaled for the correlation in time of the residual they leave.
-
-Among candidates within 10 % of the best gain, the one with fewest values wins (a payload is
-preferred to the 43 coefficient errors that could also express it), and a secondary effect
-(Term.secondary: direction-dependent Coulomb, which on a joint that never stops is a
-sensor offset; the gravity scale, a symptom) only if no plainer one is near. Selection stops when no
-candidate qualifies: with data that hold no unmodelled effect, nothing is selected.
-"""
+Fit: weighted least squares on the fit samples, each joint's rows divided by the RMS of its nominal
+residual. A step adds the candidate with the largest selection gain per sqrt of its values whose
+values are significant (chi-square, p < alpha) and plausible (Term.plausible); an arm-wide effect
+must gain on two joints; among candidates within NEAR_BEST of the best, the fewest values win (a
+payload before 43 coefficient errors) and a secondary effect (Term.secondary) only if no plainer
+one is near. The reasons and measurements: docs/measured-data.md ("Selection")."""
 
 from __future__ import annotations
 
@@ -72,11 +46,9 @@ class Selection:
 def solve(design, chosen, block: slice | None = None, covariance: bool = True) -> Fit:
     """Weighted least squares of the chosen candidates on the fit samples (moments only).
 
-    The covariance is the sandwich H^-1 (sum_j w_j^4 s_j^2 G_j) H^-1 with s_j^2 joint j's own
-    residual variance: joints differ in noise, and the weights (from the nominal residual,
-    which contains the very effects sought) are not their noise levels. With `block`, only
-    that block of it is computed (the forward selection tests one candidate at a time); with
-    covariance False, none."""
+    The covariance is the sandwich H^-1 (sum_j w_j^4 s_j^2 G_j) H^-1, s_j^2 joint j's own residual
+    variance (the weights come from the nominal residual, not the noise). With `block` only that
+    block of it; with covariance False none."""
     slots = np.concatenate([c.slots for c in chosen]) if chosen else np.zeros(0, dtype=int)
     apply, d = _factored(design.H[np.ix_(slots, slots)])
     x = apply(design.g[slots] / d) / d
@@ -94,16 +66,15 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
 
 
 def _factored(H: np.ndarray):
-    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal, Hs = H / (d d^T): the columns'
-    units differ by orders of magnitude. H^-1 b = Hs^-1 (b / d) / d."""
+    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal (the columns' units differ by orders of
+    magnitude): H^-1 b = Hs^-1 (b / d) / d."""
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
     return _solver(H / np.outer(d, d)), d
 
 
 def _solver(Hs: np.ndarray):
-    """b -> Hs^-1 b for a unit-diagonal normal matrix: Cholesky, or a pseudo-inverse when
-    columns are dependent (dependent columns then share no value instead of taking arbitrary
-    large ones)."""
+    """b -> Hs^-1 b: Cholesky, or a pseudo-inverse when columns are dependent (they then share no value
+    instead of taking arbitrary large ones)."""
     if Hs.size == 0:
         return lambda b: np.zeros_like(b)
     try:
@@ -112,24 +83,10 @@ def _solver(Hs: np.ndarray):
             return lambda b: linalg.cho_solve(factor, b, check_finite=False)
     except linalg.LinAlgError:
         pass
-    inverse = _inverse(Hs)
-    return lambda b: inverse @ b
-
-
-def _inverse(Hs: np.ndarray) -> np.ndarray:
-    """Inverse of a unit-diagonal normal matrix; a pseudo-inverse when columns are dependent
-    (dependent columns then share no value instead of taking arbitrary large ones)."""
-    if Hs.size == 0:
-        return Hs
-    try:
-        factor = linalg.cho_factor(Hs, check_finite=False)
-        if np.min(np.abs(np.diag(factor[0]))) > 1e-5:  # condition below about 1e10
-            return linalg.cho_solve(factor, np.eye(len(Hs)), check_finite=False)
-    except linalg.LinAlgError:
-        pass
     vals, vecs = np.linalg.eigh(Hs)
     keep = vals > 1e-10 * max(vals.max(), 1e-300)
-    return (vecs[:, keep] / vals[keep]) @ vecs[:, keep].T
+    inverse = (vecs[:, keep] / vals[keep]) @ vecs[:, keep].T
+    return lambda b: inverse @ b
 
 
 def significant(fit: Fit, candidate, chosen, alpha: float = ALPHA, correlation: float = 1.0) -> bool:
@@ -137,8 +94,8 @@ def significant(fit: Fit, candidate, chosen, alpha: float = ALPHA, correlation: 
 
 
 def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
-    """Chi-square test of the candidate's values against zero, with the covariance scaled by
-    the residual's correlation time in samples (see correlation.py)."""
+    """Chi-square test of the candidate's values against zero, the covariance scaled by the residual's
+    correlation time in samples (data/correlation.py)."""
     offset = sum(c.size for c in chosen[:chosen.index(candidate)])
     k = slice(offset, offset + candidate.size)
     x, C = fit.x[k], fit.covariance_of(k) * correlation
@@ -152,11 +109,9 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
 
 
 def selection_mse(design, chosen) -> np.ndarray:
-    """Per joint mean square of the residual the chosen candidates leave on selection data.
-    With selection on blocks of the fit data (design.groups), over every cut: each block group
-    judges the candidates fitted on the other groups, so every fit sample judges once (one cut
-    judges one phase of a periodic motion only: on the real LWR4+, the cut alone moved fit
-    m1 -> test m3 between 0.20 and 0.36 Nm); else on the selection recordings."""
+    """Per joint mean square of the residual the chosen candidates leave on selection data: on the
+    selection recordings, or with selection on blocks (design.groups) over every cut, each block
+    group judging the fit on the others (one cut judges one phase of a periodic motion only)."""
     if not design.groups:
         if not chosen:
             return design.select.c / max(design.select.count, 1)
@@ -180,10 +135,8 @@ def selection_mse(design, chosen) -> np.ndarray:
 
 
 def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
-    """Relative decrease of the selection mean square: on the candidate's own joint for a
-    per-joint effect, less any increase it causes on other joints (a refit of arm-wide effects
-    must not lend it credit from other joints, but it is charged for what that refit spoils
-    there); summed over joints for an arm-wide effect."""
+    """Relative decrease of the selection mean square: a per-joint effect's on its own joint, less any
+    increase on other joints (through the refit arm-wide values); an arm-wide effect's summed."""
     relative = relative_change(before, after)
     if candidate.joint is None:
         return float(relative.sum())
@@ -192,8 +145,8 @@ def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
 
 
 def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps: int = 30) -> Selection:
-    """Forward steps; the significance test here assumes uncorrelated residuals (prune() then
-    applies the honest, correlation-scaled test to what was selected)."""
+    """Forward steps; their significance test assumes uncorrelated residuals (prune() applies the
+    correlation-scaled one)."""
     selection = Selection([])
     current = selection_mse(design, [])
     tau = 1.0
@@ -230,9 +183,8 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
 
 
 def _shown(candidate, before, after, min_gain) -> bool:
-    """An arm-wide effect (a time shift, a tilt, a payload) acts on every joint it loads: it
-    must gain min_gain on at least two joints' selection data (on one, that joint's own
-    effects are the plainer explanation)."""
+    """An arm-wide effect must gain min_gain on at least two joints (on one, that joint's own effects
+    are the plainer explanation)."""
     if candidate.joint is None:
         relative = relative_change(before, after)
         return int(np.sum(relative >= min_gain)) >= min(2, len(relative))
@@ -240,11 +192,8 @@ def _shown(candidate, before, after, min_gain) -> bool:
 
 
 def relative_change(before: np.ndarray, after: np.ndarray) -> np.ndarray:
-    """Per joint relative change of the selection mean square, a decrease positive: the change
-    over the larger of the two, so that undoing a step scores exactly minus the step (over
-    `before` alone, an effect that halves one joint and doubles another would gain 0.5 - 1 on
-    the way in, 1 - 0.5 on the way out, and pruning would judge what selection did not), and
-    no joint counts for more than its whole error either way."""
+    """Per joint relative change of the selection mean square (a decrease positive), over the larger of
+    before and after: undoing a step scores exactly minus the step, so pruning judges as selection did."""
     return (before - after) / np.maximum(np.maximum(before, after), 1e-300)
 
 
@@ -260,19 +209,17 @@ def _based(candidate, chosen) -> bool:
 
 
 def without(chosen, cand) -> tuple[list, list]:
-    """(chosen less cand and the effects that extend it on its joint (Term.extends), the
-    candidates removed: cand first)."""
+    """(chosen less cand and the effects that extend it on its joint, the candidates removed: cand first)."""
     kept = [c for c in chosen if c is not cand]
     gone = [c for c in kept if not _based(c, kept)]
     return [c for c in kept if c not in gone], [cand] + gone
 
 
 def prune(design, chosen: list, correlation, alpha: float = ALPHA, min_gain: float = 0.0) -> tuple[list, float, list]:
-    """Backward elimination: drop the effect whose selection gain, with all the others kept, is
-    furthest below `min_gain` per value (the price of entry in forward(); 0: below nothing but
-    zero); then, with deviations scaled by the correlation time of the residual the
-    chosen effects leave (correlation(chosen, fit) -> samples), drop the least significant
-    effect while its p-value exceeds alpha. Returns (kept, correlation time, dropped keys)."""
+    """Backward elimination: drop the effect furthest below `min_gain` per sqrt of its values (the
+    price of entry in forward()), then, deviations scaled by the correlation time of what the chosen
+    leave (correlation(chosen, fit) -> samples), the least significant while its p-value exceeds alpha.
+    Returns (kept, correlation time, dropped keys)."""
     chosen, dropped = list(chosen), []
 
     def drop(index):

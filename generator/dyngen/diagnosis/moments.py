@@ -1,15 +1,8 @@
-"""The least-squares design of every candidate at once, kept as per-joint moments.
-
-Each candidate (an effect on one joint, or an arm-wide effect) owns a few slots of one
-global parameter vector x. For joint j and a set of samples, with A_j the columns acting on
-joint j and r_j its residual, the moments
-
-    G_j = A_j^T A_j,  b_j = A_j^T r_j,  c_j = r_j^T r_j
-
-give the fit of any subset of candidates, and its residual on any joint, without touching the
-samples again: |r_j - A_j x|^2 = c_j - 2 x.b_j + x.G_j x. That is what makes forward selection
-over dozens of candidates cheap (diagnosing 30 s at 1 kHz takes about a second).
-"""
+"""The least-squares design of every candidate at once, as per-joint moments: each candidate owns
+slots of one parameter vector x, and for joint j (columns A_j, residual r_j) the moments
+G_j = A_j^T A_j, b_j = A_j^T r_j, c_j = r_j^T r_j give the fit of any subset and its residual
+|r_j - A_j x|^2 = c_j - 2 x.b_j + x.G_j x without the samples: forward selection over dozens of
+candidates stays cheap."""
 
 from __future__ import annotations
 
@@ -82,20 +75,11 @@ def effect_columns(effects, context, segment) -> dict:
 
 
 def columns_of(effect, context, segment, joint=None) -> np.ndarray:
-    """An effect's columns on one segment, computed once per segment and effect setting (the
-    selection and the pruning ask again). Laws that switch with the sign of the velocity
-    (Term.switching: Coulomb, Stribeck, direction) are passed through the recording's filter,
-    like the torque they explain: a filtered friction step is then compared with a filtered
-    step, not a sharp one. Smooth functions of the filtered motion are filtered already.
-
-    joint: of a local effect (Term.local), only that joint's columns are computed, the
-    others left zero (the search of a velocity scale asks for one joint's column dozens of times).
-
-    The arm and its torque sensor as the chosen effects have them (as_chosen): with a time shift
-    (Context.delay), every other effect's columns are taken that much earlier, as a late sensor
-    measures friction or a payload as late as the arm's own torque; with a sensor gain
-    (Context.scale), the arm's effects (not the sensor's) are scaled by it on its joint; a
-    tilt turns a payload's gravity with the arm's (Context.load, Term.reads)."""
+    """An effect's columns on one segment, memoised per segment and setting. Switching laws
+    (Term.switching) pass through the recording's filter like the torque they explain. joint: of a
+    local effect, only that joint's columns (the others zero). As the chosen effects have the arm
+    (as_chosen): with a time shift every other effect's columns are that much later; with a sensor
+    gain the arm's effects are scaled on its joint; a tilt turns a payload's gravity (Term.reads)."""
     part = joint is not None and effect.local
     delay = 0.0 if effect.delays else context.delay
     scale = None if effect.sensor else context.scale
@@ -126,9 +110,8 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
 
 
 def world(context, chosen) -> dict:
-    """The Context fields the chosen candidates set, each at its setting: the lag of a time
-    shift (delay; Term.delays), each joint's 1 + sensor gain (scale; Term.scales) and a
-    payload (load; Term.load); none without them."""
+    """The Context fields the chosen set: a time shift's delay, each joint's 1 + sensor gain (scale) and
+    a payload (load); none without them."""
     delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
     scale = None
@@ -139,8 +122,7 @@ def world(context, chosen) -> dict:
 
 
 def as_chosen(context, chosen):
-    """The context with the arm and torque sensor the chosen candidates describe (world): the
-    columns of a set of chosen candidates are computed in it."""
+    """The context with the arm and sensor the chosen candidates describe (world)."""
     fields = world(context, chosen)
     if all(getattr(context, k) == v for k, v in fields.items()):
         return context
@@ -148,8 +130,7 @@ def as_chosen(context, chosen):
 
 
 def delayed(x: np.ndarray, t: np.ndarray, delay: float) -> np.ndarray:
-    """x (T, ...) at times t - delay, linearly interpolated, held at its first value before
-    the first sample (as TimeShift's columns are)."""
+    """x (T, ...) at times t - delay, linearly interpolated, held at its first value before the start."""
     at = np.clip(t - delay, t[0], t[-1])
     k = np.clip(np.searchsorted(t, at, side="right"), 1, t.size - 1)
     w = ((at - t[k - 1]) / (t[k] - t[k - 1])).reshape((-1,) + (1,) * (x.ndim - 1))

@@ -1,8 +1,5 @@
-"""Write a diagnosis: report.md, diagnosis.json, effects.yaml, torques.png, residuals.png and,
-when the link parameters are physically consistent, <robot>.urdf and <robot>.xml with the
-selected friction and rotor inertia; when the link parameters were found off
-(reidentify.py), consistent/identified.yaml, identified.md, <robot>.urdf and <robot>.xml with
-the re-identified consistent parameters (identification/consistent_output.py's writers)."""
+"""Write a diagnosis: report.md, diagnosis.json, effects.yaml, the figures, the URDF and MJCF with
+the selected friction where the links are consistent, and consistent/ where they were found off."""
 
 from __future__ import annotations
 

@@ -1,14 +1,7 @@
-"""Where in the motion a residual lives: per joint, every sample gets phase labels.
-
-    standstill     |qd| below `still` (default 0.02 rad/s)
-    reversal       within `window` (0.15 s) of a change of sign of qd between motions
-    slow / fast    moving, below / above half the joint's largest |qd| in the data
-    accelerating   |qdd| above half the joint's largest |qdd|
-    low / middle / high range   the lower, middle and upper third of the joint's positions
-
-A sample may carry several labels (a reversal is also slow). Per label, the report gives the
-residual's RMS there and the share of samples, so a user reads e.g. "joint 6: reversal".
-"""
+"""Where in the motion a residual lives: per joint, every sample gets phase labels (several may
+apply): standstill (|qd| < still), reversal (within `window` of a sign change of qd between
+motions), slow / fast (below / above half the largest |qd|), accelerating (|qdd| above half the
+largest), and the low / middle / high third of the positions."""
 
 from __future__ import annotations
 
@@ -59,8 +52,8 @@ def by_phase(residual: np.ndarray, masks: dict) -> list[dict]:
 
 
 def _near_reversals(t, v, moving, window) -> np.ndarray:
-    """Samples within `window` of a reversal: consecutive moving samples of opposite sign, at
-    most 2 windows apart (so noise at standstill does not count)."""
+    """Samples within `window` of a reversal: consecutive moving samples of opposite sign at most 2
+    windows apart (noise at standstill does not count)."""
     idx = np.flatnonzero(moving)
     flips = np.flatnonzero((np.sign(v[idx[1:]]) != np.sign(v[idx[:-1]])) & (t[idx[1:]] - t[idx[:-1]] <= 2 * window))
     times = 0.5 * (t[idx[flips]] + t[idx[flips + 1]])

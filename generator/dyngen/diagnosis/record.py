@@ -1,7 +1,6 @@
-"""The diagnosis's result: the findings as types and one record (Diagnosis), built by keyword
-at the end of the pipeline (pipeline.py). A type's fields are its diagnosis.json entry (entry();
-docs/conventions.md, "Diagnosis JSON"); the record and the findings are frozen: a later step
-that changes a finding (findings_check marks it suspect) returns a new one."""
+"""The diagnosis's result: the findings as types and one record (Diagnosis), built by keyword.
+Fields are the diagnosis.json entries (docs/conventions.md); frozen: a step that changes a
+finding returns a new one."""
 
 from __future__ import annotations
 
@@ -9,8 +8,7 @@ from dataclasses import dataclass, field, fields
 
 
 def entry(finding) -> dict:
-    """A finding's diagnosis.json entry: its fields in order, an optional text left empty ("")
-    left out."""
+    """A finding's diagnosis.json entry: its fields in order, an empty optional text left out."""
     return {f.name: getattr(finding, f.name) for f in fields(finding)
             if not (f.default == "" and getattr(finding, f.name) == "")}
 
@@ -33,8 +31,7 @@ class Finding:
 
 @dataclass(frozen=True)
 class Unstable:
-    """A selected effect not claimed: its values fitted on each stretch of the fit data on its
-    own disagree with the whole fit's (stable.py); it stays in the model."""
+    """A selected effect not claimed: unstable across stretches of the fit data (stable.py); kept."""
     finding: Finding  # what it would have been claimed as
     per_stretch: list  # per stretch its values (None where the stretch does not determine them)
     reason: str
@@ -66,8 +63,7 @@ class RecordingNote:
 
 @dataclass(frozen=True)
 class LinksOff:
-    """The finding "link parameters off": the joints where consistent link parameters,
-    re-identified from the fit data (reidentify.py), beat every effect and the simple model."""
+    """"Link parameters off": joints where re-identified consistent link parameters beat every effect."""
     joints: list  # 1-based
     regularisation: float  # toward the given parameters, chosen on selection data
     selection: list  # per regularisation tried: {"regularisation", "selection_weighted_ms"}

@@ -1,25 +1,12 @@
-"""Nonlinear settings of selected effects, refined after the selection.
-
-Some effects are linear in their values only once a setting is fixed: the Stribeck velocity
-vs, and the time shift, whose exact form tau_model(t - dt) - tau_model(t) is linear in nothing.
-Selection works with a few variants of vs and with the time shift to first order (the
-derivative of tau_model), which is wrong wherever tau_model jumps (acceleration steps, e.g.
-rest-to-rest trajectories). Once such an effect is selected, its setting is refined on the
-fit samples, every other selected effect refitted each time (selection and test data stay unused):
-
-  - a setting the fitted values imply (Term.implied_setting: the time shift, whose exact
-    column at dt0 gives the fitted value dt = dt0 when the model holds; the tilt, whose
-    second-order change along gravity follows from the angles) by fixed-point
-    iteration: setting <- implied setting, until it moves by less than REFINE_TOLERANCE (a
-    scalar setting whose iteration fails: the secant method on implied(s) - s);
-  - a setting independent of the values (Term.search_interval: the Stribeck velocity) by a
-    bounded scalar search for the smallest weighted fit residual.
+"""Nonlinear settings of selected effects, refined after the selection on the fit samples (every
+other selected effect refitted each time; selection and test data unused): a setting the fitted
+values imply (Term.implied_setting: time shift, gain, payload, tilt) by fixed-point iteration,
+with the secant method where that fails; one independent of them (Term.search_interval: a
+velocity scale) by a bounded scalar search for the smallest weighted fit residual.
 
     design, chosen = refine(context, segments, design, chosen)
 
-returns a design holding only the chosen candidates (slots renumbered), weighted as the
-selection's, and the chosen candidates with their refined effects.
-"""
+returns a design of the chosen candidates alone (slots renumbered), weighted as the selection's."""
 
 from __future__ import annotations
 
@@ -46,8 +33,8 @@ def refine(context, segments, design, chosen):
 
 
 def restricted(context, segments, design, chosen):
-    """The design of the chosen candidates alone on the segments' current masks (e.g. after
-    the fit masks were widened), weighted as `design`; and the candidates renumbered."""
+    """The design of the chosen candidates alone on the segments' current masks, weighted as `design`;
+    and the candidates renumbered."""
     state = _State(context, segments, design, _renumbered(chosen))
     return state.design, state.chosen
 
@@ -90,8 +77,7 @@ class _State:
         return chosen, columns, self.updated(chosen, columns, index), self.context
 
     def updated(self, chosen, columns, index):
-        """self.design with the rows and columns of candidate `index` recomputed (the others'
-        moments do not change when one candidate's setting does)."""
+        """self.design with candidate `index`'s rows and columns recomputed (the others' moments do not change)."""
         cand = chosen[index]
         new = cand.slots
         design = self.design
@@ -193,11 +179,10 @@ def _refine_one(state, index) -> None:
 
 
 def _secant(state, index) -> None:
-    """The fixed point of a scalar setting s = implied(s) as the root of implied(s) - s, by the
-    secant method: where the plain iteration overshoots further each step. A sensor gain on a
-    wrist joint beside a heavy payload: the payload's torque there, scaled by 1 + g0, moves the
-    fitted gain by more than g0 moved (random withheld case, 4.6 % on the LWR's joint 5 beside
-    2.7 kg). Kept only if it converges with plausible values; else the state stays as it was."""
+    """The fixed point s = implied(s) by the secant method, where the plain iteration overshoots further
+    each step (a sensor gain on a wrist joint beside a heavy payload: the payload's torque, scaled by
+    1 + g0, moves the fitted gain by more than g0 moved). Kept only if it converges with plausible
+    values."""
     start = state.snapshot()
 
     def excess(setting):
@@ -226,8 +211,7 @@ def _secant(state, index) -> None:
 
 
 def _settled(setting, before, effect) -> bool:
-    """Whether a fixed-point search has converged: the setting moved by less than
-    REFINE_TOLERANCE of itself, or than the effect's own tolerance."""
+    """A fixed-point step below REFINE_TOLERANCE of the setting, or the effect's own tolerance."""
     step = float(np.linalg.norm(np.subtract(setting, before)))
     return step <= max(REFINE_TOLERANCE * float(np.linalg.norm(setting)), effect.tolerance)
 
@@ -242,7 +226,7 @@ def _renumbered(chosen) -> list:
 
 
 def _groups(seg, design) -> list:
-    """The segment's block-group masks where the design keeps group moments (none else)."""
+    """The segment's block-group masks where the design keeps group moments."""
     if not design.groups:
         return []
     return seg.groups or [np.zeros(seg.residual.shape[0], dtype=bool)] * len(design.groups)

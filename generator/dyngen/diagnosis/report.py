@@ -202,8 +202,8 @@ def markdown(d, sources: dict) -> str:
 
 
 def worse_than_simple(d) -> str:
-    """The joints where the final model ends above the simple model on the judged data, with
-    both figures there and at the velocities the fit data covered; "" if none."""
+    """Joints where the final model ends above the simple model, with both figures (also within the fit
+    speeds); "" if none."""
     worse = [j for j in range(d.joints) if d.rms_after[j] > d.rms_simple[j]]
     if not worse:
         return ""

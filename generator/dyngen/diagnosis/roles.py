@@ -1,20 +1,8 @@
-"""Three roles for data, never mixed (docs: README, "From measured data"):
-
-  fit     sets the effects' values (and the simple model's);
-  select  chooses which effects are kept (their gain on these samples, never fitted to them);
-  test    is used for nothing but the residual reported as held out.
-
-Without select recordings, selection uses blocks of the fit recordings (`block_seconds` long,
-in three groups: every third block; each group in turn judges what the other two fit,
-Segment.groups), with a guard of the filter's length around every block boundary that belongs
-to neither role (a zero-phase filter spreads each sample over its neighbours). Without test
-recordings nothing is reported as held out: the report then labels its figures as selection
-figures.
-
-A test recording that repeats a fit recording's trajectory (positions nearly equal sample by
-sample) is not evidence that the effects generalise, only that they repeat: `repeated` finds
-such pairs, and the report says so.
-"""
+"""Three roles for data, never mixed: fit sets the values, select chooses the effects (never fitted
+to them), test is used for nothing but the residual reported as held out. Without select
+recordings, every third block of the fit recordings selects (each third in turn,
+Segment.groups), with the filter's reach around each cut in neither role. `repeated` finds test
+recordings that repeat a fit trajectory (evidence of repetition, not generalisation)."""
 
 from __future__ import annotations
 
@@ -29,8 +17,8 @@ REPEATED_SHARE = 0.02  # RMS position difference below this share of the motion'
 
 @dataclass(frozen=True)
 class Segment:
-    """One recording with the model's torques, its residual and its samples' roles. Frozen: a
-    stage that changes the roles or the correction returns new segments (dataclasses.replace)."""
+    """One recording with the model's torques, its residual and its samples' roles (frozen: a stage
+    returns new segments)."""
 
     signals: object
     tau_model: np.ndarray
@@ -72,8 +60,8 @@ FOLDS = 3  # every third block selects; the per-joint models are compared over a
 
 
 def blocks(sig, block_seconds: float, phase: int = FOLDS - 1) -> tuple[np.ndarray, np.ndarray]:
-    """(fit, select) masks: blocks number phase, phase + FOLDS, ... select, the rest fit, and the
-    filter's reach around every cut belongs to neither."""
+    """(fit, select) masks: blocks phase, phase + FOLDS, ... select, the rest fit, the filter's reach
+    around every cut in neither."""
     inner = sig.inner()
     block = np.floor((sig.t - sig.t[0]) / block_seconds).astype(int)
     select = block % FOLDS == phase
@@ -89,8 +77,7 @@ def blocks(sig, block_seconds: float, phase: int = FOLDS - 1) -> tuple[np.ndarra
 
 
 def repeated(fit_signals, test_signals) -> list[tuple[str, str, float]]:
-    """(fit name, test name, RMS position difference [rad]) for every test recording whose
-    positions follow a fit recording's, sample time by sample time from their starts."""
+    """(fit name, test name, RMS position difference [rad]) for each test recording following a fit one."""
     out = []
     for test in test_signals or []:
         for fit in fit_signals:

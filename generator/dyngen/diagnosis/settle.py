@@ -11,8 +11,7 @@ from .forward_selection import bases, prune, selection_mse, solve, without
 
 
 def settle(context, segments, design, chosen, correlation, options):
-    """The selected effects with their settings refined, those that no longer pay for their
-    values pruned, implausible ones refused: (design, chosen, final fit, dropped, refused)."""
+    """(design, chosen, final fit, dropped, refused)."""
     # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
     # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
     design, chosen = refine(context, segments, design, chosen)
@@ -35,14 +34,12 @@ def settle(context, segments, design, chosen, correlation, options):
 
 
 def _moved(context, chosen, before) -> bool:
-    """Whether dropping some of `before` changed what the others' columns are computed with
-    (design.world: a time shift, a gain or a payload went): then the design is rebuilt."""
+    """Whether dropping some of `before` changed what the others' columns are computed with (world)."""
     return dz.world(context, chosen) != dz.world(context, before)
 
 
 def _plausible(design, chosen):
-    """The final fit, after refusing (one at a time, the worst first) effects whose values,
-    fitted together, are no longer physically possible (e.g. a payload of negative mass)."""
+    """The final fit, after refusing, worst first, effects whose values fitted together are impossible."""
     refused = []
     while True:
         final = solve(design, chosen)
@@ -65,9 +62,8 @@ def _plausible(design, chosen):
 
 
 def _consistent_payload(context, segments, design, chosen, final, refused):
-    """An effect whose fitted values are possible only in part (Term.simplified: a payload
-    whose inertia is no body's) is replaced by the simpler form that does best on the
-    selection data (weighted as the fit), and everything refitted."""
+    """An effect possible only in part (Term.simplified: a payload whose inertia is no body's) replaced by
+    the simpler form that does best on the selection data, and everything refitted."""
     for i, (c, values) in enumerate(zip(chosen, dz.split_values(chosen, final.x))):
         simpler = c.effect.simplified(values)
         if simpler is None:
@@ -86,7 +82,6 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
 
 
 def _narrow_stribeck(chosen) -> list:
-    """Per-joint effects that only reshape another on their joint (Term.reshapes: a Stribeck
-    term no wider than the Coulomb transition)."""
+    """Per-joint effects that only reshape another on their joint (Term.reshapes)."""
     return [c for c in chosen if c.joint is not None
             and any(o.joint == c.joint and c.effect.reshapes(o.effect) for o in chosen)]

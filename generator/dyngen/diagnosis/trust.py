@@ -1,25 +1,11 @@
-"""Whether a recording's conditioning can be trusted, before anything is claimed from it.
+"""Whether a recording's conditioning can be trusted, before anything is claimed from it: where the
+nominal residual exceeds ABOVE times the measured torque (RMS, joints above TORQUE_FLOOR of the
+largest), the recording is conditioned again (automatic cutoff only: positions differentiated,
+cutoffs halved down to MIN_CUTOFF, the highest within KEEP of the best kept); when nothing helps,
+Unusable (exit status EXIT_UNUSABLE, no effect claimed). docs/measured-data.md, "When
+conditioning cannot be trusted".
 
-The nominal model, however wrong its details, predicts most of an arm's torque: its residual
-is a fraction of the measured torque on every joint that carries torque. Where conditioning
-failed (a logger's repeated rows or late stamps differentiated as if they were motion,
-recorded accelerations that are noise, a cutoff far above what the positions allow), the
-model torque carries tens of Nm of differentiation noise and the residual exceeds the
-torque itself; every effect fitted to it is then a description of the noise.
-
-    signals = checked(model, s, signals)    # raises Unusable when nothing helps
-
-For each recording the nominal residual RMS is compared with the measured torque's RMS on the
-joints that carry torque (above TORQUE_FLOOR of the largest). Where the residual is ABOVE times
-larger,
-the recording is conditioned again, when its cutoff was the automatic one: positions
-differentiated through the automatic cutoff (if recorded velocities were used), then cutoffs
-halved down to MIN_CUTOFF; the highest cutoff whose residual is within KEEP of the best tried
-and below the torque on every judged joint is used, and the recording's warnings say so. When
-none is, the conditioning cannot be trusted: Unusable carries one line for the terminal and
-report.md and every trial for the figure (commands/diagnose.py: exit status EXIT_UNUSABLE, no
-effect claimed).
-"""
+    signals = checked(model, s, signals)"""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""What `dyngen diagnose` writes when the data cannot support a diagnosis (trust.Unusable):
-report.md with the one line and every conditioning tried, diagnosis.json for scripts
-({"usable": false, ...}), and conditioning.png, the figure that shows why: per joint, the
-measured torque's RMS beside the nominal residual's under each conditioning tried."""
+"""What `dyngen diagnose` writes when the data cannot support a diagnosis (trust.Unusable): report.md,
+diagnosis.json ({"usable": false}) and conditioning.png (torque RMS beside each trial's residual)."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""The updated model: the nominal link parameters plus the selected effects, as
-
-- YAML (`effects.yaml`): every selected effect with its values and deviations, and per
-  joint the friction vector of the generated `<robot>_friction(qd, f, tau)` routine;
-- per-joint simulator terms for URDF (damping, friction) and MJCF (damping, frictionloss,
-  armature), written with the nominal links by dyngen.export.
-
-Effects with no place in a simulator file (sensor offset and gain, time shift, tilt,
-coefficient errors) stay in the YAML only; a payload is added to the last link.
-"""
+"""The updated model: effects.yaml (every selected effect, and per joint the vector of the generated
+`<robot>_friction`) and the per-joint simulator terms of the URDF and MJCF exports; a payload is
+added to the last link, other effects stay in the YAML."""
 
 from __future__ import annotations
 
@@ -22,9 +15,8 @@ FRICTION_FIELDS = FRICTION_NAMES  # the emitted <robot>_friction's vector, per j
 
 
 def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
-    """f for <robot>_friction, FRICTION_FIELDS per joint (each effect's friction_terms): the laws
-    as fitted, each term's velocity scales included (Stribeck's and direction's signs are smoothed
-    with sign_velocity, as in the diagnosis's columns: Context.sign)."""
+    """f for <robot>_friction, FRICTION_FIELDS per joint: the laws as fitted, their velocity scales
+    included (the Stribeck and direction signs smoothed with sign_velocity, as in the columns)."""
     f = np.zeros((diagnosis.joints, len(FRICTION_FIELDS)))
     for name in ("vc", "es", "ed"):
         f[:, FRICTION_FIELDS.index(name)] = sign_velocity
@@ -35,8 +27,7 @@ def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
 
 
 def joint_dynamics(diagnosis) -> list[dict]:
-    """Per joint {"damping", "friction", "armature"} for the URDF and MJCF exports (each
-    effect's simulator attribute)."""
+    """Per joint {"damping", "friction", "armature"} for the exports (each effect's `simulator`)."""
     out = [{} for _ in range(diagnosis.joints)]
     for e in diagnosis.selected:
         simulator = effect_class(e.effect).simulator
@@ -47,8 +38,7 @@ def joint_dynamics(diagnosis) -> list[dict]:
 
 
 def with_payload(diagnosis, p: np.ndarray) -> np.ndarray:
-    """Link parameters with what selected effects add to the last link (a payload whose values
-    are all determined); otherwise p unchanged."""
+    """Link parameters with what selected effects add to the last link (a determined payload)."""
     s = None
     for e in diagnosis.selected:
         added = effect_class(e.effect).last_link(e.values, e.variant)

@@ -1,27 +1,14 @@
 """The excitation design: a Fourier series at rest at its ends, scaled into the limits, with the
 condition number of the identification matrix minimised over its coefficients.
 
-Parametrisation (validation.excitation.FourierTrajectory, joint j, harmonics l = 1..L):
-    qd_j(t) = sum_l a_jl cos(w l t) + b_jl sin(w l t),   q_j = q0_j + integral
-At rest at t = 0 (hence at every multiple of the period): qd_j(0) = sum_l a_jl = 0 and
-qdd_j(0) = w sum_l l b_jl = 0; a_j1 and b_j1 are solved from these, the other 2 (L - 1)
-coefficients of each joint and its centre q0_j are free.
-
-Limits by construction, not by penalty: for any coefficients, each joint's motion about q0_j is
-scaled by the largest factor that keeps position, velocity and acceleration within `margin`
-of their limits (the peaks taken on a grid of 200 points per period of the highest harmonic,
-then checked again on the written samples), and the whole motion shrinks further if the flange
-would leave the optional workspace box. The optimiser therefore sees only feasible trajectories;
-motion at the limits is what excites best, so the scaling is where the optimum lies anyway.
-
-Criterion: log cond(A), A = [Y(q, qd, qdd), per joint Coulomb, viscous, offset and (where the
-rigid body does not carry it) rotor-inertia columns] on `points` samples of one period: the
-columns of the terms (terms/) that `dyngen identify` fits by default, as they are (Swevers 1997,
-Gaz 2019; the condition with unit-norm columns is reported too), with a fixed Coulomb scale
-(terms.friction.EXCITATION_SCALE) where identify searches one per joint, unfiltered and unlagged. Minimised by
-L-BFGS-B (finite differences) from the best of `candidates` random starts; all draws come from
-`seed`, so the design is deterministic.
-"""
+Joint j's qd_j(t) = sum_l a_jl cos(w l t) + b_jl sin(w l t) (validation.excitation.FourierTrajectory);
+at rest at t = 0, sum_l a_jl = 0 and sum_l l b_jl = 0 fix a_j1 and b_j1. Limits by construction:
+each joint's motion about its centre is scaled by the largest factor that keeps position, velocity
+and acceleration within `margin` of their limits (peaks on GRID_PER_HARMONIC points per period of
+the highest harmonic), and shrunk further to keep the flange in the workspace box. Criterion:
+log cond(A), A the rigid body's regressor and the per-joint columns `dyngen identify` fits by
+default (terms.joint_columns, Coulomb at EXCITATION_SCALE), on `points` samples of a period;
+L-BFGS-B from the best of `candidates` random starts, every draw from `seed`. docs/measured-data.md."""
 
 from __future__ import annotations
 
@@ -44,8 +31,7 @@ GRID_PER_HARMONIC = 200  # samples per period of the highest harmonic for the pe
 
 @dataclass
 class Settings:
-    """The excitation step's options: those declared with option(...) are `dyngen excite` flags
-    (dyngen.options), the rest the method's own settings."""
+    """The excitation step's options: those declared with option(...) are `dyngen excite` flags."""
 
     seed: int = option(1, "seed of every random draw", bounds=(0, 2**31 - 1))
     period: float = option(10.0, "period [s] (base frequency 1 / period)", metavar="S", bounds=(0.1, 3600))
@@ -130,11 +116,7 @@ class _Shape:
                         m * lim.velocity / np.maximum(np.abs(qd).max(axis=0), tiny),
                         m * lim.acceleration / np.maximum(np.abs(qdd).max(axis=0), tiny)], axis=0)
         scale = np.where(np.isfinite(scale), scale, 0.0)
-        a, b = a * scale[:, None], b * scale[:, None]
-        # offset such that q(0) = q0: the series' value at 0 is -sum b / (w l)
-        w = 2 * np.pi * self.base_hz * np.arange(1, self.L + 1)
-        offset = q0 + (b / w).sum(axis=1)
-        traj = FourierTrajectory(self.base_hz, offset, a, b)
+        traj = _from(self.base_hz, q0, a * scale[:, None], b * scale[:, None])
         if self.flange is not None and self.settings.workspace is not None:
             traj = self._into_box(traj, q0)
         return traj
@@ -158,10 +140,14 @@ class _Shape:
         return _shrunk(traj, q0, lo)
 
 
+def _from(base_hz, q0, a, b) -> FourierTrajectory:
+    """The series with q(0) = q0 (its value at 0 without an offset is -sum b / (w l))."""
+    w = 2 * np.pi * base_hz * np.arange(1, a.shape[1] + 1)
+    return FourierTrajectory(base_hz, q0 + (b / w).sum(axis=1), a, b)
+
+
 def _shrunk(traj, q0, factor) -> FourierTrajectory:
-    w = 2 * np.pi * traj.base_hz * np.arange(1, traj.a.shape[1] + 1)
-    a, b = traj.a * factor, traj.b * factor
-    return FourierTrajectory(traj.base_hz, q0 + (b / w).sum(axis=1), a, b)
+    return _from(traj.base_hz, q0, traj.a * factor, traj.b * factor)
 
 
 def _inside(points, box) -> np.ndarray:
@@ -169,14 +155,13 @@ def _inside(points, box) -> np.ndarray:
 
 
 def flange_of(robot):
-    """q (T, N) -> flange position (T, 3) in the base frame: the last link frame's origin (the
-    joint model's forward kinematics)."""
+    """q (T, N) -> flange position (T, 3) in the base frame (the last link frame's origin)."""
     return lambda q: forward_kinematics(robot.joint_models, q)[-1].origin
 
 
 def identification_matrix(model, q, qd, qdd, coulomb_velocity=EXCITATION_SCALE, armature=None) -> np.ndarray:
-    """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major:
-    identify's default columns (terms.joint_columns), each on its own joint's rows."""
+    """[Y | per joint: tanh(qd_j / v), qd_j, 1, qdd_j (where armature[j])], rows sample-major: identify's
+    default columns, each on its own joint's rows."""
     T, n = q.shape
     Y = RigidBody.regressor(model, q, qd, qdd).reshape(T * n, -1)
     cols = []
@@ -202,8 +187,7 @@ def _conditions(A) -> tuple[float, float]:
 
 
 def optimise(robot, model, settings: Settings | None = None) -> Design:
-    """The optimised excitation for `robot` (its YAML limits; the flange within
-    settings.workspace if given) with the compiled `model`."""
+    """The optimised excitation for `robot` (its limits; the flange within settings.workspace if given)."""
     settings = settings or Settings()
     if settings.harmonics < 2:
         raise InputError("--harmonics", "", f"{settings.harmonics}: at least 2 (one is used to start at rest)")
@@ -252,8 +236,7 @@ def random_design(robot, settings: Settings, seed: int) -> FourierTrajectory:
 
 
 def check_limits(robot, t, q, qd, qdd, workspace=None, tolerance: float = 1e-9) -> list[str]:
-    """Every violated limit on the given samples, the flange's workspace box included (empty:
-    all respected)."""
+    """Every violated limit on the samples, the flange's workspace box included (empty: all respected)."""
     lim = limits_of(robot)
     problems = []
     for name, bad in (("lower", q < lim.lower - tolerance), ("upper", q > lim.upper + tolerance),

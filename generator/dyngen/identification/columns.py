@@ -1,21 +1,8 @@
-"""The identification's columns beside the rigid body's base regressor, per recording.
-
-Per joint j (its rows only), each a term of terms/ (TERM_OF):
-  coulomb      tanh(qd_j(t - lag_j) / vs_j)   Coulomb friction, smoothed, following the velocity
-               with a lag; a switching signal, so it is passed through the recording's own
-               low-pass, like the torque it explains (a filtered friction step is compared with
-               a filtered step, not a sharp one; as the diagnosis does, diagnosis/moments.py)
-  viscous      qd_j
-  offset       1
-  armature     qdd_j (rotor inertia, where the rigid body does not carry it already)
-  ripple_cos   cos q_j   }  a first harmonic of position (cables, gear ripple):
-  ripple_sin   sin q_j   }  the optional group "ripple"
-and for the arm, the optional group "tilt": ("tilt", 0) and ("tilt", 1), the torques of a
-gravity component across it (terms/tilt.py: the diagnosis's tilt), in every joint's rows.
-The smooth columns are functions of the filtered motion, filtered already.
-
-A label is (kind, j): j the joint (0-based), or for the tilt the direction (0, 1: u1, u2).
-"""
+"""The identification's columns beside the rigid body's base regressor. A label is (kind, j): per
+joint j, in its rows only, coulomb tanh(qd_j(t - lag_j) / vs_j) (switching: through the
+recording's filter, like the torque), viscous qd_j, offset 1, armature qdd_j, and the optional
+group "ripple" cos q_j, sin q_j; for the arm the optional group "tilt", j its direction u1, u2
+(terms/tilt.py), in every joint's rows. Each kind is a term of terms/ (TERM_OF)."""
 
 from __future__ import annotations
 
@@ -59,9 +46,8 @@ def lagged(t, x, lag: float) -> np.ndarray:
 
 
 def switching_filter(signals):
-    """The filter the recording's torques went through, for columns that switch with the sign of
-    the velocity: the recording's own low-pass, redesigned for this sampling rate where the
-    samples were decimated after filtering (the diagnosis's pieces); identity without one."""
+    """The filter the recording's torques went through, for columns that switch with the velocity's
+    sign (redesigned for the rate where samples were decimated after filtering); identity without."""
     lowpass = getattr(signals, "lowpass", None)
     cutoff = getattr(signals, "cutoff", None)
     if lowpass is None or cutoff is None or len(signals.t) < 16:
@@ -85,8 +71,7 @@ def coulomb_matrix(signals, smoothing, lags) -> np.ndarray:
 
 
 def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
-    """(T,): the column of (kind, j) in joint j's rows (coulomb: from coulomb_matrix, filtered
-    and lagged; the others as terms.joint_columns has them)."""
+    """(T,): the column of (kind, j) in joint j's rows (coulomb from coulomb_matrix)."""
     if kind == "coulomb":
         return coulomb[:, j]
     return joint_columns.column(kind, signals.q[:, j], signals.qd[:, j], signals.qdd[:, j])
@@ -94,8 +79,8 @@ def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
 
 @dataclass
 class Piece:
-    """A block of one recording as the fit sees it (blocks.py): its data samples, the regressor
-    evaluated once, and which part (fold) each sample belongs to."""
+    """A block of one recording as the fit sees it (blocks.py): its data samples, the regressor once,
+    and the part (fold) of each sample."""
 
     signals: object  # the block's samples: t, q, qd, qdd, tau
     keep: slice  # the data samples among them

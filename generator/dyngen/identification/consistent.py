@@ -1,35 +1,16 @@
 """Physically consistent identification with friction: the extraction's convex problem with the
-data's cost.
+data's cost,
 
     min_{s, f}  || Y pi(s) + F f - tau ||_W^2  +  lambda || pi(s) - pi(prior) ||_D^2
-    s.t.  every link consistent (pseudo-inertia positive definite less the extraction's margin),
-          the YAML's bounds and total mass, per joint: Fc >= 0, Fv >= 0, Ia >= 0
+    s.t.  every link consistent, the YAML's bounds and total mass, per joint Fc, Fv, Ia >= 0,
 
-pi(s) are the full base coefficients (linear in the standard parameters s); W scales the rows of
-joint j by 1 / sigma_j (its noise estimate); F holds the columns of columns.py: per joint Coulomb
-friction (smoothing and lag chosen per joint on the fit data, filtered like the torque), viscous
-friction, an offset and rotor inertia (where the rigid body does not already carry it: joint 1's
-is part of link 1's inertia), and the optional groups, kept only where held-out data ask for them
-(held_out.py): a position ripple per joint, a tilted base (a rotation, terms/tilt.py).
-
-The order of work, every step on the fit recordings only (test data are never seen here):
-  1. the regressor and every column, once (columns.py), and the normal equations per contiguous
-     part and joint (normal.py): every later fit, score and statistic comes from them;
-  2. the Coulomb smoothing and lag per joint (the unconstrained fit's residual per joint);
-  3. the noise per joint sigma_j (the unconstrained fit's residual), the weights; columns the data
-     cannot tell from the rest are left out and named;
-  4. lambda on held-out data (held_out.py: cross-validation over contiguous parts, or the
-     `select` recordings), with every optional group in;
-  5. each optional group kept or left out at that lambda, on the same held-out data;
-  6. the consistent fit on all fit data (solver.py: the extraction's driver, one solver); a tilt
-     is refitted as a rotation, and refused beyond tilt.MAX_TILT_DEG;
-  7. standard deviations, condition numbers and unexcited columns of the same columns'
-     unconstrained weighted fit (statistics.py: a sandwich estimate that holds for correlated
-     residuals).
-
-Public entry point: identify_consistent(robot, model, folder, signals, options, select=None) -> Consistent
-(its options: identify_options.py ConsistentOptions; the result and its YAML: consistent_output.py).
-"""
+W weighting joint j's rows by 1 / sigma_j, F the columns of columns.py. The order of work, on the
+fit recordings only: 1. the columns and the normal equations per part and joint, once (normal.py);
+2. the Coulomb smoothing and lag per joint; 3. the noise per joint, the weights, and the columns
+the data cannot separate left out; 4. lambda on held-out data (held_out.py); 5. each optional
+group kept or left out there; 6. the consistent fit on all fit data (solver.py), a tilt refitted
+as a rotation; 7. the statistics of the same columns (statistics.py). docs/measured-data.md,
+"Excitation and physically consistent identification"."""
 
 from __future__ import annotations
 
@@ -58,11 +39,9 @@ from .statistics import estimate
 
 
 def _coulomb_search(normal, trials, fit, grid, tolerance: float):
-    """Per joint, the value of grid whose trial (normal with every Coulomb column at that value:
-    Swaps) leaves joint j the least unconstrained residual on the fit parts; a value must beat
-    the one before by `tolerance` (relative). Joint j's normal equations with its choice are
-    those of the trial of that value (a joint's Coulomb column meets its own rows only).
-    Returns (choice per joint, normal with it)."""
+    """Per joint, the grid value whose trial (normal with every Coulomb column at it) leaves joint j the
+    least unconstrained residual on the fit parts, each beating the one before by `tolerance`
+    (relative). Returns (choice per joint, normal with it)."""
     n = normal.n[fit].sum(axis=0)
     best, choice, which = np.full(normal.dof, np.inf), np.full(normal.dof, grid[0], dtype=float), np.zeros(normal.dof, int)
     for i, (value, trial) in enumerate(zip(grid, trials)):
@@ -79,9 +58,8 @@ def _at(dof, smoothing, lags):
 
 
 def _coulomb(blocks, normal, fit, options, dof, swaps=None):
-    """(smoothing, lags, normal): chosen per joint on the fit data unless given (swaps: the
-    smoothing grid's trials, summed in the normal equations' pass); the blocks' settings follow
-    the choice."""
+    """(smoothing, lags, normal) chosen per joint on the fit data unless given (swaps: the smoothing
+    grid's trials, summed in the normal equations' pass); the blocks follow the choice."""
     smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
     ks = [k for k, (kind, _) in enumerate(normal.labels) if kind == "coulomb"]
@@ -109,10 +87,9 @@ def _labels(kinds, armature_ok, dof, with_tilt: bool) -> list:
 
 
 def _unexcited(normal, fit, weights, r) -> set:
-    """Labels (indices) the weighted fit cannot tell from the rest: while the columns (unit norm)
-    have a direction weaker than least_squares.WEAK, the label that carries most of the weakest
-    one is left out (a ripple cos q_j, sin q_j shaped like joint j's gravity; coefficients the
-    data do not excite are left to the prior and consistency instead)."""
+    """Labels (indices) the weighted fit cannot tell from the rest: while the unit-norm columns have a
+    direction weaker than WEAK, the label carrying most of it goes (coefficients the data do not
+    excite are left to the prior and consistency)."""
     G, _ = normal.total(fit, weights)
     norms = np.sqrt(np.maximum(np.diag(G), 0.0))
     out = {k - r for k in range(r, G.shape[0]) if norms[k] == 0}
@@ -131,11 +108,9 @@ def _unexcited(normal, fit, weights, r) -> set:
 
 def identify_consistent(robot, model, folder, signals_list, options: ConsistentOptions | None = None,
                         select=None) -> Consistent:
-    """robot: description (bounds, total mass, nominal, velocity limits, gravity); model:
-    runtime.load of its generated folder `folder` (which holds <robot>_extract.cpp); signals_list:
-    conditioned recordings with torques to fit, or blocks.Source (a file read in blocks); select:
-    the same, to make the held-out choices on (default: cross-validation over contiguous parts of
-    the fit recordings)."""
+    """robot: its description; model: runtime.load of its generated folder `folder` (with
+    <robot>_extract.cpp); signals_list: conditioned recordings with torques, or blocks.Source;
+    select: the same to make the held-out choices on (default: cross-validation over the fit's parts)."""
     options = options or ConsistentOptions()
     if options.friction_bound not in BOUNDS:
         raise ValueError(f"friction_bound {options.friction_bound!r}: expected one of {', '.join(BOUNDS)}")
@@ -237,9 +212,8 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
 
 
 def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam, workers):
-    """Step 5: each optional group (the tilt; the ripple and friction falling with speed, per
-    joint) kept where it gains on the held-out data by more than a standard error; returns
-    (active labels, joints whose friction may fall with speed, decisions)."""
+    """Step 5: each optional group (tilt; per joint ripple and friction falling with speed) kept where it
+    gains on held-out data by more than a standard error: (active labels, cone joints, decisions)."""
     labels = normal.labels
     decisions, out, out_cone = [], set(active), set(cone)
     for group in ("tilt", "ripple", "falling"):
@@ -265,12 +239,10 @@ def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam,
 
 
 def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior, g_vec, notes, dropped):
-    """Step 6: the consistent fit on all fit data; a tilt refitted as a rotation (the shortening
-    along gravity at the estimate), refused (and the fit redone without it) beyond
-    tilt.MAX_TILT_DEG. The tilt's torques are those of the prior's links: a horizontal gravity
-    meets combinations of first moments that gravity along its axis never shows (link 1's of the
-    LWR), which the data cannot give; the identified links' values there are the prior's, or
-    whatever consistency left (with them the tilt found in MuJoCo data fell from 2 to 0.8 deg)."""
+    """Step 6: the consistent fit on all fit data; a tilt refitted as a rotation and refused beyond
+    tilt.MAX_TILT_DEG. The tilt's torques are the prior's links' (a horizontal gravity meets first
+    moments the data's gravity never shows: with the identified ones the tilt in MuJoCo data fell from
+    2 to 0.8 deg)."""
     labels, r = normal.labels, normal.r
 
     def fit_with(act):

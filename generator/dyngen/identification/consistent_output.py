@@ -1,8 +1,6 @@
-"""What `dyngen identify` writes for the consistent identification: a YAML with the link
-parameters (the `parameters.nominal` / extraction `links:` format, so `dyngen diagnose --params`
-and the exporters read it), the friction per joint, and the `identified:` block of the base
-coefficients (each with the unconstrained fit's standard deviation); a Markdown table; the
-summary lines printed."""
+"""What `dyngen identify` writes for the consistent identification: the YAML (`links:` as
+`diagnose --params` and the exporters read them, friction per joint, the `identified:` block),
+a Markdown table, and the summary lines printed."""
 
 from __future__ import annotations
 
@@ -46,8 +44,7 @@ class Consistent:
     simple: dict | None = None
 
     def joint_dynamics(self) -> list:
-        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (MuJoCo's
-        damping must be >= 0: a negative Fv is left out there, and said so by the caller)."""
+        """Per joint {"damping", "friction", "armature"} for the URDF/MJCF writers (a negative Fv left out)."""
         f = self.friction
         return [{"damping": max(_nz(f["viscous"][j]), 0.0), "friction": _nz(f["coulomb"][j]),
                  "armature": _nz(f["armature"][j])} for j in range(len(self.sigma))]
@@ -58,8 +55,7 @@ class Consistent:
         return tilt.angle_deg(tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
 
     def predict(self, model, signals) -> np.ndarray:
-        """Torques (T, N) of this model (rigid body + friction + offset + rotor inertia + optional
-        groups) on signals (Coulomb through the recording's filter, as in the fit)."""
+        """Torques (T, N) of this model on signals (Coulomb through the recording's filter, as in the fit)."""
         f = {k: np.nan_to_num(v) for k, v in self.friction.items()}
         out = model.batch("regressor", signals.q, signals.qd, signals.qdd) @ self.pi
         if np.any(f["coulomb"]):

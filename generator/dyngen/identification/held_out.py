@@ -1,24 +1,9 @@
-"""Choices made on held-out data, never on test data: the prior's weight lambda, and which
-optional column groups (a tilted base, a position ripple per joint) the model keeps.
-
-Held out: the `select` recordings when given (one split: fit on every fit recording, score on
-them), otherwise contiguous parts of the fit recordings, each held out once (cross-validation).
-A score is the mean square of the held-out residual, weighted like the fit (1 / sigma_j^2), and
-per joint unweighted. Every fit is the consistent one (solver.py): the model chosen is the model
-reported.
-
-lambda: the grid is walked upwards; the chosen value is the largest whose mean score is within
-one standard error of the best (the one-standard-error rule: a held-out part of the same
-recording flatters the fit, so the least regularised model that "wins" there generalises worse
-to other motions), or the best ("min"). The walk stops once a value scores worse than the best
-plus that standard error (held-out scores rise steadily past their minimum).
-
-Groups, at the chosen lambda: the model without the group is scored on the same folds, and the
-group stays only where it gains by more than one standard error of the paired differences
-(again the simpler model unless the data clearly ask for more): the tilt on the weighted score
-of every joint, the ripple of joint j and friction falling with speed on joint j (a viscous
-value below zero, solver.py) on joint j's own score.
-"""
+"""Choices made on held-out data, never on test data: the prior's weight lambda and which optional
+column groups stay. Held out: the `select` recordings, or each contiguous part of the fit
+recordings once; a score is the held-out mean square weighted like the fit (and per joint), every
+fit the consistent one. lambda: the largest within one standard error of the best (the walk up
+the grid stops once past it); a group stays where it gains by more than one standard error of the
+paired differences (docs/measured-data.md)."""
 
 from __future__ import annotations
 
@@ -50,8 +35,8 @@ class Scores:
 
 
 def scores(solver, normal, folds: Folds, labels_idx, lam: float, free=None, workers: int = 1, cone=()) -> Scores:
-    """Each fold's consistent fit (coefficients and the labels labels_idx; cone: the joints whose
-    friction may fall with speed) at lam, scored on its held-out parts."""
+    """Each fold's consistent fit of the coefficients and labels_idx at lam (cone: joints whose friction
+    may fall with speed), scored on its held-out parts."""
     r = normal.r
     keep = np.r_[np.arange(r), r + np.asarray(labels_idx, dtype=int)]
     labels = [normal.labels[k] for k in labels_idx]
@@ -100,8 +85,7 @@ def _se(x: np.ndarray) -> float:
 
 
 def gains(with_group: Scores, without: Scores, joint: int | None = None) -> tuple[float, float, float]:
-    """(mean gain, its standard error, the mean score without the group) over the folds: the
-    weighted score, or joint's."""
+    """(mean gain, its standard error, the mean score without the group) over the folds (joint's score)."""
     if joint is None:
         a, b = without.weighted, with_group.weighted
     else:
@@ -114,7 +98,6 @@ SMALLEST_GAIN = 1e-3  # relative to the score without the group: below it, two f
 
 
 def keeps(gain: tuple[float, float, float], folds: Folds) -> bool:
-    """The group stays when it gains by more than one standard error (with one split: at all),
-    and by more than SMALLEST_GAIN of the score."""
+    """The group stays when it gains by more than one standard error (one split: at all) and SMALLEST_GAIN."""
     mean, se, reference = gain
     return mean > (se if len(folds.splits) > 1 else 0.0) and mean > SMALLEST_GAIN * reference

@@ -1,14 +1,7 @@
-"""Ordinary least squares with what a user needs to trust it: the regressor's condition
-number, a standard deviation per coefficient, and the coefficients the data do not excite.
-
-    std_k = sqrt(sigma^2 [(A^T A)^-1]_kk),  sigma^2 = |b - A x|^2 / (rows - columns)
-
-(the textbook formula, which assumes uncorrelated residuals; filtered signals are correlated
-in time, so these deviations are lower bounds). A coefficient is *not excited* when the
-directions of A that carry it are weak: after scaling every column to unit norm, it loads by
-more than half on right singular vectors whose singular value is below `weak` times the
-largest. Such coefficients are solved in the minimum-norm sense and flagged.
-"""
+"""Ordinary least squares with its condition number, a textbook standard deviation per coefficient
+(std_k = sqrt(sigma^2 [(A^T A)^-1]_kk): a lower bound for correlated residuals), and the
+coefficients not excited (loading over half on directions below `weak` of the largest singular
+value, columns at unit norm), solved in the minimum-norm sense and flagged."""
 
 from __future__ import annotations
 
@@ -36,9 +29,8 @@ class Estimate:
 
 
 def fit_factor(R: np.ndarray, rows: int, names: list[str], weak: float = WEAK) -> Estimate:
-    """The fit of `rows` rows whose [A | b] has the triangular factor R (R^T R = [A b]^T [A b]):
-    the singular values and right singular vectors of A are those of R's first c columns, U^T b
-    comes through its last column, the residual |b - A x| is |R (x, -1)|."""
+    """The fit of `rows` rows whose [A | b] has the triangular factor R: A's singular values and vectors
+    are those of R's first c columns, U^T b comes through its last, |b - A x| = |R (x, -1)|."""
     c = R.shape[1] - 1
     A, b = R[:, :c], R[:, c]
     norms = np.linalg.norm(A, axis=0)

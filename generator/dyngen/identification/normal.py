@@ -1,18 +1,9 @@
-"""Normal equations per part (fold) and joint: everything the identification needs from ~10^5
-rows, in matrices of ~10^2 x 10^2, formed once.
-
-For part p and joint j (the rows of joint j at the samples of part p), with A the columns there
-(the base regressor's row of joint j, then every label's column, global order: coefficients,
-then labels) and b the measured torques:
+"""Normal equations per part (fold) and joint, formed once: for part p and joint j, with A the
+columns in joint j's rows there (coefficients, then labels) and b the torques,
 
     G[p, j] = A^T A,   g[p, j] = A^T b,   bb[p, j] = b^T b,   n[p, j] = rows
 
-A joint's friction column meets only that joint's rows, so A has the coefficients, the joint's
-own labels and the arm's (tilt) labels. Any fit on any union of parts with per-joint weights is
-then a sum of these blocks, and its residual on any part is bb - 2 x^T g + x^T G x: the
-cross-validation's folds, the noise estimate and every candidate model come from them without
-touching the rows again.
-"""
+Any weighted fit on any union of parts is a sum of these, its residual bb - 2 x^T g + x^T G x."""
 
 from __future__ import annotations
 
@@ -31,8 +22,7 @@ def segments(part: np.ndarray) -> list:
 
 
 def local_columns(labels, r: int, j: int, hidden: int) -> tuple[list[int], np.ndarray]:
-    """(the labels whose column is non-zero in joint j's rows, joint j's columns of the normal
-    equations: the coefficients, those labels and the hidden ones)."""
+    """(labels non-zero in joint j's rows, joint j's columns: the coefficients, those labels, the hidden)."""
     ks = [k for k, (kind, jj) in enumerate(labels) if kind == "tilt" or jj == j]
     return ks, np.r_[np.arange(r), r + np.asarray(ks, dtype=int), r + len(labels) + np.arange(hidden)]
 
@@ -43,15 +33,13 @@ def _in_rows(v: np.ndarray, j: int) -> np.ndarray:
 
 
 def label_design(piece, labels, j: int, ks, hidden: int) -> np.ndarray:
-    """(T, len(ks) + hidden): joint j's rows of the labels ks (then the hidden column), the
-    design's columns after the coefficients' piece.Yj[j]."""
+    """(T, len(ks) + hidden): joint j's rows of the labels ks, then the hidden column."""
     return np.column_stack([_in_rows(piece.columns[labels[k]], j) for k in ks]
                            + ([piece.along[:, j]] if hidden else []) + [np.zeros((piece.tau.shape[0], 0))])
 
 
 def gram(Y: np.ndarray, L: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(A^T A, A^T b) of A = [Y L] without forming A: Y (T, r) is a strided view of the block's
-    regressor, which a copy into A would cost as much as the products (Y^T Y: one BLAS syrk)."""
+    """(A^T A, A^T b) of A = [Y L] without forming A (Y a strided view of the block's regressor)."""
     r, c = Y.shape[1], Y.shape[1] + L.shape[1]
     G = np.empty((c, c))
     G[:r, :r] = Y.T @ Y
@@ -63,8 +51,7 @@ def gram(Y: np.ndarray, L: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.nd
 
 class Normal:
     def __init__(self, r: int, labels: list, parts: int, dof: int, hidden: int = 0):
-        """hidden: the trailing columns that are no label (the tilt's gravity along its axis,
-        piece.along: the tilt's rotation is then algebra on them, rotated())."""
+        """hidden: trailing columns that are no label (the tilt's gravity along its axis, for rotated())."""
         self.r, self.labels, self.dof, self.hidden = r, list(labels), dof, hidden
         c = r + len(labels) + hidden
         self.G = np.zeros((parts, dof, c, c))
@@ -74,9 +61,8 @@ class Normal:
 
     @classmethod
     def build(cls, pieces, labels, r: int, parts: int, dof: int, swaps=None, hidden: int = 0) -> "Normal":
-        """swaps (Swaps): also summed in the same pass. Each block's sums are made on their own
-        (Blocks.each: in worker processes) and added here in block order: every entry gets the
-        same additions in the same order as in one process."""
+        """swaps: also summed in the same pass. Blocks are summed on their own (Blocks.each) and added in
+        block order: the same additions in the same order as in one process."""
         out = cls(r, labels, parts, dof, hidden)
 
         def of_block(piece):
@@ -130,9 +116,8 @@ class Normal:
                                 np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1))
 
     def rotated(self, ks, betas) -> "Normal":
-        """A copy in which label ks[d]'s column c_d is c_d - betas[d] * w, w the first hidden
-        column: the normal equations of A M (M the identity but M[w, c_d] = -betas[d]), so
-        M^T G M and M^T g, without reading the rows again."""
+        """A copy in which label ks[d]'s column is c_d - betas[d] * w (w the first hidden column): M^T G M
+        and M^T g without reading the rows again."""
         M = np.eye(self.G.shape[-1])
         for k, beta in zip(ks, betas):
             M[self.r + len(self.labels), self.r + k] = -beta
@@ -140,8 +125,7 @@ class Normal:
         return self._with(M.T @ self.G @ M, self.g @ M)
 
     def total(self, parts, weights=None, keep=None) -> tuple[np.ndarray, np.ndarray]:
-        """(A^T W A, A^T W b) over the given parts, joint j's rows weighted by weights[j]^2,
-        restricted to the columns `keep` (indices, default all)."""
+        """(A^T W A, A^T W b) over the parts, joint j weighted by weights[j]^2, on the columns `keep`."""
         w2 = np.ones(self.dof) if weights is None else np.asarray(weights, dtype=float) ** 2
         c = self.r + len(self.labels)  # the hidden columns are no unknowns
         G = np.einsum("pjab,j->ab", self.G[parts][:, :, :c, :c], w2)
@@ -162,10 +146,8 @@ class Normal:
 
 
 class Swaps:
-    """The Coulomb searches' variants: one label per joint (ks, each its joint's own), variant
-    v's columns those of makes[v](piece) (T, N), summed piece by piece (each joint's variants in
-    one matrix product per block, the other columns as they are); normals(base): per variant,
-    base with those labels' rows and columns replaced."""
+    """The Coulomb searches' variants: per joint one label (ks), variant v's columns makes[v](piece),
+    summed piece by piece; normals(base): per variant, base with those rows and columns replaced."""
 
     def __init__(self, labels, r: int, parts: int, dof: int, ks, makes, hidden: int = 0):
         self.labels, self.r, self.ks, self.makes, self.hidden = labels, r, ks, makes, hidden
@@ -204,8 +186,8 @@ class Swaps:
 
 
 def solve_unconstrained(G, g, weak: float = WEAK) -> np.ndarray:
-    """Least squares through the normal equations of unit-norm columns, the pseudo-inverse cut at
-    weak^2 of the largest eigenvalue (directions the data do not excite get no value)."""
+    """Least squares through the normal equations of unit-norm columns, cut at weak^2 of the largest
+    eigenvalue (directions the data do not excite get no value)."""
     scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
     ev, V = np.linalg.eigh(G / np.outer(scale, scale))
     keep = ev > weak ** 2 * ev[-1]

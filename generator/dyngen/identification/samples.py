@@ -25,8 +25,7 @@ def stacked_inertia_columns(manifest) -> list[str]:
 
 
 def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray, np.ndarray]:
-    """(Y (T, m, c), b (T, m)): the regressor rows and measurements of T samples, m rows each,
-    as identification.samples.stacked orders them."""
+    """(Y (T, m, c), b (T, m)): the regressor rows and measurements of T samples, m rows each."""
     if kind == "gravity":
         return model.batch(REGRESSOR[kind], q), tau
     if kind == "inertia":

@@ -1,27 +1,14 @@
-"""The consistent fit of given normal equations, by the extraction's own solver.
+"""The consistent fit of given normal equations, by the extraction's own solver:
 
     min_{s, f}  x^T G x - 2 x^T g  +  lambda || pi(s) - pi(prior) ||^2_D,   x = (pi(s), f)
     s.t.  every link consistent, the YAML's bounds and total mass; signs of the friction values
 
-G, g: the weighted normal equations of the coefficients and the chosen labels (normal.py).
-For the friction values that are free (not held at their bound 0) the cost is minimised in
-closed form, which leaves a quadratic in pi alone, || R pi - v ||^2 + const, R the Cholesky
-factor of the Gram matrix's Schur complement: exactly the extraction's cost || W pi(p) - v ||^2,
-so the extraction's driver (its barrier Newton method in the standard parameters) solves it
-unchanged; among equally good parameter sets it returns the one closest to the prior. The signs
-are an active set around it (Lawson-Hanson): a value that comes out negative is held at 0, one
-held at 0 whose gradient asks to grow is freed again. The set found by the same fit without the
-consistency constraints (a few microseconds), or by the previous fit of a cross-validation, is
-where it starts: one driver run in practice.
-
-Signs, per joint:
-  Fc >= 0, Fv >= 0, Ia >= 0     (by default: what MuJoCo's frictionloss, damping and armature hold)
-  Fc >= 0, Fc + Fv V >= 0, Ia >= 0   (the joints in `cone`) V the joint's velocity limit:
-                friction that falls with speed but opposes motion at every speed the joint
-                can reach. The cone is spanned by (0, 1) and (V, -1) with non-negative weights,
-                so every constraint is again a sign.
-lambda is relative to unit-norm columns (lambda = 1 weighs like one well-excited column).
-"""
+The free friction values minimised in closed form leave || R pi - v ||^2 (R the Cholesky factor
+of the Schur complement): the extraction's cost, solved by its driver unchanged. The signs are
+an active set around it (Lawson-Hanson), started from the unconstrained fit's. Per joint
+Fc, Fv, Ia >= 0, or for the joints in `cone` Fc >= 0, Fc + Fv V >= 0 (V the velocity limit:
+friction falling with speed that still opposes motion), again signs in the cone's generators.
+lambda is relative to unit-norm columns."""
 
 from __future__ import annotations
 
@@ -51,8 +38,7 @@ def generators(labels, r: int, V, cone) -> np.ndarray:
 
 
 def signs(G, g, r: int, bounded: np.ndarray, free: np.ndarray | None = None, rounds: int = 20) -> np.ndarray:
-    """The free set of the friction weights at the minimum of x^T G x - 2 g^T x with only their
-    signs imposed (no consistency): the driver's starting guess."""
+    """The free set of the friction weights with only their signs imposed: the driver's starting guess."""
     nf = G.shape[0] - r
     free = np.ones(nf, dtype=bool) if free is None else free.copy()
     ridge = 1e-12 * np.eye(G.shape[0])
@@ -87,9 +73,8 @@ class Solver:
         self.pi_prior = model("pi_full", prior) if prior is not None else None
 
     def solve(self, gram, rhs, labels, lam: float, restarts=None, free=None, cone=()):
-        """(x = (pi, natural friction values), free set, rounds, extraction result) for the normal
-        equations of the coefficients and `labels` (natural columns); cone: the joints whose
-        friction is held dissipative rather than Fv >= 0."""
+        """(x = (pi, natural friction values), free set, rounds, extraction result) for the normal equations
+        of the coefficients and `labels`; cone: joints held dissipative rather than Fv >= 0."""
         r = self.r
         M = generators(labels, r, self.V, cone)
         gram, rhs = M.T @ gram @ M, M.T @ rhs
@@ -138,8 +123,7 @@ class Solver:
 
 
 def robot_with_default_bounds(robot):
-    """The YAML's bounds, or (none given) wide ones: a link 1 g to 1000 kg, its centre of mass
-    within 2 m of its frame, inertias within 100 kg m^2 (consistency does the real work)."""
+    """The YAML's bounds, or wide ones (consistency does the real work)."""
     if robot.lower is not None:
         return robot
     lo = LinkValues(1e-3, (-2.0, -2.0, -2.0), (0.0, -100.0, -100.0, 0.0, -100.0, 0.0))

@@ -1,27 +1,11 @@
-"""What a user needs to trust the identified values: a standard deviation per column that holds
-for real data, the condition numbers, and the columns the data do not excite.
+"""What a user needs to trust the identified values: a standard deviation per column that holds for
+real data, the condition numbers, and the columns not excited (least_squares.py), of the
+unconstrained weighted fit of the same columns.
 
-The values are those of the unconstrained weighted least squares of the same columns (rows of
-joint j weighted by 1 / sigma_j), through the normal equations of unit-norm columns
-(normal.py); a column is *not excited* when it loads by more than half on directions whose
-singular value is below WEAK times the largest (least_squares.py).
-
-Standard deviations. The textbook (A^T W A)^-1 sigma^2 assumes residuals independent from sample
-to sample. Filtered and differentiated signals are not: the residual of a 10 Hz filtered
-recording at 1 kHz is correlated over tens of samples, and the textbook deviation is too small
-by the square root of that correlation time. The deviation reported is the sandwich (batch
-means) estimate
-
-    Cov(x) = H^-1 S H^-1,   H = A^T W A,   S = sum_b s_b s_b^T,   s_b = sum_{t in block b} a_t w_t e_t
-
-over contiguous blocks b of BLOCK_TIMES integrated autocorrelation times of the residual
-(data/correlation.py's estimate, the largest over joints), at least MIN_BLOCKS of them:
-the scores' variance as the data show it, whatever the residual's correlation, its change of
-size along the motion, or a model error that comes and goes with the motion (a sticking joint at
-rest). Where the data are too short for MIN_BLOCKS such blocks, the textbook deviation scaled by
-the square root of the correlation time is reported instead. Either way never below the
-textbook deviation.
-"""
+The deviation is the sandwich (batch means) estimate Cov(x) = H^-1 S H^-1, H = A^T W A,
+S = sum_b s_b s_b^T, s_b = sum_{t in block b} a_t w_t e_t, over contiguous blocks of BLOCK_TIMES
+correlation times of the residual (at least MIN_BLOCKS, else the textbook deviation times the
+square root of the correlation time), never below the textbook deviation."""
 
 from __future__ import annotations
 
@@ -54,9 +38,8 @@ def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int)
 
 
 class _Correlation:
-    """data.correlation.integrated_time of a series given a block at a time: the lag products
-    up to LAGS, the sum, the first and last LAGS values. The same number wherever rho first
-    drops below 0.05 within LAGS samples (else the sum stops at LAGS)."""
+    """data.correlation.integrated_time of a series given a block at a time (the lag products up to LAGS,
+    the sum, the first and last LAGS values)."""
 
     def __init__(self):
         self.n, self.total = 0, 0.0
@@ -102,9 +85,8 @@ def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
 
 
 def _score_blocks(spilled, length: int):
-    """(sum over blocks of s s^T, count): s the scores of a contiguous block of `length` samples
-    of a recording, counted from its first data sample (a last, shorter block is left out);
-    spilled: per piece (its source, its first sample, the file of its score rows)."""
+    """(sum over blocks of s s^T, count): s the scores of a contiguous block of `length` samples of a
+    recording (a last, shorter one left out); spilled: per piece (source, first sample, its file)."""
     S, count = 0.0, 0
     current, index, open_sum = None, -1, None
 
@@ -131,11 +113,9 @@ def _score_blocks(spilled, length: int):
 
 
 def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
-    """The weighted unconstrained fit of the columns keep (indices into coefficients, then
-    labels) on the given parts, with standard deviations as above; two passes over the fit
-    recordings' blocks (blocks.py): the residuals' size and correlation time, and their scores
-    per sample, kept in a temporary folder until the correlation time gives the blocks' length
-    (reading them back costs less than a second pass: the regressor again)."""
+    """The weighted unconstrained fit of the columns keep on the parts, with the deviations above: two
+    passes over the blocks (the residuals' size and correlation time; their score rows, kept in a
+    temporary folder until the correlation time gives the blocks' length)."""
     G, g = normal.total(parts, weights, keep)
     cols = len(keep)
     norms = np.sqrt(np.maximum(np.diag(G), 0.0))

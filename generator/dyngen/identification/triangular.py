@@ -1,19 +1,8 @@
-"""Least squares accumulated block by block, per joint: memory independent of the row count.
-
-For joint j, the rows [A_j | b_j] of every block are folded into the triangular factor R_j of
-their QR decomposition (R_j^T R_j = [A_j b_j]^T [A_j b_j], the normal equations, but formed
-without squaring the condition number):
-
-    R_j <- triu(qr([R_j; A_block b_block]))
-
-R_j holds everything a least-squares fit over those rows needs: the singular values and right
-singular vectors of A_j (those of R_j's first c columns), U^T b (through R_j's last column) and
-the part of b no x can explain (the last diagonal entry). Factors of several recordings, joints
-or machines stack the same way, so the pooled fit, each recording's own fit and any fit's
-residual on any recording and joint come from these (c+1)^2 numbers: their fit is
-identification.least_squares.fit_factor, which the in-memory fit of the stacked rows also goes
-through (one code path; equal to rounding).
-"""
+"""Least squares accumulated block by block, per joint, memory independent of the row count: the
+rows [A_j | b_j] are folded into the triangular factor of their QR decomposition,
+R_j <- triu(qr([R_j; A_block b_block])) (the normal equations without squaring the condition).
+R_j holds all a fit needs (least_squares.fit_factor, which the in-memory fit also goes through),
+and factors of recordings, joints or machines stack the same way."""
 
 from __future__ import annotations
 

@@ -1,24 +1,13 @@
-"""The torque terms: one definition of each, drawn on by identification's columns, the
-diagnosis's candidates (its "effects"), excitation's information matrix and the emitted friction
-routine.
-
-Each term (term.Term) states its fitted values and their physical ranges (term.Value), its
-nonlinear settings, its regressor columns (numpy, per chunk of samples where `pointwise`), its
-documentation line, and for the friction routine its fields and its C (friction.IN_FRICTION):
-the firmware's friction is, by construction, the law that was fitted. An instance is the
-diagnosis's candidate at its settings, its columns of a recording computed in a context
-(context.py): a residual r = tau_measured - tau_model ~= sum over terms of columns @ values.
+"""The torque terms: one definition of each, drawn on by identification's columns, the diagnosis's
+candidates (its "effects"), excitation's information matrix and the emitted friction routine
+(term.Term; a residual r = tau_measured - tau_model ~= sum over terms of columns @ values).
 
     offset, gain, time_shift   sensor.py   errors of the measurement
     coulomb, viscous, stribeck,
     direction                  friction.py per joint, of its own motion
     ripple, armature           rotor.py    the gear's harmonics, the rotor's inertia
     payload, coefficients      body.py     a body on the last link; the base regressor
-    tilt, gravity_scale        tilt.py     gravity turned or scaled (from the joint model)
-
-A nonlinear setting (the Stribeck velocity, the time shift of the exact form) is tried as a few
-fixed variants of one term (`library`), refined once the term is selected (diagnosis/refine.py).
-"""
+    tilt, gravity_scale        tilt.py     gravity turned or scaled (from the joint model)"""
 
 from __future__ import annotations
 
@@ -49,13 +38,12 @@ def check_names(names) -> None:
 
 
 def effect_class(name: str) -> type:
-    """The term a report entry names (FixedShapePayload reports as "payload")."""
+    """The term a report entry names."""
     return next(term for term in TERMS if term.name == name)
 
 
 def library(context: Context, names=None) -> list[Term]:
-    """Every candidate tried by default (or those whose name is in `names`), for the diagnosis of
-    one robot and its link parameters (context)."""
+    """Every candidate tried by default (or those named), for one diagnosis (context)."""
     names = DEFAULT_NAMES if names is None else names
     check_names(names)
     candidates = [Offset(), *[Coulomb(v) for v in SCALE_VARIANTS], Viscous(), *[Stribeck(v) for v in STRIBECK_VARIANTS],

@@ -1,12 +1,6 @@
-"""The rigid body and errors in it: the base regressor Y(q, qd, qdd) of the full dynamics (as a
-diagnosis's candidate "coefficients": errors in every base coefficient), and a payload on the
-last link.
-
-payload: the 10 standard parameters (m, mx, my, mz, XX, XY, XZ, YY, YZ, ZZ, frame of the last
-  link, docs/conventions.md) of a body fixed to the last link. Newton-Euler is linear in the
-  standard parameters, so its torque columns are rnea(q, qd, qdd, e_k) with e_k the unit vector
-  of the last link's k-th parameter.
-"""
+"""The rigid body (its base regressor Y(q, qd, qdd); as a candidate "coefficients": errors in every
+base coefficient) and a payload on the last link: its 10 standard parameters, whose torque
+columns are rnea(q, qd, qdd, e_k) (Newton-Euler is linear in them)."""
 
 from __future__ import annotations
 
@@ -39,8 +33,7 @@ class RigidBody(Term):
 
 
 class Payload(Term):
-    """A body has a positive mass, not more than the arm's, and its centre of mass within a metre
-    of the flange frame."""
+    """A body of positive mass, not more than the arm's, its centre within REACH of the flange frame."""
 
     name, scope, doc = "payload", "arm", "a payload: a body fixed to the last link (its 10 standard parameters)"
     values = tuple(Value(n, u) for n, u in zip(STANDARD_NAMES_PER_LINK, (
@@ -92,13 +85,9 @@ class Payload(Term):
         return {"arm mass": self.max_mass}
 
     def simplified(self, values):
-        """A fitted inertia that is no body's (about its centre of mass: a negative principal
-        moment, or one larger than the other two together): at the fitted centre, either the
-        nearest body's inertia per kg of the fitted mass or none (a point mass), as fixed shapes
-        (FixedShapePayload). The data determine m and m c far better than that inertia, and an
-        impossible one mispredicts other motions; which of the two predicts better depends on
-        how far off the fitted one is (at 1 kHz the nearest body's, at 100 Hz from a 17-bit
-        encoder none), so the selection data choose."""
+        """A fitted inertia no body has: at the fitted centre, either the nearest body's inertia per kg or
+        none (FixedShapePayload), whichever predicts the selection data better (the data determine m and
+        m c far better than the inertia)."""
         if consistent_inertia(values):
             return None
         refusal = ("the payload's inertia about its centre of mass (not a body's; the payload keeps its fitted "
@@ -124,10 +113,8 @@ class Payload(Term):
 
 
 class FixedShapePayload(Payload):
-    """A payload of a fixed shape: centre c0 and inertia J0 about it per kg (those of a fitted
-    Payload whose own inertia came out no body's: Payload.simplified), its mass fitted. Values m
-    and m c; the inertia about the frame origin is m (J0 + |c0|^2 1 - c0 c0^T), a body's for any
-    positive m."""
+    """A payload of a fixed shape (centre c0, inertia J0 about it per kg), its mass fitted: values m and
+    m c; its inertia about the origin m (J0 + |c0|^2 1 - c0 c0^T) is a body's for any m > 0."""
 
     values = Payload.values[:4]
 
@@ -176,10 +163,8 @@ def _point(c) -> np.ndarray:
 
 
 def nearest_body_inertia(I) -> np.ndarray:
-    """The inertia nearest to the symmetric I (in principal moments, same axes) that a body can
-    have: principal moments non-negative, none larger than the other two together. The set is a
-    cone with six faces; the nearest point lies on some of them, so it is the nearest of the
-    projections onto each set of faces that satisfies all six."""
+    """The inertia nearest to the symmetric I (principal moments, same axes) a body can have: moments
+    non-negative, none above the other two together; the nearest valid projection onto the cone's faces."""
     e, V = np.linalg.eigh(I)
     faces = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], dtype=float)
     best, distance = np.zeros(3), np.inf
@@ -192,23 +177,19 @@ def nearest_body_inertia(I) -> np.ndarray:
 
 
 def consistent_inertia(values) -> bool:
-    """Whether a fitted payload's 10 standard values (m, m c, inertia about the frame origin)
-    describe a body: its inertia about its centre of mass meets the triangle inequalities
-    (parameters.consistency_margin, the extraction's check; the mass is the range's)."""
+    """Whether a payload's 10 standard values describe a body (parameters.consistency_margin)."""
     return consistency_margin(dynamic_from_standard_link(values)) >= 0.0
 
 
 def standard_of_payload(values: dict, variant=None) -> np.ndarray:
-    """The 10 standard parameters of a selected payload (its 10 values, or a fixed shape's 4
-    with the variant's inertia per kg)."""
+    """The 10 standard parameters of a selected payload (or a fixed shape's with its inertia per kg)."""
     if "XX" in values:
         return np.array(list(values.values()), dtype=float)
     return FixedShapePayload.last_link(values, variant)
 
 
 def armature_identifiable(model, dof: int, seed: int = 0) -> list[bool]:
-    """Per joint, whether its rotor inertia Ia_j qdd_j (terms.Armature) is independent of the rigid
-    body's base columns (at random states of the compiled model)."""
+    """Per joint, whether its rotor inertia is independent of the rigid body's base columns."""
     rng = np.random.default_rng(seed)
     states = 40
     q, qd, qdd = (rng.uniform(-2, 2, (states, dof)) for _ in range(3))

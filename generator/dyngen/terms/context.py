@@ -1,5 +1,5 @@
-"""What a term's columns of a recording are computed in besides the recording: the diagnosis's
-context (the model, the robot, its link parameters, what the chosen terms set) and its memo."""
+"""What a term's columns are computed in besides the recording (the model, the robot, its link
+parameters, what the chosen terms set) and its memo."""
 
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ MEMO_BYTES = 256 << 20
 
 
 class Memo:
-    """compute() once per key, kept while the values' bytes stay under `limit` (least recently
-    used evicted first); shared by a context and its dataclasses.replace copies."""
+    """compute() once per key, kept while the values' bytes stay under `limit` (least recently used
+    evicted first); shared by a context and its dataclasses.replace copies."""
 
     def __init__(self, limit: int | None = None):
         self.limit = MEMO_BYTES if limit is None else limit
@@ -48,8 +48,7 @@ def _nbytes(value) -> int:
 
 @dataclass
 class Context:
-    """What a term's columns may use besides the signals: the compiled model, the robot, its link
-    parameters (dynamic p and standard s) and the smoothing velocity of sign(qd)."""
+    """What a term's columns may use besides the signals."""
 
     model: object  # dyngen.runtime.Compiled
     robot: object  # dyngen.description.Robot
@@ -73,6 +72,5 @@ class Context:
             self.cache = Memo()
 
     def memo(self, key, compute):
-        """compute() once per key while it fits in the memo's bytes (its recordings do not
-        change during one diagnosis, so a value computed again is the same)."""
+        """compute() once per key (one diagnosis's recordings do not change, so a value computed again is the same)."""
         return self.cache.get(key, compute)

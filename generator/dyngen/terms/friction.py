@@ -1,22 +1,13 @@
-"""Joint friction: per joint, each acting on its own joint and depending on its own motion
-alone (columns (T, N, k): entry [:, j] acts on joint j; the gear's ripple and the rotor's
-inertia: rotor.py).
+"""Joint friction, per joint, of its own motion (columns (T, N, k)):
 
     coulomb    Fc tanh(qd / vc)                     [Nm]        vc: the law's velocity scale
     viscous    Fv qd                                [Nm s/rad]
     stribeck   Fs tanh(qd / es) exp(-(qd / vs)^2)   [Nm]        static friction above the Coulomb level
     direction  dFc |tanh(qd / ed)|                  [Nm]        Coulomb levels Fc + dFc forwards, Fc - dFc backwards
 
-Every velocity scale belongs to its own term (vc, es, ed are three numbers, each the one its
-term was fitted with): the emitted friction vector carries each (FRICTION_FIELDS), so the
-firmware's friction is the law that was measured. (Units for a prismatic joint: N, N s/m.)
-
-As the diagnosis's candidates: Coulomb at a few velocity scales vc and Stribeck at a few
-velocities vs, refined once selected (refine.py). vc is fitted because real joints do not
-switch sharply: in stick phases and reversals friction takes any value in [-Fc, Fc], which a
-smooth law with a wider vc follows better than a sharp sign. The Stribeck and direction terms' signs are smoothed by the
-diagnosis's sign velocity (Context.sign_velocity) so that standstill noise does not flip them.
-"""
+Each velocity scale is its own term's, carried in the emitted vector: the firmware's friction is
+the law that was measured. vc is fitted (real joints do not switch sharply); es and ed are the
+diagnosis's sign velocity (Context.sign_velocity), so that standstill noise does not flip them."""
 
 from __future__ import annotations
 
@@ -40,13 +31,12 @@ STATIC_RESOLVED = 0.25  # ... and at least this share of it (see Stribeck.refusa
 
 
 def coulomb(qd, vc):
-    """tanh(qd / vc): the Coulomb law's shape (any array, vc broadcast)."""
+    """tanh(qd / vc): the Coulomb law's shape."""
     return np.tanh(qd / vc)
 
 
 class _AtVelocity(Term):
-    """A friction term at one velocity setting (`velocity`, its field `field`): the diagnosis's
-    variant of it, refined once selected."""
+    """A friction term at one velocity setting (its field `field`), refined once selected."""
 
     field = ""
     switching = refinable = local = True
@@ -165,14 +155,9 @@ class Stribeck(_AtVelocity):
         return lo, max(self.velocity * 3, lo)
 
     def refusal_beside(self, values, base):
-        """Static friction above the Coulomb level, between STATIC_RESOLVED and STATIC_EXCESS
-        times that level. A breakaway torque of ten Coulomb levels at a reversal is no joint's:
-        it is a spike standing in for a conditioning artefact (at 100 Hz, 17-bit positions: Fs
-        10.5 Nm beside Fc 1.0). A small excess is what a low-pass filter makes of the reversals
-        of friction that sticks, where the torque takes any value within the Coulomb levels
-        while the filtered velocity passes through zero smoothly (withheld benchmark, `sticky`,
-        no static friction injected: 0.04-0.13 Nm beside 0.4-0.9 Nm; injected static friction
-        came out at 0.9-1.6 Coulomb levels)."""
+        """Static friction between STATIC_RESOLVED and STATIC_EXCESS Coulomb levels: ten levels at a reversal
+        is a conditioning artefact (100 Hz, 17-bit positions: Fs 10.5 Nm beside Fc 1.0); a small excess is
+        a filter's rounding of reversals where friction sticks (docs/measured-data.md, `sticky`)."""
         if np.any(values > STATIC_EXCESS * base):
             return f"static friction above {STATIC_EXCESS:g} Coulomb levels is no joint's"
         if np.any(values < STATIC_RESOLVED * base):
@@ -181,9 +166,7 @@ class Stribeck(_AtVelocity):
         return ""
 
     def reshapes(self, other):
-        """No wider than STRIBECK_WIDER times the joint's Coulomb velocity scale (up to the
-        search's 1 % tolerance: refined onto that bound): there the two laws trade shape with
-        each other, and no static friction is shown."""
+        """No wider than STRIBECK_WIDER Coulomb scales (up to the search's 1 %): the two laws trade shape."""
         return isinstance(other, Coulomb) and self.velocity < 1.02 * STRIBECK_WIDER * other.velocity
 
     @classmethod
@@ -226,8 +209,7 @@ FRICTION_NAMES = tuple(field.name for field in FRICTION_FIELDS)
 
 
 def friction_torque(m, qd, f) -> list:
-    """Per joint, the emitted routine's friction at velocities qd for the vector f (every
-    joint's FRICTION_FIELDS in turn), with math module m: the sum of the terms' laws."""
+    """Per joint, the emitted routine's friction at velocities qd for the vector f, with math module m."""
     n = len(FRICTION_FIELDS)
     out = []
     for j, v in enumerate(qd):
@@ -237,9 +219,8 @@ def friction_torque(m, qd, f) -> list:
 
 
 def c_terms(names, v: str = "v", vector: str = "fj") -> list[dict]:
-    """The friction routine's terms for its template: each term's doc line, fields and C on one
-    joint (v its velocity, vector[k] its k-th field; names: the C names of sgn, exp, abs and
-    zero, attributes of one object)."""
+    """The friction routine's terms for its template: doc line, fields and C on one joint (v its
+    velocity, vector[k] its k-th field; names: the C names of sgn, exp, abs and zero)."""
     index = {name: k for k, name in enumerate(FRICTION_NAMES)}
     return [{"name": term.name, "doc": term.doc, "fields": term.friction,
              "c": term.c(v, lambda name: f"{vector}[{index[name]}]", names)} for term in IN_FRICTION]

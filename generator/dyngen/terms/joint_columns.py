@@ -1,9 +1,5 @@
-"""The per-joint columns `dyngen identify` fits by default and the excitation design's
-information matrix holds (identification/columns.py, excitation/design.py): one definition of
-each, from its term, so the matrix the trajectory is designed for is the one identified.
-
-    column(kind, q, qd, qdd, vc)   (T,) of joint j's own motion (q, qd, qdd: that joint's)
-"""
+"""The per-joint columns `dyngen identify` fits and the excitation design's information matrix holds,
+from their terms: the trajectory is designed for the matrix that is identified."""
 
 from __future__ import annotations
 
@@ -19,8 +15,8 @@ TERM_OF = {"coulomb": Coulomb, "viscous": Viscous, "offset": Offset, "armature":
 
 
 def column(kind: str, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, vc: float | None = None) -> np.ndarray:
-    """(T,): the column of `kind` in its joint's rows (coulomb: at velocity scale vc, unfiltered;
-    ripple_cos, ripple_sin: the first harmonic of the position)."""
+    """(T,): the column of `kind` for one joint's q, qd, qdd (coulomb at scale vc, unfiltered; ripple:
+    the first harmonic)."""
     if kind == "coulomb":
         return Coulomb.regressor(qd, vc)[:, 0]
     if kind == "viscous":

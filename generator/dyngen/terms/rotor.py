@@ -1,10 +1,7 @@
 """The drive train's terms, per joint and of its own motion (columns (T, N, k)):
 
     ripple     sum_k a_k cos(k q) + b_k sin(k q)    [Nm]        gear and cogging harmonics of the joint's position
-    armature   Ia qdd                               [kg m^2]    reflected rotor inertia (kg for a prismatic joint)
-
-As the diagnosis's candidates the ripple's positions are clipped to the fit data's (Context.q_range).
-"""
+    armature   Ia qdd                               [kg m^2]    reflected rotor inertia (kg for a prismatic joint)"""
 
 from __future__ import annotations
 
@@ -17,8 +14,7 @@ RIPPLE_SEPARABLE = 4.0  # harmonics' amplitudes summing to more than this many p
 
 
 class Ripple(Term):
-    """Known only where the data went: the diagnosis clips q to the fit data's range (harmonics
-    extrapolated beyond it are guesses); a prismatic joint has none (harmonics of metres)."""
+    """Known only where the data went: q is clipped to the fit data's range; a prismatic joint has none."""
 
     HARMONICS = (1, 2, 3)
     name, doc = "ripple", "position ripple sum_k a_k cos(k q) + b_k sin(k q) (gear and cogging harmonics)"
@@ -27,7 +23,7 @@ class Ripple(Term):
 
     @staticmethod
     def harmonic(q, k: int, kind: str):
-        """cos(k q) or sin(k q) (one column, e.g. identify's first harmonic)."""
+        """cos(k q) or sin(k q): one column."""
         x = q if k == 1 else k * q
         return np.cos(x) if kind == "cos" else np.sin(x)
 

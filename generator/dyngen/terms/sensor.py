@@ -4,15 +4,9 @@
     gain        (k - 1) tau_model                  per joint [1]: the sensor reads k times the torque
     time_shift  (tau(t - dt0) - tau(t)) / dt0      whole arm [s]: torques lag the positions by dt
 
-The time shift is linear in dt only to first order, -dt * d tau_model / dt, which fails wherever
-tau_model jumps (an acceleration step): the measured torque keeps the value before the jump for
-dt, while the sampled derivative puts a spike of jump * dt / (2 h) on the two samples around it
-(h the sample period; 5 times the jump for 10 ms at 1 kHz). So its column is the exact form at a
-shift dt0 (tau_model interpolated linearly in time; its columns need dt0 of samples before a
-chunk), whose fitted value dt equals dt0 when the model holds. The diagnosis tries a few variants
-of dt0 (TIME_SHIFTS, terms/__init__.py); once selected, dt0 is refined by fixed-point iteration
-dt0 <- dt (refine.py), which also reaches negative shifts (torques leading the positions).
-"""
+The time shift's column is its exact form at a shift dt0 (the first-order -dt d tau_model / dt
+spikes wherever tau_model jumps), whose fitted dt equals dt0 when the model holds: the diagnosis
+tries TIME_SHIFTS and refines dt0 <- dt once selected (refine.py), negative shifts included."""
 
 from __future__ import annotations
 

@@ -1,12 +1,6 @@
-"""The simple model every diagnosis is measured against: per joint, independently,
-
-    r_j = b_j + Fc_j tanh(qd_j / 0.02) + Fv_j qd_j
-
-(offset, Coulomb and viscous friction: three numbers per joint) fitted by least squares to the
-nominal model's residual on the fit samples. Its columns go through the recording's filter
-like the torques. A diagnosis that does worse than this on a joint has not explained that
-joint; the pipeline then keeps the simple model there (joints.py).
-"""
+"""The simple model every diagnosis is measured against: per joint r_j = b_j + Fc_j tanh(qd_j / 0.02)
++ Fv_j qd_j, fitted to the nominal residual on the fit samples (columns filtered like the torques).
+A diagnosis worse than this on a joint keeps it there (diagnosis/joints.py)."""
 
 from __future__ import annotations
 

@@ -1,15 +1,10 @@
-"""What every torque term states: its values, their physical range, its columns and its law,
-and what the diagnosis needs of it as a candidate (one class per term: an instance is a
-candidate at its settings, e.g. Coulomb(0.01), the class the law identify fits).
+"""What every torque term states (one class per term; an instance is a diagnosis's candidate at its
+settings, e.g. Coulomb(0.01)): its values and their physical range, its columns and its law.
 
-A term is a torque linear in its fitted values: tau_term = columns @ values. Its nonlinear
-settings (a velocity scale, a lag) are fixed while it is fitted. Columns are computed from
-samples (q, qd, qdd, t, the model's torque) with numpy; a `pointwise` term's columns of a
-chunk of samples need that chunk alone, so the normal equations A^T A, A^T b of any fit that
-uses it accumulate chunk by chunk (a time shift needs the samples up to its lag before; a
-`switching` term's columns go through the recording's low-pass like the torque, which needs
-the filter's overlap at a chunk's ends).
-"""
+A term is linear in its fitted values, tau_term = columns @ values, its nonlinear settings fixed
+while fitted. A `pointwise` term's columns of a chunk of samples need that chunk alone (a time
+shift needs the samples up to its lag before; a `switching` term's go through the recording's
+low-pass, which needs the filter's overlap)."""
 
 from __future__ import annotations
 
@@ -20,8 +15,8 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Value:
-    """A fitted value or a setting: its name, unit, and the open interval (low, high) a
-    physical one lies in (units of `per`: "" absolute, "g" the size of gravity, "arm mass")."""
+    """A fitted value or a setting: name, unit and the open interval (low, high) a physical one lies in,
+    in units of `per` ("" absolute, "g" the size of gravity, "arm mass")."""
 
     name: str
     unit: str
@@ -36,8 +31,8 @@ class Value:
 
 @dataclass(frozen=True)
 class FrictionField:
-    """One entry of a joint's friction vector (the generated <robot>_friction's f): a term's value
-    (kind "value") or setting (kind "velocity": a scale, the plain sign or no term when <= 0)."""
+    """One entry of a joint's emitted friction vector: a term's value or its velocity setting (a
+    scale; the plain sign or no term when <= 0)."""
 
     name: str
     kind: str  # "value" | "velocity"
@@ -45,16 +40,10 @@ class FrictionField:
 
 
 class Term:
-    """name: the term's identifier (reports, JSON, --effects); scope "joint" (one candidate per
-    joint, acting on it) or "arm" (shared values); values: its fitted values (parameters and units
-    their names and units); settings: its nonlinear settings; doc: one line (the law).
-    `friction`: its entries of the emitted friction vector and `c`, its C on one joint.
-
-    As a diagnosis's candidate, what it needs to know of a term lives here as attributes and
-    methods with plain defaults: what it needs (a context-built term is made by `of`), what
-    follows from its values (`derived`), what the updated model takes from it (`friction_terms`,
-    `simulator`, `last_link`, read from a finding (diagnosis/record.Finding): classmethods) and
-    when it is reported with a warning (`suspect`, `warnings`)."""
+    """name: its identifier (reports, JSON, --effects); scope "joint" (one candidate per joint, acting
+    on it) or "arm"; values, settings; doc: one line (the law); friction and c: its entries of the
+    emitted friction vector and its C. As the diagnosis's candidate it answers through the plain
+    defaults below (classmethods read a finding, diagnosis/record.Finding)."""
 
     name = ""
     scope = "joint"
@@ -88,49 +77,42 @@ class Term:
 
     @classmethod
     def inside(cls, values, scales: dict | None = None) -> bool:
-        """Whether fitted values are physical: each inside its range (terms whose values are
-        bounded together say so here)."""
+        """Whether fitted values are physical: each inside its range."""
         values = np.atleast_1d(values)
         return all(v.inside(x, scales) for v, x in zip(cls.values, values))
 
     @classmethod
     def c(cls, v: str, f, c) -> str:
-        """C expression of the term's torque on one joint: v the velocity, f(name) its fields, c
-        the C names of sgn(v, e) (term.sign), exp, abs (|x|) and zero (attributes)."""
+        """C of its torque on one joint: v the velocity, f(name) its fields, c the C names of sgn, exp, abs, zero."""
         raise NotImplementedError
 
     @classmethod
     def torque(cls, m, v, f: dict):
-        """Its torque at velocity v for fields f, with math module m (numpy or mpmath): the same
-        law as `c`, the oracle the emitted C is checked against."""
+        """Its torque at velocity v for fields f with math module m (numpy or mpmath): the emitted C's oracle."""
         raise NotImplementedError
 
     # ---- as a candidate of the diagnosis
 
     @classmethod
     def of(cls, context) -> "Term":
-        """The candidate for one diagnosis (terms that need the robot or its model read them here)."""
+        """The candidate for one diagnosis (terms that need the robot or its model read the context)."""
         return cls()
 
     def columns(self, context, signals, tau_model: np.ndarray) -> np.ndarray:
-        """(T, N, k): column c of joint j's residual on a recording (signals; context:
-        terms/context.py). Scope "joint": entry [:, j, :] is the candidate on joint j and acts on
-        joint j only."""
+        """(T, N, k): the columns on a recording; scope "joint": [:, j, :] is the candidate on joint j."""
         raise NotImplementedError
 
     def reads(self, context) -> tuple:
-        """The parts of the context its columns depend on besides the recording (for the memo):
-        what other chosen terms set (Context.load)."""
+        """What besides the recording its columns depend on (the memo's key): other chosen terms' settings."""
         return ()
 
     @property
     def load(self):
-        """A payload at its setting: its (m, mx, my, mz) (Context.load); others None."""
+        """A payload at its setting: its (m, mx, my, mz) (Context.load)."""
         return None
 
     def plausible(self, values: np.ndarray) -> bool:
-        """Whether fitted values can be this term at all (e.g. friction opposes motion): inside
-        its physical range."""
+        """Whether fitted values can be this term at all (e.g. friction opposes motion)."""
         return self.inside(values, self.range_scales())
 
     def range_scales(self) -> dict:
@@ -138,37 +120,32 @@ class Term:
         return {}
 
     def refusal_beside(self, values: np.ndarray, base: np.ndarray) -> str:
-        """Why fitted values cannot be this term beside those of the term it extends on its
-        joint (Term.extends); "" if they can."""
+        """Why fitted values cannot be this term beside those of the term it extends ("" if they can)."""
         return ""
 
     def simplified(self, values: np.ndarray):
-        """Fitted values possible only in part: ((what of it is refused, its values): the refusal
-        to report, simpler terms that keep the first of these values, of which the selection data
-        take one); else None."""
+        """Values possible only in part: ((refusal, its values), simpler terms, one chosen on selection data)."""
         return None
 
     def reshapes(self, other: "Term") -> bool:
-        """Whether this term, on the same joint as `other`, only reshapes it (and goes)."""
+        """Whether, on the same joint as `other`, it only reshapes it (and goes)."""
         return False
 
     @property
     def setting(self):
-        """Refinable terms: the current nonlinear setting (what `at` takes); others None."""
+        """A refinable term's nonlinear setting (what `at` takes)."""
         return None
 
     def implied_setting(self, values: np.ndarray) -> float | None:
-        """Refinable terms whose fitted values imply their setting (refined by fixed-point
-        iteration): that setting; others None."""
+        """The setting its fitted values imply (refined by fixed-point iteration), if any."""
         return None
 
     def search_interval(self, values: np.ndarray, beside: tuple = ()) -> tuple[float, float] | None:
-        """Refinable terms whose setting is independent of their values: where to search it
-        (refined by scalar search), given the other terms on its joint (`beside`); others None."""
+        """Where to search a setting independent of its values, given the other terms on its joint."""
         return None
 
     def at(self, setting: float) -> "Term":
-        """Refinable terms: the same term at another setting."""
+        """The same term at another setting."""
         raise NotImplementedError
 
     def fixed(self) -> dict:
@@ -176,25 +153,23 @@ class Term:
         return {}
 
     def derived(self, robot, values: dict, std: dict, torque_rms) -> dict:
-        """Quantities a reader wants next to the fitted values (None where undetermined), e.g.
-        tilt angles. torque_rms(): the RMS torque of the fitted values on the fit data (per-joint
-        terms)."""
+        """What a reader wants beside the fitted values (None where undetermined); torque_rms(): RMS torque
+        of the values on the fit data (per-joint terms)."""
         return {}
 
     @classmethod
     def warnings(cls, finding) -> list[str]:
-        """Warnings on a selected term's finding (diagnosis/record.Finding)."""
+        """Warnings on a selected term's finding."""
         return []
 
     @classmethod
     def friction_terms(cls, values: dict, variant: dict) -> dict:
-        """Entries of its joint's generated <robot>_friction vector (FRICTION_FIELDS)."""
+        """Entries of its joint's emitted friction vector (FRICTION_FIELDS)."""
         return {}
 
     @classmethod
     def last_link(cls, values: dict, variant: dict | None = None) -> np.ndarray | None:
-        """Standard parameters this term adds to the last link (a payload; its finding's values
-        and variant); else None."""
+        """Standard parameters it adds to the last link (a payload), else None."""
         return None
 
     @property

@@ -1,21 +1,11 @@
-"""A tilted base and a gravity of the wrong size, from the joint model's forward kinematics (the
-one numeric kinematics: description/joint_model.py).
+"""A tilted base and a gravity of the wrong size, from the joint model's forward kinematics.
 
-The gravity torque is linear in the gravity vector: g(q) = G(q) gvec, column k of G the joint
-torques of a unit gravity along base axis k. For joint i (axis z through o) and every link k it
-carries, with mass m_k and centre of mass p_k,
+g(q) = G(q) gvec: for joint i (axis z through o) and every link k it carries (mass m_k, centre p_k)
     revolute:  G_i = - sum_k m_k (z x (p_k - o))      prismatic:  G_i = - sum_k m_k z
-(the potential is V = -sum m_k gvec . p_k and g = dV/dq).
-
-tilt: a rotation of the base turns gvec by d gvec = dg1 u1 + dg2 u2 across gravity (u1, u2,
-  n = gvec / |gvec| a right-handed triple: `directions`; for gravity along -z, u1 = base +x and
-  u2 = base -y), and shortens it along n by what keeps |gvec|: -(dg1^2 + dg2^2) / (2 |g|) to
-  second order. Its column k is G u_k - G n dg_k0 / (2 |g|), linearised at an estimate dg_k0 and
-  refitted there, so a tilt cannot change gravity's size. Beyond MAX_TILT_DEG it is no mounting
-  error (the diagnosis refuses it).
-gravity_scale: G n dg: every link's gravity torque scaled alike (no tilt does this: the
-  diagnosis reports it as suspect, a symptom, not a cause).
-"""
+tilt: the base turns gvec by dg1 u1 + dg2 u2 across gravity (`directions`) and shortens it along n
+  by -(dg1^2 + dg2^2) / (2 |g|), so its size is kept: column k is G u_k - G n dg_k0 / (2 |g|),
+  linearised at an estimate dg_k0 and refitted. Beyond MAX_TILT_DEG it is no mounting error.
+gravity_scale: G n dg (no tilt does this: reported as suspect)."""
 
 from __future__ import annotations
 
@@ -42,8 +32,7 @@ def gravity_norm(robot) -> float:
 
 
 def directions(g) -> np.ndarray:
-    """(3, 3): rows u1, u2 across gravity and n along it, u2 = n x u1 (u1 the base axis least
-    along gravity, made perpendicular): for gravity along -z, base +x, base -y and -z."""
+    """(3, 3): rows u1, u2 across gravity and n along it, u2 = n x u1 (for gravity along -z: +x, -y, -z)."""
     g = np.asarray(g, dtype=float)
     n = g / np.linalg.norm(g)
     seed = np.eye(3)[int(np.argmin(np.abs(n)))]
@@ -59,7 +48,7 @@ def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
 
 
 def tilt_axes(robot) -> tuple[str, str]:
-    """Names of u1 and u2 in the base frame, e.g. ("base +x", "base -y") for gravity along -z."""
+    """Names of u1 and u2 in the base frame, e.g. ("base +x", "base -y")."""
     names = []
     for u in tilt_directions(robot):
         k = int(np.argmax(np.abs(u)))
@@ -71,15 +60,13 @@ def tilt_axes(robot) -> tuple[str, str]:
 
 
 def angle_deg(g, a) -> float:
-    """The tilt angle [deg] of the rotation that gives gravity g (its vector or size) the
-    components a across it: a rotation keeps |g|, so |a| = |g| sin(angle). The one formula for
-    identify's refusal and report and the diagnosis's range and angles (angles_deg)."""
+    """The tilt angle [deg] that gives gravity g (vector or size) the components a across it:
+    |a| = |g| sin(angle). The one formula for identify and the diagnosis."""
     return float(np.degrees(np.arcsin(min(np.hypot(*a[:2]) / np.linalg.norm(g), 1.0))))
 
 
 def angles_deg(g, a) -> tuple[float, float]:
-    """The tilt's rotation vector [deg] split along the two directions it turns gravity towards
-    (u1, u2): angle_deg(g, a) times a / |a|, so that their hypot is the tilt angle."""
+    """The tilt angle split along u1, u2 (angle_deg times a / |a|)."""
     size = float(np.hypot(*a[:2]))
     if size == 0.0:
         return 0.0, 0.0
@@ -88,17 +75,14 @@ def angles_deg(g, a) -> tuple[float, float]:
 
 
 def change(g, a) -> np.ndarray:
-    """The change of g (coefficients along u1, u2, n) when the base turns so that gravity gains
-    the components a across it: a rotation, so the component along n shortens by
-    |g| - sqrt(|g|^2 - |a|^2)."""
+    """The change of g (along u1, u2, n) when gravity gains the components a across it (|g| kept)."""
     size = float(np.linalg.norm(g))
     a = np.asarray(a, dtype=float)
     return np.array([a[0], a[1], np.sqrt(max(size ** 2 - float(a @ a), 0.0)) - size])
 
 
 def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
-    """G (T, N, 3) with g(q) = G(q) gvec for link parameters p (dynamic, 10N); poses: the
-    forward kinematics of q, if computed already."""
+    """G (T, N, 3) with g(q) = G(q) gvec for dynamic link parameters p (10N); poses: q's kinematics."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     links = np.asarray(p, dtype=float).reshape(-1, 10)
     poses = poses or forward_kinematics(robot.joint_models, q)
@@ -114,10 +98,8 @@ def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
 
 
 def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
-    """B (T, N, 3, 4): the G(q) of a body on the last link per unit of its standard values
-    (m, mx, my, mz; first moments in the last link's frame). Its mass times its centre is
-    m o_N + R_N (mx, my, mz), so for a revolute joint i (axis z through o):
-    B_i = -[z x (o_N - o), z x R_N e_x, z x R_N e_y, z x R_N e_z]; prismatic: [-z, 0, 0, 0]."""
+    """B (T, N, 3, 4): G(q) of a body on the last link per unit of its (m, mx, my, mz): for a revolute
+    joint i, B_i = -[z x (o_N - o), z x R_N e_x, z x R_N e_y, z x R_N e_z]; prismatic [-z, 0, 0, 0]."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     poses = poses or forward_kinematics(robot.joint_models, q)
     last = poses[-1]
@@ -134,9 +116,7 @@ def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
 
 
 class Tilt(Term):
-    """As the diagnosis's candidate the second-order term is linearised at the current estimate,
-    refined by fixed-point iteration once the tilt is selected (refine.py); its angles are named
-    by the base axes it turns gravity towards (tilt_axes)."""
+    """As a candidate it is linearised at the current estimate, refined once selected (refine.py)."""
 
     name, scope, doc = "tilt", "arm", "a tilted base: gravity turned by dg1 u1 + dg2 u2, its size kept"
     values = (Value("dg1", "m/s^2"), Value("dg2", "m/s^2"))
@@ -224,9 +204,7 @@ class GravityScale(Term):
 
 
 def recording_gravity(context, signals) -> np.ndarray:
-    """G(q) of a recording (memoised in the context: the tilt's and the gravity scale's), with a
-    chosen payload (Context.load) on the last link: a tilt turns its gravity too (B of
-    body_gravity_matrix times its (m, mx, my, mz))."""
+    """G(q) of a recording (memoised), with a chosen payload on the last link (Context.load)."""
     def poses():
         return context.memo(("poses", id(signals)), lambda: forward_kinematics(context.robot.joint_models, signals.q))
 
