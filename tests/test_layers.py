@@ -40,7 +40,7 @@ DIAGNOSIS_STAGES = (
     {"joints", "reidentify", "choose"},  # 4. choose
     {"judge"},  # 5. test
     {"findings", "findings_check", "stable", "across", "notes", "diagnose_options", "pipeline"},  # 6. report; the pipeline
-    {"report", "updated_model", "figures", "outputs", "unusable_output", ""},  # written out; the package
+    {"report", "updated_model", "figures", "outputs", ""},  # written out; the package
 )
 DIAGNOSIS_RANK = {name: k for k, names in enumerate(DIAGNOSIS_STAGES) for name in names}
 MEASURED_DATA = ("data", "diagnosis", "terms", "identification", "excitation", "streaming")

@@ -133,7 +133,7 @@ def main(argv, prog="dyngen diagnose") -> int:
     if sampled:
         sources["sampled"] = sampled
     from ..diagnosis.trust import EXIT_UNUSABLE, Unusable  # the diagnosis loads only once it runs
-    from ..diagnosis.unusable_output import write_unusable
+    from ..diagnosis.outputs import write_unusable
 
     try:
         with progress.step("residual, effects, selection, test"):

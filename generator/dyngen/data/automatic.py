@@ -13,13 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .noise_floor import spectral_noise
-
 NOISE_SHARE = 0.003  # acceleration noise allowed, relative to the motion's acceleration RMS
 MAX_FRACTION = 0.2  # the cutoff stays below this fraction of the sampling rate
 MIN_CUTOFF = 0.5  # Hz
 HEAVY_TAILS = 1.5  # the spectrum's noise is used when it exceeds the robust estimate by this factor
 NO_FILTER_NOISE = 1e-12  # rad: positions this clean are differentiated without a filter
+BAND_FROM = 0.25  # of the sampling rate: the band whose median power is the spectral noise floor (up to 0.5)
+MEDIAN_OF_CHI2_2 = np.log(2.0)  # median / mean of a periodogram bin (chi-square, 2 degrees of freedom)
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,7 @@ class Decision:
 
 def position_noise(q: np.ndarray) -> np.ndarray:
     """Per joint sigma of white noise on q from robust third differences, or the spectrum's where it
-    shows clearly more broadband error (noise_floor.py)."""
+    shows clearly more broadband error (spectral_noise)."""
     if q.shape[0] < 8:
         return np.zeros(q.shape[1])
     d3 = np.diff(q, n=3, axis=0)
@@ -40,6 +40,22 @@ def position_noise(q: np.ndarray) -> np.ndarray:
     robust = 1.4826 * mad / np.sqrt(20.0)
     broadband = spectral_noise(q)
     return np.where(broadband > HEAVY_TAILS * robust, broadband, robust)
+
+
+def spectral_noise(q: np.ndarray) -> np.ndarray:
+    """Per joint sigma of the broadband position errors, which a robust scale does not see (a
+    logger's late samples sit qd * delay off the motion on a few per cent of the rows): for white
+    noise of sigma the third difference's power density is sigma^2 (2 sin(pi f / fs))^6, so its
+    median over the upper band divided by that shape is sigma^2 whatever the errors' shape."""
+    x = np.diff(np.asarray(q, dtype=float), n=3, axis=0)
+    if x.shape[0] < 64:
+        return np.zeros(q.shape[1])
+    window = np.hanning(x.shape[0])
+    power = np.abs(np.fft.rfft((x - x.mean(axis=0)) * window[:, None], axis=0)) ** 2 / np.sum(window ** 2)
+    f = np.fft.rfftfreq(x.shape[0])  # cycles per sample
+    band = (f >= BAND_FROM) & (f > 0)
+    shape = (2.0 * np.sin(np.pi * f[band])) ** 6
+    return np.sqrt(np.median(power[band] / shape[:, None], axis=0) / MEDIAN_OF_CHI2_2)
 
 
 def acceleration_noise(sigma_q, cutoff: float, rate: float, order: int = 2) -> np.ndarray:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def integrated_time(x: np.ndarray, max_lag: int | None = None) -> float:
+def integrated_time(x: np.ndarray) -> float:
     x = np.asarray(x, dtype=float)
     x = x - x.mean()
     n = x.size
@@ -16,8 +16,11 @@ def integrated_time(x: np.ndarray, max_lag: int | None = None) -> float:
     size = 1 << int(np.ceil(np.log2(2 * n)))
     spectrum = np.fft.rfft(x, size)
     acf = np.fft.irfft(spectrum * np.conj(spectrum), size)[:n]
-    rho = acf / acf[0]
-    limit = min(n - 1, max_lag or n // 4)
+    return truncated(acf / acf[0], min(n - 1, n // 4))
+
+
+def truncated(rho: np.ndarray, limit: int) -> float:
+    """1 + 2 sum_k rho_k over k = 1 .. limit, up to where rho first drops below 0.05."""
     below = np.flatnonzero(rho[1:limit + 1] < 0.05)
     stop = below[0] + 1 if below.size else limit + 1
     return float(max(1.0, 1.0 + 2.0 * rho[1:stop].sum()))

@@ -1,7 +1,7 @@
 """A recording as a logger wrote it, made into samples of one regular clock before filtering:
 repeated rows (every value equal to the row before while the arm moves) left out, held columns
 (a block updated only every k-th row) interpolated between their updates, jittered stamps
-replaced by the clock (timeline.py) and what is still uneven interpolated onto the grid of the
+replaced by the clock (regular_clock) and what is still uneven interpolated onto the grid of the
 median step by cubic splines (the zero-phase filter assumes equal steps).
 
     recording, report = regular_samples(recording)      # report.notes, report.warnings"""
@@ -14,13 +14,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from . import timeline
 from .recording import Recording
 
 UNEVEN = 0.01  # steps differing from the median by more than this share are not one grid
 HELD_MEDIAN = 2  # a block whose updates are this many rows apart (median) is at a lower rate
 LONG_GAP = 10  # warn when interpolation fills a gap of more than this many steps
 REPEATS_WORTH_SAYING = 0.001  # share of rows
+JITTER_SHARE = 0.45  # of a step: stamps further from the clock than this are not jitter
+ROUGHER = 0.5  # the clock is used when the positions' jerk energy over it is below this share
 
 
 @dataclass
@@ -29,7 +30,7 @@ class LogReport:
     held: dict = field(default_factory=dict)  # block -> median rows between its updates
     filled: int = 0  # samples interpolated onto the grid where the log had none
     longest_gap: float = 0.0  # s
-    clock: str | None = None  # timeline.regular's note, when the stamps were replaced by a clock
+    clock: str | None = None  # regular_clock's note, when the stamps were replaced by a clock
     notes: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
 
@@ -109,7 +110,7 @@ class Streamed:
     def _check(self, block) -> None:
         if block.t.size < 16 or self.report.warnings:
             return
-        held, jitter = held_blocks(block), timeline.regular(block.t, block.q)[1]
+        held, jitter = held_blocks(block), regular_clock(block.t, block.q)[1]
         if held or jitter:
             what = ", ".join(f"{k} updated every {v:g} rows" for k, v in held.items()) or "time stamps jitter"
             self.report.warnings.append(f"{block.name}: {what}; read in blocks, this is not repaired (the whole-recording "
@@ -170,7 +171,7 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
         report.warnings.append(f"{r.name}: mixed rates: {name} is updated only every {every:g} rows; interpolated "
                                "between its updates")
     report.held = held
-    t, note = timeline.regular(r.t, r.q)
+    t, note = regular_clock(r.t, r.q)
     if note:
         report.clock = note
         r = dataclasses.replace(r, t=t)
@@ -189,3 +190,38 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
             report.warnings.append(f"{r.name}: a gap of {1e3 * report.longest_gap:.3g} ms in the stamps "
                                    f"({report.longest_gap / period:.0f} steps) was filled by interpolation")
     return r, report
+
+
+def regular_clock(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """Sample times as the recording's clock took them, not as a logger stamped them when it wrote
+    them (the real LWR4+ recordings: 5 ms steps with pairs of 6.5 + 3.4 ms, a spike in the
+    differentiated acceleration at every pair): the clock t0 + k T (k counted from the stamps, so a
+    dropped sample stays a gap) when every stamp lies within JITTER_SHARE of a step from it, the
+    stamps differ from it, and the positions' jerk over it carries less than ROUGHER of its energy
+    over the stamps; otherwise the stamps and None."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 16:
+        return t, None
+    steps = np.diff(t)
+    # ticks counted step by step (a late stamp and the early one after it are one tick each;
+    # a step of two periods is a dropped sample), so that a slow drift of the stamps cannot
+    # make two samples one tick
+    k = np.concatenate([[0.0], np.cumsum(np.maximum(np.round(steps / np.median(steps)), 1.0))])
+    # The clock's period and phase as medians: most stamps are on time, and a logger's are
+    # late, never early, so a mean (a line fit) would put the clock late by their average delay.
+    half = t.size // 2
+    period = float(np.median((t[half:2 * half] - t[:half]) / (k[half:2 * half] - k[:half])))
+    clock = float(np.median(t - k * period)) + k * period
+    off = np.abs(t - clock)
+    if off.max() > JITTER_SHARE * period or off.max() <= 1e-6 * period:
+        return t, None
+    if _roughness(clock, q) >= ROUGHER * _roughness(t, q):
+        return t, None
+    return clock, (f"time stamps jitter by up to {1e3 * off.max():.2g} ms around a regular {1e3 * period:.4g} ms "
+                   "clock; the positions are smooth over the clock, not over the stamps: the clock is used")
+
+
+def _roughness(t: np.ndarray, q: np.ndarray) -> float:
+    """Median over joints of the energy of the positions' third derivative over times t."""
+    jerk = np.gradient(np.gradient(np.gradient(q, t, axis=0), t, axis=0), t, axis=0)
+    return float(np.median(np.sum(jerk ** 2, axis=0)))

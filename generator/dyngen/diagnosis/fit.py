@@ -40,14 +40,8 @@ def build(context, effects, segments, n) -> CandidateMoments:
             size = candidates[-1].start + candidates[-1].size
             moments = [dz.empty(n, size) for _ in range(3)]
             groups = [dz.empty(n, size) for _ in range(roles.FOLDS)]
-        roles_here = [*zip(moments, (seg.fit, seg.select, seg.test)), *zip(groups, seg.groups or [])]
-        for j in range(n):
-            A, slots = dz.joint_matrix(candidates, columns, j)
-            for m, mask in roles_here:
-                if mask.any():
-                    dz.accumulate(m, A[mask], slots, seg.residual[mask, j], j)
-        for m, mask in roles_here:
-            m.count += int(mask.sum())
+        dz.add_segment([*zip(moments, (seg.fit, seg.select, seg.test)), *zip(groups, seg.groups or [])],
+                      candidates, columns, seg)
     if moments[0].count == 0:
         raise ValueError("no fit samples (recordings too short for the filter's start-up?)")
     rms = np.sqrt(moments[0].c / max(moments[0].count, 1))

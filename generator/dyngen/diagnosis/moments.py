@@ -153,5 +153,18 @@ def accumulate(moments: Moments, A: np.ndarray, slots: np.ndarray, r: np.ndarray
     moments.c[joint] += r @ r
 
 
+def add_segment(roles, candidates, columns: dict, segment) -> None:
+    """Adds a segment's samples to each role's moments (roles: pairs of Moments and a mask (T,))."""
+    residual = segment.residual
+    for j in range(residual.shape[1]):
+        acting = [c for c in candidates if c.joint is None or c.joint == j]
+        A, slots = joint_matrix(acting, columns, j) if acting else (np.zeros((residual.shape[0], 0)), np.zeros(0, int))
+        for m, mask in roles:
+            if mask.any():
+                accumulate(m, A[mask], slots, residual[mask, j], j)
+    for m, mask in roles:
+        m.count += int(mask.sum())
+
+
 def empty(n_joints: int, size: int) -> Moments:
     return Moments(np.zeros((n_joints, size, size)), np.zeros((n_joints, size)), np.zeros(n_joints), 0)

@@ -1,11 +1,15 @@
 """Write a diagnosis: report.md, diagnosis.json, effects.yaml, the figures, the URDF and MJCF with
-the selected friction where the links are consistent, and consistent/ where they were found off."""
+the selected friction where the links are consistent, and consistent/ where they were found off;
+or, when the data cannot support one, what shows why (write_unusable)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
-from ..atomic import write_file
+import numpy as np
+
+from ..atomic import write_figure, write_file
 from . import reidentify, report, updated_model
 
 
@@ -53,3 +57,58 @@ def _consistent(diagnosis, robot, folder, sources: dict) -> dict:
     exported = write_all(robot, c.p, folder, c.joint_dynamics())
     paths.update({f"consistent/{path.name}": path for path in exported})
     return paths
+
+
+FIGURE = "conditioning.png"
+
+
+def _figure(record, path: Path) -> Path:
+    """conditioning.png: per joint the measured torque's RMS beside each trial's nominal residual."""
+    from .figures import plt  # with the Agg backend
+
+    trials = record.trials
+    n = trials[0].torque.size
+    fig, ax = plt.subplots(figsize=(10, 4))
+    width = 0.8 / (len(trials) + 1)
+    x = np.arange(n)
+    ax.bar(x, trials[0].torque, width, color="black", label="measured torque")
+    for k, t in enumerate(trials):
+        ax.bar(x + (k + 1) * width, t.residual, width, label=f"nominal residual: {t.how[:60]}")
+    ax.set_yscale("log")
+    ax.set_xticks(x + 0.4 - width / 2, [f"J{j + 1}" for j in range(n)])
+    ax.set_ylabel("RMS [Nm]")
+    ax.set_title(f"{record.recording}: the nominal residual exceeds the torque (conditioning cannot be trusted)")
+    ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    out = write_figure(path, fig, 110)
+    plt.close(fig)
+    return out
+
+
+def write_unusable(err, out_dir, sources: dict) -> dict:
+    """When the data cannot support a diagnosis (trust.Unusable): report.md with the one line and
+    every conditioning tried, diagnosis.json ({"usable": false}) and conditioning.png."""
+    out = Path(out_dir)
+    lines = ["# Diagnosis not possible: the conditioning cannot be trusted", "", f"**{err.line}**", "",
+             f"![the nominal residual against the torque]({FIGURE})", ""]
+    doc = {"schema": report.SCHEMA_VERSION, "usable": False, "reason": err.line, **sources, "recordings": []}
+    for r in err.recordings:
+        lines += [f"## {r.recording}", "", "| conditioning | cutoff [Hz] | " + " | ".join(
+            f"J{j + 1}" for j in range(r.trials[0].torque.size)) + " |",
+                  "|---|---:|" + "---:|" * r.trials[0].torque.size,
+                  "| measured torque RMS | | " + " | ".join(f"{v:.3g}" for v in r.trials[0].torque) + " |"]
+        for t in r.trials:
+            cut = "none" if t.cutoff is None else f"{t.cutoff:.3g}"
+            lines.append(f"| {t.how} | {cut} | " + " | ".join(f"{v:.3g}" for v in t.residual) + " |")
+        lines.append("")
+        doc["recordings"].append({"recording": r.recording, "torque_rms": r.trials[0].torque.tolist(),
+                                  "trials": [{"how": t.how, "cutoff": t.cutoff, "residual_rms": t.residual.tolist()}
+                                             for t in r.trials]})
+    lines += ["Nothing is claimed from these data. The nominal model's residual is larger than the torque it should "
+              "explain: differentiation noise (a logger's repeated or late rows, recorded accelerations that are "
+              "noise) or torques that do not belong to the positions. See docs/measured-data.md (logs as loggers "
+              "write them).", ""]
+    write_file(out / "report.md", "\n".join(lines))
+    write_file(out / "diagnosis.json", json.dumps(doc, indent=1) + "\n")
+    figure = _figure(err.recordings[0], out / FIGURE)
+    return {"report.md": out / "report.md", "diagnosis.json": out / "diagnosis.json", FIGURE: figure}

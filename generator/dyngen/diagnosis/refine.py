@@ -53,11 +53,8 @@ class _State:
         effects = list({c.effect.key: c.effect for c in chosen}.values())
         return [dz.effect_columns(effects, context, seg) for seg in self.segments]
 
-    def values(self, index, design=None, chosen=None) -> np.ndarray:
-        design, chosen = design or self.design, chosen or self.chosen
-        fit = solve(design, chosen)
-        offset = sum(c.size for c in chosen[:index])
-        return fit.x[offset: offset + chosen[index].size]
+    def values(self, index) -> np.ndarray:
+        return dz.split_values(self.chosen, solve(self.design, self.chosen).x)[index]
 
     def trial(self, index, setting):
         """(chosen, columns, design, context) with candidate `index` at another setting."""
@@ -121,19 +118,8 @@ class _State:
         fit, select, test = dz.empty(n, size), dz.empty(n, size), dz.empty(n, size)
         groups = [dz.empty(n, size) for _ in self.template.groups]
         for seg, cols in zip(self.segments, columns):
-            roles = [(fit, seg.fit), (select, seg.select), (test, seg.test),
-                     *zip(groups, _groups(seg, self.template))]
-            for j in range(n):
-                acting = [c for c in chosen if c.joint is None or c.joint == j]
-                if acting:
-                    A, slots = dz.joint_matrix(acting, cols, j)
-                else:
-                    A, slots = np.zeros((seg.residual.shape[0], 0)), np.zeros(0, dtype=int)
-                for moments, mask in roles:
-                    if mask.any():
-                        dz.accumulate(moments, A[mask], slots, seg.residual[mask, j], j)
-            for moments, mask in roles:
-                moments.count += int(mask.sum())
+            roles = [(fit, seg.fit), (select, seg.select), (test, seg.test), *zip(groups, _groups(seg, self.template))]
+            dz.add_segment(roles, chosen, cols, seg)
         return type(self.template)(chosen, fit, select, test, self.weights, groups)
 
 

@@ -37,12 +37,11 @@ def generators(labels, r: int, V, cone) -> np.ndarray:
     return M
 
 
-def signs(G, g, r: int, bounded: np.ndarray, free: np.ndarray | None = None, rounds: int = 20) -> np.ndarray:
+def signs(G, g, r: int, bounded: np.ndarray) -> np.ndarray:
     """The free set of the friction weights with only their signs imposed: the driver's starting guess."""
-    nf = G.shape[0] - r
-    free = np.ones(nf, dtype=bool) if free is None else free.copy()
+    free = np.ones(G.shape[0] - r, dtype=bool)
     ridge = 1e-12 * np.eye(G.shape[0])
-    for _ in range(rounds):
+    for _ in range(20):  # rounds of the active set
         idx = np.r_[np.arange(r), r + np.flatnonzero(free)]
         x = np.zeros(G.shape[0])
         x[idx] = np.linalg.lstsq(G[np.ix_(idx, idx)] + ridge[np.ix_(idx, idx)], g[idx], rcond=None)[0]

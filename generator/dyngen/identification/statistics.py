@@ -15,6 +15,7 @@ import tempfile
 import numpy as np
 from scipy import signal
 
+from ..data.correlation import truncated
 from .least_squares import WEAK, Estimate
 
 BLOCK_TIMES = 20  # block length in integrated autocorrelation times of the residual
@@ -64,11 +65,7 @@ class _Correlation:
         acf = self.products[k] - m * (2 * self.total - last - first) + (n - k) * m * m
         if not acf[0] > 1e-24 * max(self.products[0], 1e-300):
             return 1.0
-        rho = acf / acf[0]
-        limit = min(lags, n // 4)
-        below = np.flatnonzero(rho[1:limit + 1] < 0.05)
-        stop = below[0] + 1 if below.size else limit + 1
-        return float(max(1.0, 1.0 + 2.0 * rho[1:stop].sum()))
+        return truncated(acf / acf[0], min(lags, n // 4))
 
 
 def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:

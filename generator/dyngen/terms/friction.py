@@ -87,10 +87,6 @@ class Coulomb(_AtVelocity):
         hi = min([self.velocity * 4] + [e.velocity / STRIBECK_WIDER for e in beside if isinstance(e, Stribeck)])
         return min(self.velocity / 4, hi), hi
 
-    @classmethod
-    def friction_terms(cls, values, variant):
-        return {"Fc": values["Fc"], "vc": variant["vc"]}  # the fitted velocity scale
-
 
 class Viscous(Term):
     name, doc = "viscous", "viscous friction Fv qd"
@@ -112,10 +108,6 @@ class Viscous(Term):
 
     def columns(self, context, signals, tau_model):
         return self.regressor(signals.qd)
-
-    @classmethod
-    def friction_terms(cls, values, variant):
-        return {"Fv": values["Fv"]}
 
 
 class Stribeck(_AtVelocity):
@@ -169,10 +161,6 @@ class Stribeck(_AtVelocity):
         """No wider than STRIBECK_WIDER Coulomb scales (up to the search's 1 %): the two laws trade shape."""
         return isinstance(other, Coulomb) and self.velocity < 1.02 * STRIBECK_WIDER * other.velocity
 
-    @classmethod
-    def friction_terms(cls, values, variant):
-        return {"Fs": values["Fs"], "vs": variant["vs"]}  # its sign's smoothing: the context's (friction_vector)
-
 
 class Direction(Term):
     name, doc = "direction", "direction-dependent Coulomb friction dFc |tanh(qd / ed)| (Fc + dFc forwards, Fc - dFc back)"
@@ -197,10 +185,6 @@ class Direction(Term):
 
     def columns(self, context, signals, tau_model):
         return self.regressor(signals.qd, context.sign_velocity)
-
-    @classmethod
-    def friction_terms(cls, values, variant):
-        return {"dFc": values["dFc"]}  # its sign's smoothing: the context's (friction_vector)
 
 
 IN_FRICTION = (Coulomb, Viscous, Stribeck, Direction)  # the terms of the emitted friction routine, in its order

@@ -164,8 +164,10 @@ class Term:
 
     @classmethod
     def friction_terms(cls, values: dict, variant: dict) -> dict:
-        """Entries of its joint's emitted friction vector (FRICTION_FIELDS)."""
-        return {}
+        """Entries of its joint's emitted friction vector: its values, and the velocity settings its
+        variant fixes (the others are the diagnosis's sign velocity: updated_model.friction_vector)."""
+        return {f.name: values[f.name] if f.kind == "value" else variant[f.name]
+                for f in cls.friction if f.kind == "value" or f.name in variant}
 
     @classmethod
     def last_link(cls, values: dict, variant: dict | None = None) -> np.ndarray | None:
