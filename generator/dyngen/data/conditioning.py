@@ -35,7 +35,6 @@ def cutoff_of(text: str):
 
 @dataclass(frozen=True)
 class Conditioning:
-    """The signal conditioning options of the commands that read recordings."""
 
     cutoff: float | str | None = option(
         AUTO, "override: zero-phase Butterworth low-pass on positions and torques alike, in Hz, or 'none'. "

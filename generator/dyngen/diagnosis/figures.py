@@ -21,7 +21,6 @@ SHADED = {"reversal": "tab:orange", "standstill": "0.75"}
 
 
 def _shade(ax, t, mask, color):
-    """Shade the time intervals where mask is true."""
     if not mask.any():
         return
     edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))

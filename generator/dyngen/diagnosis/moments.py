@@ -70,7 +70,6 @@ def candidates_of(effects, n_joints: int, sizes: dict) -> list[Candidate]:
 
 
 def effect_columns(effects, context, segment) -> dict:
-    """effect key -> (T, N, k) columns on one segment."""
     return {e.key: columns_of(e, context, segment) for e in effects}
 
 

@@ -108,7 +108,6 @@ class _State:
         self.chosen, self.columns, self.design, self.context = trial
 
     def snapshot(self):
-        """The state as a trial, to accept again if a search fails."""
         return self.chosen, self.columns, self.design, self.context
 
     def restricted(self, chosen, columns):

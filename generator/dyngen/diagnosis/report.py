@@ -219,7 +219,6 @@ def worse_than_simple(d) -> str:
 
 
 def summary_lines(d) -> list[str]:
-    """A short table for the terminal."""
     where = "test" if d.judged_on == "test" else "selection (no test data)"
     out = [f"  {where} RMS per joint: nominal {' '.join(f'{x:.3f}' for x in d.rms_before)}",
            f"  {' ' * len(where)}               after   {' '.join(f'{x:.3f}' for x in d.rms_after)}",

@@ -11,7 +11,6 @@ from .forward_selection import bases, prune, selection_mse, solve, without
 
 
 def settle(context, segments, design, chosen, correlation, options):
-    """(design, chosen, final fit, dropped, refused)."""
     # Settings first (velocity scales, exact time shift and tilt), then pruning: a Stribeck term
     # that only made up for a Coulomb velocity scale on its variant grid goes once the scale is fitted.
     design, chosen = refine(context, segments, design, chosen)

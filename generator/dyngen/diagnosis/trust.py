@@ -54,7 +54,6 @@ class Untrusted:
 
 
 class Unusable(Exception):
-    """The conditioning of some recording cannot be trusted: nothing is claimed."""
 
     def __init__(self, line: str, recordings: list):
         super().__init__(line)

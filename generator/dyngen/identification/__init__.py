@@ -9,7 +9,6 @@ physically consistent identification with friction (consistent.py: its order of 
 
 from .consistent import Consistent, ConsistentOptions, identify_consistent
 from .least_squares import Estimate
-from .output import identified_yaml, summary_table
-from .samples import identify
+from .samples import identified_yaml, identify, summary_table
 
 __all__ = ["Consistent", "ConsistentOptions", "identify_consistent", "Estimate", "identified_yaml", "identify", "summary_table"]

@@ -69,13 +69,11 @@ def choose_lambda(solver, normal, folds: Folds, labels_idx, grid, rule: str = "1
         table.append((float(lam), float(s.weighted.mean())))
         means = np.array([m for _, m in table])
         best = int(np.argmin(means))
-        if len(table) - 1 > best and means[-1] > means[best] + _se(kept[table[best][0]].weighted):
+        limit = means[best] + _se(kept[table[best][0]].weighted)
+        if len(table) - 1 > best and means[-1] > limit:
             break
-    means = np.array([m for _, m in table])
-    best = int(np.argmin(means))
     chosen = best
     if rule == "1se" and len(folds.splits) > 1:
-        limit = means[best] + _se(kept[table[best][0]].weighted)
         chosen = max(i for i in range(len(means)) if means[i] <= limit)
     return table[chosen][0], table, kept
 

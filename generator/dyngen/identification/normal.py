@@ -27,14 +27,10 @@ def local_columns(labels, r: int, j: int, hidden: int) -> tuple[list[int], np.nd
     return ks, np.r_[np.arange(r), r + np.asarray(ks, dtype=int), r + len(labels) + np.arange(hidden)]
 
 
-def _in_rows(v: np.ndarray, j: int) -> np.ndarray:
-    """A label's column in joint j's rows ((T,) for a joint's label, (T, N) for the arm's)."""
-    return v[:, j] if v.ndim == 2 else v
-
-
 def label_design(piece, labels, j: int, ks, hidden: int) -> np.ndarray:
     """(T, len(ks) + hidden): joint j's rows of the labels ks, then the hidden column."""
-    return np.column_stack([_in_rows(piece.columns[labels[k]], j) for k in ks]
+    columns = [piece.columns[labels[k]] for k in ks]  # (T,) for a joint's label, (T, N) for the arm's
+    return np.column_stack([v[:, j] if v.ndim == 2 else v for v in columns]
                            + ([piece.along[:, j]] if hidden else []) + [np.zeros((piece.tau.shape[0], 0))])
 
 
@@ -155,7 +151,6 @@ class Swaps:
         self.g = np.zeros((len(makes), parts, dof))
 
     def of_block(self, piece) -> tuple:
-        """(rows, g) of the piece alone."""
         own = Swaps(self.labels, self.r, self.rows.shape[1], self.rows.shape[2], self.ks, self.makes, self.hidden)
         own.add(piece)
         return own.rows, own.g

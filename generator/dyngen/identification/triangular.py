@@ -40,7 +40,6 @@ class Triangular:
         return out
 
     def factor(self) -> np.ndarray:
-        """All joints' rows together: the (c+1, c+1) factor of the stacked [A | b]."""
         return fold(None, np.vstack([self._full(j) for j in range(self.dof)]))
 
     def _full(self, j) -> np.ndarray:

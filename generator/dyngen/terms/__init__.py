@@ -38,7 +38,6 @@ def check_names(names) -> None:
 
 
 def effect_class(name: str) -> type:
-    """The term a report entry names."""
     return next(term for term in TERMS if term.name == name)
 
 

@@ -109,7 +109,16 @@ class Payload(Term):
 
     @classmethod
     def last_link(cls, values, variant=None):
-        return None if None in values.values() else standard_of_payload(values, variant)
+        """Its 10 standard values, or a fixed shape's 4 (m, m c) with the variant's inertia per kg."""
+        if None in values.values():
+            return None
+        if "XX" in values:
+            return np.array(list(values.values()), dtype=float)
+        m = values["m"]
+        c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
+        J = inertia_array((variant or {}).get("inertia_per_kg", [0.0] * 6))
+        I = m * (J + _point(c))
+        return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
 
 
 class FixedShapePayload(Payload):
@@ -142,16 +151,6 @@ class FixedShapePayload(Payload):
         units = [np.array([1.0, 0, 0, 0, *(I[i, k] for i, k in _UPPER)]), *np.eye(PER_LINK)[1:4]]
         return self.regressor(context.model, signals.q, signals.qd, signals.qdd, np.array(units))
 
-    @classmethod
-    def last_link(cls, values, variant=None):
-        if None in values.values():
-            return None
-        m = values["m"]
-        c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
-        J = inertia_array((variant or {}).get("inertia_per_kg", [0.0] * 6))
-        I = m * (J + _point(c))
-        return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
-
 
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))  # XX, XY, XZ, YY, YZ, ZZ
 
@@ -179,13 +178,6 @@ def nearest_body_inertia(I) -> np.ndarray:
 def consistent_inertia(values) -> bool:
     """Whether a payload's 10 standard values describe a body (parameters.consistency_margin)."""
     return consistency_margin(dynamic_from_standard_link(values)) >= 0.0
-
-
-def standard_of_payload(values: dict, variant=None) -> np.ndarray:
-    """The 10 standard parameters of a selected payload (or a fixed shape's with its inertia per kg)."""
-    if "XX" in values:
-        return np.array(list(values.values()), dtype=float)
-    return FixedShapePayload.last_link(values, variant)
 
 
 def armature_identifiable(model, dof: int, seed: int = 0) -> list[bool]:

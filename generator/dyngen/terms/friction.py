@@ -31,7 +31,6 @@ STATIC_RESOLVED = 0.25  # ... and at least this share of it (see Stribeck.refusa
 
 
 def coulomb(qd, vc):
-    """tanh(qd / vc): the Coulomb law's shape."""
     return np.tanh(qd / vc)
 
 

@@ -23,7 +23,6 @@ class Ripple(Term):
 
     @staticmethod
     def harmonic(q, k: int, kind: str):
-        """cos(k q) or sin(k q): one column."""
         x = q if k == 1 else k * q
         return np.cos(x) if kind == "cos" else np.sin(x)
 

@@ -145,7 +145,6 @@ class Term:
         return None
 
     def at(self, setting: float) -> "Term":
-        """The same term at another setting."""
         raise NotImplementedError
 
     def fixed(self) -> dict:
@@ -159,7 +158,6 @@ class Term:
 
     @classmethod
     def warnings(cls, finding) -> list[str]:
-        """Warnings on a selected term's finding."""
         return []
 
     @classmethod

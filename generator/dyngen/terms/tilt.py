@@ -42,7 +42,6 @@ def directions(g) -> np.ndarray:
 
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
-    """u1, u2 of the robot's gravity (directions)."""
     D = directions([float(x) for x in robot.gravity])
     return D[0], D[1]
 
@@ -115,10 +114,22 @@ def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
     return B
 
 
-class Tilt(Term):
+class _Gravity(Term):
+    """A term of the recording's gravity torques G(q) (recording_gravity), ranged relative to |g|."""
+
+    scope = "arm"
+
+    def reads(self, context):
+        return (context.load,)
+
+    def range_scales(self):
+        return {"g": self.g}
+
+
+class Tilt(_Gravity):
     """As a candidate it is linearised at the current estimate, refined once selected (refine.py)."""
 
-    name, scope, doc = "tilt", "arm", "a tilted base: gravity turned by dg1 u1 + dg2 u2, its size kept"
+    name, doc = "tilt", "a tilted base: gravity turned by dg1 u1 + dg2 u2, its size kept"
     values = (Value("dg1", "m/s^2"), Value("dg2", "m/s^2"))
     refinable = True
 
@@ -145,12 +156,6 @@ class Tilt(Term):
     def columns(self, context, signals, tau_model):
         return self.regressor(recording_gravity(context, signals), *self.directions, self.g, self.estimate)
 
-    def reads(self, context):
-        return (context.load,)
-
-    def range_scales(self):
-        return {"g": self.g}
-
     @property
     def setting(self):
         return np.array(self.estimate)
@@ -172,8 +177,8 @@ class Tilt(Term):
                 "tilt_total_deg": angle_deg(self.g, a)}
 
 
-class GravityScale(Term):
-    name, scope, doc = "gravity_scale", "arm", "gravity's size changed by dg: every link's gravity torque scaled alike"
+class GravityScale(_Gravity):
+    name, doc = "gravity_scale", "gravity's size changed by dg: every link's gravity torque scaled alike"
     values = (Value("dg", "m/s^2", -MAX_GRAVITY_SCALE, MAX_GRAVITY_SCALE, per="g"),)
     suspect = ("no tilt changes gravity's size; every link's gravity torque scaled alike points at masses and "
                "centres of mass wrong by one factor, or at a torque-sensor gain")
@@ -192,12 +197,6 @@ class GravityScale(Term):
 
     def columns(self, context, signals, tau_model):
         return self.regressor(recording_gravity(context, signals), *tilt_directions(context.robot))
-
-    def reads(self, context):
-        return (context.load,)
-
-    def range_scales(self):
-        return {"g": self.g}
 
     def derived(self, robot, values, std, torque_rms):
         return {} if values.get("dg") is None else {"relative": values["dg"] / self.g}
