@@ -1,11 +1,6 @@
-"""The low-pass cutoff for differentiating recorded positions, decided from the recording.
-
-A zero-phase low-pass of cutoff fc leaves, for white position noise sigma_q at rate fs, an
-acceleration noise sigma_qdd(fc) = sigma_q (2 pi)^2 sqrt(fc^5 / (5 fs / 2)) (ideal low-pass); the
-cutoff is the largest whose noise stays below NOISE_SHARE of the motion's acceleration RMS
-(iterated from fs / 20), sigma_q from robust third differences (white noise of sigma gives
-sigma sqrt(20)). The motion's band (99 % of its velocity power) is reported beside it: a cutoff
-below twice the band means the noise limits what can be seen."""
+"""The low-pass cutoff for differentiating recorded positions, decided from the recording: the
+largest whose acceleration noise, sigma_q (2 pi)^2 sqrt(fc^5 / (5 fs / 2)) for white position noise
+sigma_q at rate fs, stays below NOISE_SHARE of the motion's acceleration RMS (docs/measured-data.md)."""
 
 from __future__ import annotations
 
@@ -31,8 +26,7 @@ class Decision:
 
 
 def position_noise(q: np.ndarray) -> np.ndarray:
-    """Per joint sigma of white noise on q from robust third differences, or the spectrum's where it
-    shows clearly more broadband error (spectral_noise)."""
+    """Per joint white-noise sigma of q from robust third differences, or the spectrum's where larger."""
     if q.shape[0] < 8:
         return np.zeros(q.shape[1])
     d3 = np.diff(q, n=3, axis=0)
@@ -75,8 +69,7 @@ def motion_band(qd: np.ndarray, rate: float) -> float:
 
 
 def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision:
-    """lowpass_of(cutoff) -> a filter of (T, ...) arrays along time. order 1: q are recorded
-    velocities, differentiated once."""
+    """lowpass_of(cutoff) -> a filter along time; order 1: q are recorded velocities, differentiated once."""
     rate = 1.0 / float(np.median(np.diff(t)))
     sigma = position_noise(q)
 

@@ -1,10 +1,7 @@
-"""Signal conditioning: what the models take from a recording.
-
-Velocities and accelerations are the recording's own when it has them, else central differences
-of the positions through a zero-phase Butterworth low-pass whose cutoff is decided from the
-recording (automatic.py) or given. The same filter (kept as Signals.lowpass) passes positions,
-torques and whatever is compared with the torque; `trim` samples at each end are its start-up.
-Rows as a logger wrote them are first made samples of one regular clock (log_quality.py)."""
+"""Signal conditioning: what the models take from a recording. Recorded qd, qdd are used as they are,
+else q is differentiated through a zero-phase Butterworth low-pass (cutoff from automatic.py, or
+given) kept as Signals.lowpass for everything compared with the torque; `trim` samples at each end
+are its start-up. Rows as a logger wrote them are made one regular clock's first (log_quality.py)."""
 
 from __future__ import annotations
 
@@ -105,11 +102,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     if isinstance(cutoff, str):
         if cutoff != AUTO:
             raise InputError(r.name, "cutoff", f"{cutoff!r}: expected a frequency in Hz or {AUTO!r}")
-        if differentiate:
-            decision = automatic.decide(r.t, r.q, lambda fc: _lowpass(r.name, rate, fc, options.order))
-            cutoff = decision.cutoff
-        elif r.qdd is None:  # recorded qd, differentiated once: through a cutoff chosen from qd's noise
-            decision = automatic.decide(r.t, r.qd, lambda fc: _lowpass(r.name, rate, fc, options.order), order=1)
+        if differentiate or r.qdd is None:  # q differentiated twice, or recorded qd once: a cutoff from its noise
+            decision = automatic.decide(r.t, r.q if differentiate else r.qd,
+                                        lambda fc: _lowpass(r.name, rate, fc, options.order), 2 if differentiate else 1)
             cutoff = decision.cutoff
         else:
             cutoff = None  # the recording's own velocities: nothing to differentiate, nothing to filter

@@ -1,8 +1,6 @@
-"""A recording as a logger wrote it, made into samples of one regular clock before filtering:
-repeated rows (every value equal to the row before while the arm moves) left out, held columns
-(a block updated only every k-th row) interpolated between their updates, jittered stamps
-replaced by the clock (regular_clock) and what is still uneven interpolated onto the grid of the
-median step by cubic splines (the zero-phase filter assumes equal steps).
+"""A recording as a logger wrote it, made into samples of one regular clock before filtering: repeated
+rows left out, held columns interpolated between their updates, jittered stamps replaced by the
+clock, uneven ones interpolated onto a regular grid (docs/measured-data.md, "Logs as loggers write them").
 
     recording, report = regular_samples(recording)      # report.notes, report.warnings"""
 
@@ -64,9 +62,7 @@ def repeated_rows(r: Recording) -> np.ndarray:
 
 
 def _repeats(data: np.ndarray, q: np.ndarray, before=None) -> tuple[np.ndarray, int]:
-    """(repeats as repeated_rows has them, the first row of the run of repeats at the end): a run
-    counts when the row after it has other positions than the run; a run at the very end (no row
-    after it) is kept. before: the row before data's first (a block of a longer recording)."""
+    """(repeats, the first row of a run at the end): a run counts when the row after it has other positions."""
     same = np.zeros(data.shape[0], dtype=bool)
     same[1:] = np.all(data[1:] == data[:-1], axis=1)
     if before is not None and data.shape[0]:

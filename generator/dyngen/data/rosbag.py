@@ -1,9 +1,6 @@
-"""A ROS 2 bag's joint states as a Recording (through rosbags, the optional extra `formats`): its
-sensor_msgs/JointState topic (the one ending in joint_states, or the only one), header stamps as
-t, positions, velocities (when every message has them) and measured efforts; with
-`effort_topic`, tau is the latest effort of that topic at or before each joint state. Format and
-rules: docs/many-recordings.md. Messages are decoded by rosbags' CDR reader for these fixed
-types only: nothing in the bag is executed."""
+"""A ROS 2 bag's joint states as a Recording, through rosbags (the optional extra `formats`), tau the
+measured efforts or `effort_topic`'s latest before each state (docs/many-recordings.md). Messages
+are decoded by rosbags' CDR reader for these fixed types only: nothing in the bag is executed."""
 
 from __future__ import annotations
 

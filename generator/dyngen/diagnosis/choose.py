@@ -16,8 +16,7 @@ from .forward_selection import solve
 
 
 def on_folds(context, segments, design, chosen, final, options) -> list[str]:
-    """Per joint model (joints.py) from its selection errors summed over the roles.FOLDS cuts of the fit
-    recordings into fit and selection blocks, refitted per cut: every sample judges once."""
+    """Per joint model (joints.py) from selection errors summed over the roles.FOLDS cuts, refitted per cut."""
     totals = None
     for phase in range(roles.FOLDS):
         cut = [replace(seg, **dict(zip(("fit", "select"), roles.blocks(seg.signals, options.block_seconds, phase))))
@@ -36,8 +35,7 @@ def on_folds(context, segments, design, chosen, final, options) -> list[str]:
 
 
 def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain, flagged):
-    """(Consistent result, its corrections per segment, modes) where the consistent link parameters win
-    a joint `flagged` by reidentify.gate on selection data, else (None, None, modes)."""
+    """(Consistent result, corrections, modes) where consistent links win a flagged joint; else no result."""
     if not flagged:
         return None, None, modes
     result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
@@ -52,8 +50,7 @@ def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, m
 
 
 def refit(robot, model, p, segments, reid, consistent):
-    """The consistent model refitted on every fit sample, kept if it fits about as well as the one from
-    the fit blocks alone (reidentify.REFIT_WORSE)."""
+    """The consistent model refitted on every fit sample, kept unless it fits worse (reidentify.REFIT_WORSE)."""
     refit = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"), regularisation=reid.regularisation)
     if np.all(refit.residual_rms <= reidentify.REFIT_WORSE * reid.residual_rms):
         return refit, reidentify.corrections(refit, model, segments)

@@ -14,8 +14,7 @@ from .forward_selection import relative_change, selection_gain, selection_mse
 
 
 def describe(robot, design, chosen, final, cand, min_gain) -> Finding:
-    """What an effect does on the selection data (its gain, the joints it helps); its values
-    are filled in by with_values once the final fit is made."""
+    """What an effect does on the selection data (its gain, the joints it helps); values come in with_values."""
     mse_without = selection_mse(design, [c for c in chosen if c is not cand])
     mse_with = selection_mse(design, chosen)
     gain_per_joint = relative_change(mse_without, mse_with)
@@ -30,8 +29,7 @@ def describe(robot, design, chosen, final, cand, min_gain) -> Finding:
 
 
 def with_values(described, design, chosen, final, tau_corr, robot) -> list[Finding]:
-    """The findings with the final values of every chosen effect, deviations scaled for the
-    residual's correlation in time, and what follows from them (Term.derived)."""
+    """The findings with the final values, deviations scaled for the correlation time, and Term.derived."""
     offset, out = 0, []
     for cand, e in zip(chosen, described):
         k = slice(offset, offset + cand.size)
@@ -64,8 +62,7 @@ def identifiable(design, chosen) -> np.ndarray:
 
 
 def reported(chosen, described, replaced) -> tuple[list[Finding], list[Finding]]:
-    """(selected, superseded): superseded are per-joint findings on joints another model won (replaced,
-    0-based); an arm-wide finding keeps the other joints."""
+    """(selected, superseded on joints another model won); an arm-wide finding keeps the other joints."""
     selected, superseded = [], []
     for c, e in zip(chosen, described):
         if c.joint is not None and c.joint in replaced:

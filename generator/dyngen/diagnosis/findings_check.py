@@ -1,7 +1,5 @@
-"""A finding is physical or it is flagged: a per-joint offset or ripple whose torque exceeds LARGER
-times its joint's whole nominal residual (RMS, selection data), or a rotor inertia outside
-identify's range (sanity.rotor_inertia_range) or as large, is marked `suspect`; two such terms
-on one joint are named as not told apart (docs/measured-data.md, "A finding is physical").
+"""A finding is physical or it is flagged `suspect`: an offset, ripple or rotor inertia whose torque
+exceeds LARGER times its joint's nominal residual, or a rotor inertia outside identify's range.
 
     selected, warnings = check(selected, selection_before, model, s, fit_signals)"""
 

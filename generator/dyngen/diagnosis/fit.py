@@ -80,16 +80,13 @@ def reweighted(design, final) -> CandidateMoments:
 
 def correlation_time(segments, weights) -> float:
     """Integrated autocorrelation time of the final weighted fit residual, median over joints."""
-    times = []
-    for j, w in enumerate(weights):
-        r = np.concatenate([(seg.residual - seg.correction)[seg.fit, j] for seg in segments])
-        times.append(integrated_time(w * r))
+    times = [integrated_time(w * np.concatenate([(seg.residual - seg.correction)[seg.fit, j] for seg in segments]))
+             for j, w in enumerate(weights)]
     return float(np.median(times))
 
 
 def ranged(context, segments, chosen):
-    """The context with the positions the fit samples cover (Context.q_range) if a chosen effect needs
-    them (Term.ranged); else the context itself."""
+    """The context with the positions the fit samples cover (Context.q_range) if a chosen effect needs them."""
     if not any(c.effect.ranged for c in chosen):
         return context
     q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])

@@ -1,12 +1,7 @@
 """Forward selection of effects by what they do on selection data (never on the fit's samples), and
-prune(), backward elimination once their settings are refined (settle.py).
-
-Fit: weighted least squares on the fit samples, each joint's rows divided by the RMS of its nominal
-residual. A step adds the candidate with the largest selection gain per sqrt of its values whose
-values are significant (chi-square, p < alpha) and plausible (Term.plausible); an arm-wide effect
-must gain on two joints; among candidates within NEAR_BEST of the best, the fewest values win (a
-payload before 43 coefficient errors) and a secondary effect (Term.secondary) only if no plainer
-one is near. The reasons and measurements: docs/measured-data.md ("Selection")."""
+prune(), backward elimination once their settings are refined (settle.py). A step takes the
+candidate with the largest selection gain per sqrt of its values that is significant and plausible;
+near ties go to the fewest values and plainer effects. Rules and reasons: docs/measured-data.md."""
 
 from __future__ import annotations
 
@@ -66,15 +61,13 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
 
 
 def _factored(H: np.ndarray):
-    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal (the columns' units differ by orders of
-    magnitude): H^-1 b = Hs^-1 (b / d) / d."""
+    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal (units differ by orders): H^-1 b = Hs^-1 (b / d) / d."""
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
     return _solver(H / np.outer(d, d)), d
 
 
 def _solver(Hs: np.ndarray):
-    """b -> Hs^-1 b: Cholesky, or a pseudo-inverse when columns are dependent (they then share no value
-    instead of taking arbitrary large ones)."""
+    """b -> Hs^-1 b: Cholesky, or a pseudo-inverse when columns are dependent (they then share no value)."""
     if Hs.size == 0:
         return lambda b: np.zeros_like(b)
     try:
@@ -94,8 +87,7 @@ def significant(fit: Fit, candidate, chosen, alpha: float = ALPHA, correlation: 
 
 
 def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
-    """Chi-square test of the candidate's values against zero, the covariance scaled by the residual's
-    correlation time in samples (data/correlation.py)."""
+    """Chi-square test of the candidate's values against zero, the covariance scaled by the correlation time."""
     offset = sum(c.size for c in chosen[:chosen.index(candidate)])
     k = slice(offset, offset + candidate.size)
     x, C = fit.x[k], fit.covariance_of(k) * correlation
@@ -145,8 +137,7 @@ def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
 
 
 def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps: int = 30) -> Selection:
-    """Forward steps; their significance test assumes uncorrelated residuals (prune() applies the
-    correlation-scaled one)."""
+    """Forward steps; their significance test assumes uncorrelated residuals (prune() scales it)."""
     selection = Selection([])
     current = selection_mse(design, [])
     tau = 1.0
@@ -183,8 +174,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
 
 
 def _shown(candidate, before, after, min_gain) -> bool:
-    """An arm-wide effect must gain min_gain on at least two joints (on one, that joint's own effects
-    are the plainer explanation)."""
+    """An arm-wide effect must gain min_gain on two joints (on one, that joint's own effects explain it)."""
     if candidate.joint is None:
         relative = relative_change(before, after)
         return int(np.sum(relative >= min_gain)) >= min(2, len(relative))

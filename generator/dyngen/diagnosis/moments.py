@@ -109,8 +109,7 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
 
 
 def world(context, chosen) -> dict:
-    """The Context fields the chosen set: a time shift's delay, each joint's 1 + sensor gain (scale) and
-    a payload (load); none without them."""
+    """The Context fields the chosen set: a time shift's delay, 1 + each sensor gain (scale), a payload (load)."""
     delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
     scale = None

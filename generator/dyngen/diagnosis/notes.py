@@ -12,9 +12,7 @@ DIFFERENTIATION_SHARE = 0.5  # warn when differentiation noise is this share of 
 
 
 def notes(d, model, s, fit_signals, select_signals, test_signals, used) -> list[str]:
-    out = []
-    for sig in [*fit_signals, *select_signals, *test_signals]:
-        out += sig.warnings
+    out = [w for sig in [*fit_signals, *select_signals, *test_signals] for w in sig.warnings]
     if d.judged_on == "selection":
         out.append("no test recording (--test): the residual 'after' is measured on the selection data, which chose "
                    "the effects; it is not a held-out figure")

@@ -86,8 +86,7 @@ def _figure(record, path: Path) -> Path:
 
 
 def write_unusable(err, out_dir, sources: dict) -> dict:
-    """When the data cannot support a diagnosis (trust.Unusable): report.md with the one line and
-    every conditioning tried, diagnosis.json ({"usable": false}) and conditioning.png."""
+    """When the data cannot support a diagnosis (trust.Unusable): report.md, diagnosis.json and the figure."""
     out = Path(out_dir)
     lines = ["# Diagnosis not possible: the conditioning cannot be trusted", "", f"**{err.line}**", "",
              f"![the nominal residual against the torque]({FIGURE})", ""]

@@ -52,8 +52,7 @@ def by_phase(residual: np.ndarray, masks: dict) -> list[dict]:
 
 
 def _near_reversals(t, v, moving, window) -> np.ndarray:
-    """Samples within `window` of a reversal: consecutive moving samples of opposite sign at most 2
-    windows apart (noise at standstill does not count)."""
+    """Samples within `window` of a reversal: moving samples of opposite sign at most 2 windows apart."""
     idx = np.flatnonzero(moving)
     flips = np.flatnonzero((np.sign(v[idx[1:]]) != np.sign(v[idx[:-1]])) & (t[idx[1:]] - t[idx[:-1]] <= 2 * window))
     times = 0.5 * (t[idx[flips]] + t[idx[flips + 1]])

@@ -1,12 +1,8 @@
-"""Nonlinear settings of selected effects, refined after the selection on the fit samples (every
-other selected effect refitted each time; selection and test data unused): a setting the fitted
-values imply (Term.implied_setting: time shift, gain, payload, tilt) by fixed-point iteration,
-with the secant method where that fails; one independent of them (Term.search_interval: a
-velocity scale) by a bounded scalar search for the smallest weighted fit residual.
+"""Nonlinear settings of selected effects, refined on the fit samples, every other selected effect
+refitted each time: a setting the values imply (Term.implied_setting) by fixed-point iteration (the
+secant method where that fails), one independent of them (Term.search_interval) by a bounded search.
 
-    design, chosen = refine(context, segments, design, chosen)
-
-returns a design of the chosen candidates alone (slots renumbered), weighted as the selection's."""
+    design, chosen = refine(context, segments, design, chosen)   # a design of the chosen alone"""
 
 from __future__ import annotations
 
@@ -33,8 +29,7 @@ def refine(context, segments, design, chosen):
 
 
 def restricted(context, segments, design, chosen):
-    """The design of the chosen candidates alone on the segments' current masks, weighted as `design`;
-    and the candidates renumbered."""
+    """The design of the chosen alone on the segments' current masks, weighted as `design`; renumbered."""
     state = _State(context, segments, design, _renumbered(chosen))
     return state.design, state.chosen
 

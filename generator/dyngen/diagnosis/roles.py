@@ -17,8 +17,7 @@ REPEATED_SHARE = 0.02  # RMS position difference below this share of the motion'
 
 @dataclass(frozen=True)
 class Segment:
-    """One recording with the model's torques, its residual and its samples' roles (frozen: a stage
-    returns new segments)."""
+    """One recording with the model's torques, its residual and its samples' roles (frozen)."""
 
     signals: object
     tau_model: np.ndarray
@@ -41,18 +40,15 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
 
     none = lambda sig: np.zeros(sig.t.size, dtype=bool)  # noqa: E731
     if select_signals:
-        for sig in fit_signals:
-            out.append(segment(sig, sig.inner(), none(sig), none(sig)))
-        for sig in select_signals:
-            out.append(segment(sig, none(sig), sig.inner(), none(sig)))
+        out += [segment(sig, sig.inner(), none(sig), none(sig)) for sig in fit_signals]
+        out += [segment(sig, none(sig), sig.inner(), none(sig)) for sig in select_signals]
         split = "selection on separate recordings"
     else:
         for sig in fit_signals:
             fit, select = blocks(sig, block_seconds)
             out.append(segment(sig, fit, select, none(sig), [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]))
         split = f"selection on blocks of {block_seconds:g} s of the fit data (each third of them in turn)"
-    for sig in test_signals or []:
-        out.append(segment(sig, none(sig), none(sig), sig.inner()))
+    out += [segment(sig, none(sig), none(sig), sig.inner()) for sig in test_signals or []]
     return out, split
 
 
@@ -60,8 +56,7 @@ FOLDS = 3  # every third block selects; the per-joint models are compared over a
 
 
 def blocks(sig, block_seconds: float, phase: int = FOLDS - 1) -> tuple[np.ndarray, np.ndarray]:
-    """(fit, select) masks: blocks phase, phase + FOLDS, ... select, the rest fit, the filter's reach
-    around every cut in neither."""
+    """(fit, select) masks: blocks phase, phase + FOLDS, ... select, the filter's reach at cuts in neither."""
     inner = sig.inner()
     block = np.floor((sig.t - sig.t[0]) / block_seconds).astype(int)
     select = block % FOLDS == phase

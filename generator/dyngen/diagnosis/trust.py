@@ -1,9 +1,6 @@
-"""Whether a recording's conditioning can be trusted, before anything is claimed from it: where the
-nominal residual exceeds ABOVE times the measured torque (RMS, joints above TORQUE_FLOOR of the
-largest), the recording is conditioned again (automatic cutoff only: positions differentiated,
-cutoffs halved down to MIN_CUTOFF, the highest within KEEP of the best kept); when nothing helps,
-Unusable (exit status EXIT_UNUSABLE, no effect claimed). docs/measured-data.md, "When
-conditioning cannot be trusted".
+"""Whether a recording's conditioning can be trusted before anything is claimed: where the nominal
+residual exceeds ABOVE times the torque, the recording is conditioned again (automatic cutoff only);
+when nothing helps, Unusable (docs/measured-data.md, "When conditioning cannot be trusted").
 
     signals = checked(model, s, signals)"""
 
@@ -115,11 +112,8 @@ def checked(model, s, signals: list) -> list:
         record = Untrusted(sig.name, [first])
         best = None
         if sig.source is not None and sig.options is not None and sig.options.cutoff == AUTO:
-            tried = []
-            for how, other in _alternatives(sig):
-                t = trial(model, s, other, how)
-                record.trials.append(t)
-                tried.append((t, other))
+            tried = [(trial(model, s, other, how), other) for how, other in _alternatives(sig)]
+            record.trials += [t for t, _ in tried]
             good = [(t, o) for t, o in tried if not t.above]
             if good:
                 floor = min(t.share for t, _ in good)

@@ -15,8 +15,7 @@ FRICTION_FIELDS = FRICTION_NAMES  # the emitted <robot>_friction's vector, per j
 
 
 def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
-    """f for <robot>_friction, FRICTION_FIELDS per joint: the laws as fitted, their velocity scales
-    included (the Stribeck and direction signs smoothed with sign_velocity, as in the columns)."""
+    """f for <robot>_friction: the laws as fitted, velocity scales included (signs at sign_velocity)."""
     f = np.zeros((diagnosis.joints, len(FRICTION_FIELDS)))
     for name in ("vc", "es", "ed"):
         f[:, FRICTION_FIELDS.index(name)] = sign_velocity

@@ -1,14 +1,8 @@
-"""The excitation design: a Fourier series at rest at its ends, scaled into the limits, with the
-condition number of the identification matrix minimised over its coefficients.
-
-Joint j's qd_j(t) = sum_l a_jl cos(w l t) + b_jl sin(w l t) (validation.excitation.FourierTrajectory);
-at rest at t = 0, sum_l a_jl = 0 and sum_l l b_jl = 0 fix a_j1 and b_j1. Limits by construction:
-each joint's motion about its centre is scaled by the largest factor that keeps position, velocity
-and acceleration within `margin` of their limits (peaks on GRID_PER_HARMONIC points per period of
-the highest harmonic), and shrunk further to keep the flange in the workspace box. Criterion:
-log cond(A), A the rigid body's regressor and the per-joint columns `dyngen identify` fits by
-default (terms.joint_columns, Coulomb at EXCITATION_SCALE), on `points` samples of a period;
-L-BFGS-B from the best of `candidates` random starts, every draw from `seed`. docs/measured-data.md."""
+"""The excitation design: a Fourier series at rest at its ends (validation.excitation.FourierTrajectory),
+scaled into the limits by construction, with log cond of the identification matrix (the rigid body's
+regressor and identify's default per-joint columns, terms.joint_columns) minimised over its
+coefficients by L-BFGS-B from the best of `candidates` random starts, every draw from `seed`
+(docs/measured-data.md, "Excitation and physically consistent identification")."""
 
 from __future__ import annotations
 
@@ -91,8 +85,7 @@ class _Shape:
         self.size = self.n + 2 * self.n * (self.L - 1)
 
     def random(self, rng) -> np.ndarray:
-        """A random x: centres within 20 % of the range about the middle, coefficients falling
-        as 1 / harmonic."""
+        """A random x: centres within 20 % of the range about the middle, coefficients falling as 1 / harmonic."""
         decay = np.tile(np.repeat(1.0 / np.arange(2, self.L + 1)[None, :], 2, axis=0).ravel(), self.n)
         return np.concatenate([rng.uniform(-0.2, 0.2, self.n), rng.standard_normal(self.size - self.n) * decay])
 

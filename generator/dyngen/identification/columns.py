@@ -46,8 +46,7 @@ def lagged(t, x, lag: float) -> np.ndarray:
 
 
 def switching_filter(signals):
-    """The filter the recording's torques went through, for columns that switch with the velocity's
-    sign (redesigned for the rate where samples were decimated after filtering); identity without."""
+    """The recording's low-pass, for columns switching with the velocity's sign (redesigned if decimated)."""
     lowpass = getattr(signals, "lowpass", None)
     cutoff = getattr(signals, "cutoff", None)
     if lowpass is None or cutoff is None or len(signals.t) < 16:
@@ -79,8 +78,7 @@ def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
 
 @dataclass
 class Piece:
-    """A block of one recording as the fit sees it (blocks.py): its data samples, the regressor once,
-    and the part (fold) of each sample."""
+    """A block of one recording as the fit sees it (blocks.py): data samples, regressor and part of each sample."""
 
     signals: object  # the block's samples: t, q, qd, qdd, tau
     keep: slice  # the data samples among them

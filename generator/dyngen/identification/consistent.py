@@ -58,8 +58,7 @@ def _at(dof, smoothing, lags):
 
 
 def _coulomb(blocks, normal, fit, options, dof, swaps=None):
-    """(smoothing, lags, normal) chosen per joint on the fit data unless given (swaps: the smoothing
-    grid's trials, summed in the normal equations' pass); the blocks follow the choice."""
+    """(smoothing, lags, normal) chosen per joint on the fit data unless given; the blocks follow the choice."""
     smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
     ks = [k for k, (kind, _) in enumerate(normal.labels) if kind == "coulomb"]
@@ -212,8 +211,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
 
 
 def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam, workers):
-    """Step 5: each optional group (tilt; per joint ripple and friction falling with speed) kept where it
-    gains on held-out data by more than a standard error: (active labels, cone joints, decisions)."""
+    """Step 5: each optional group kept where it gains on held-out data by more than a standard error."""
     labels = normal.labels
     decisions, out, out_cone = [], set(active), set(cone)
     for group in ("tilt", "ripple", "falling"):

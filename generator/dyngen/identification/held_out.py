@@ -1,9 +1,6 @@
-"""Choices made on held-out data, never on test data: the prior's weight lambda and which optional
-column groups stay. Held out: the `select` recordings, or each contiguous part of the fit
-recordings once; a score is the held-out mean square weighted like the fit (and per joint), every
-fit the consistent one. lambda: the largest within one standard error of the best (the walk up
-the grid stops once past it); a group stays where it gains by more than one standard error of the
-paired differences (docs/measured-data.md)."""
+"""Choices made on held-out data (the `select` recordings, or each contiguous part of the fit data
+once), never on test data: the prior's weight lambda (the one-standard-error rule) and which optional
+column groups stay (a gain over one standard error of the paired differences): docs/measured-data.md."""
 
 from __future__ import annotations
 
@@ -35,8 +32,7 @@ class Scores:
 
 
 def scores(solver, normal, folds: Folds, labels_idx, lam: float, free=None, workers: int = 1, cone=()) -> Scores:
-    """Each fold's consistent fit of the coefficients and labels_idx at lam (cone: joints whose friction
-    may fall with speed), scored on its held-out parts."""
+    """Each fold's consistent fit of the coefficients and labels_idx at lam, scored on its held-out parts."""
     r = normal.r
     keep = np.r_[np.arange(r), r + np.asarray(labels_idx, dtype=int)]
     labels = [normal.labels[k] for k in labels_idx]

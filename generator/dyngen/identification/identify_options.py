@@ -33,8 +33,7 @@ REGULARISATION_GRID = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0)
 
 @dataclass
 class ConsistentOptions:
-    """Options of the consistent identification; those declared with option(...) are also
-    `dyngen identify` flags (dyngen.options), the rest the method's own settings."""
+    """The consistent identification's options: with option(...), also `dyngen identify` flags."""
 
     friction: tuple = option(DEFAULT_KINDS, "per-joint columns always in: " + ", ".join(CHOICES)
                              + " (ripple: cos q_j, sin q_j)", metavar="LIST", listed=True, choices=CHOICES)

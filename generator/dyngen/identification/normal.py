@@ -57,8 +57,7 @@ class Normal:
 
     @classmethod
     def build(cls, pieces, labels, r: int, parts: int, dof: int, swaps=None, hidden: int = 0) -> "Normal":
-        """swaps: also summed in the same pass. Blocks are summed on their own (Blocks.each) and added in
-        block order: the same additions in the same order as in one process."""
+        """swaps: summed in the same pass. Blocks summed on their own (Blocks.each) and added in block order."""
         out = cls(r, labels, parts, dof, hidden)
 
         def of_block(piece):
@@ -112,8 +111,7 @@ class Normal:
                                 np.stack([m.g[:, j] for j, m in enumerate(normals)], axis=1))
 
     def rotated(self, ks, betas) -> "Normal":
-        """A copy in which label ks[d]'s column is c_d - betas[d] * w (w the first hidden column): M^T G M
-        and M^T g without reading the rows again."""
+        """A copy with label ks[d]'s column c_d - betas[d] * w (w the first hidden column): M^T G M, M^T g."""
         M = np.eye(self.G.shape[-1])
         for k, beta in zip(ks, betas):
             M[self.r + len(self.labels), self.r + k] = -beta
@@ -142,8 +140,7 @@ class Normal:
 
 
 class Swaps:
-    """The Coulomb searches' variants: per joint one label (ks), variant v's columns makes[v](piece),
-    summed piece by piece; normals(base): per variant, base with those rows and columns replaced."""
+    """The Coulomb searches' variants: per joint one label (ks), variant v's columns makes[v](piece)."""
 
     def __init__(self, labels, r: int, parts: int, dof: int, ks, makes, hidden: int = 0):
         self.labels, self.r, self.ks, self.makes, self.hidden = labels, r, ks, makes, hidden
@@ -181,8 +178,7 @@ class Swaps:
 
 
 def solve_unconstrained(G, g, weak: float = WEAK) -> np.ndarray:
-    """Least squares through the normal equations of unit-norm columns, cut at weak^2 of the largest
-    eigenvalue (directions the data do not excite get no value)."""
+    """Least squares on unit-norm columns, cut at weak^2 of the largest eigenvalue (unexcited: no value)."""
     scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
     ev, V = np.linalg.eigh(G / np.outer(scale, scale))
     keep = ev > weak ** 2 * ev[-1]

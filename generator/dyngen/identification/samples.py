@@ -35,9 +35,7 @@ def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray
 
 
 def identify(model, signals: list, kind: str) -> Estimate:
-    """The least-squares fit of every sample of the conditioned recordings: their rows folded
-    into per-joint triangular factors as `dyngen identify --ols` folds its blocks
-    (streaming/step.py, identification/triangular.py), then least_squares.fit_factor."""
+    """The least-squares fit of every sample, folded into per-joint triangular factors as --ols folds blocks."""
     if kind not in REGRESSOR:
         raise ValueError(f"unknown kind {kind!r}; expected one of {', '.join(REGRESSOR)}")
     names = [e["standard"] for e in model.manifest["coefficients"][kind]["expressions"]]
@@ -65,8 +63,7 @@ def identify(model, signals: list, kind: str) -> Estimate:
 
 
 def identified_yaml(robot_name: str, estimates: dict, sources: list[str], conditioning: str) -> str:
-    """estimates: kind -> Estimate. Coefficients are written as their standard-parameter
-    expressions (dyngen's base coefficients), which `identified:` accepts as they are."""
+    """estimates: kind -> Estimate; coefficients written as standard-parameter expressions."""
     lines = [f"# Base coefficients of {robot_name} identified by dyngen (least squares, eq. 11) from "
              f"{', '.join(sources)}.",
              f"# Conditioning: {conditioning}.",

@@ -3,12 +3,8 @@
     min_{s, f}  x^T G x - 2 x^T g  +  lambda || pi(s) - pi(prior) ||^2_D,   x = (pi(s), f)
     s.t.  every link consistent, the YAML's bounds and total mass; signs of the friction values
 
-The free friction values minimised in closed form leave || R pi - v ||^2 (R the Cholesky factor
-of the Schur complement): the extraction's cost, solved by its driver unchanged. The signs are
-an active set around it (Lawson-Hanson), started from the unconstrained fit's. Per joint
-Fc, Fv, Ia >= 0, or for the joints in `cone` Fc >= 0, Fc + Fv V >= 0 (V the velocity limit:
-friction falling with speed that still opposes motion), again signs in the cone's generators.
-lambda is relative to unit-norm columns."""
+The free friction values minimised in closed form leave the extraction's cost || R pi - v ||^2;
+the signs are an active set around it (docs/measured-data.md). lambda is relative to unit-norm columns."""
 
 from __future__ import annotations
 
@@ -72,8 +68,7 @@ class Solver:
         self.pi_prior = model("pi_full", prior) if prior is not None else None
 
     def solve(self, gram, rhs, labels, lam: float, restarts=None, free=None, cone=()):
-        """(x = (pi, natural friction values), free set, rounds, extraction result) for the normal equations
-        of the coefficients and `labels`; cone: joints held dissipative rather than Fv >= 0."""
+        """(x = (pi, natural friction values), free set, rounds, extraction result); cone: joints held dissipative."""
         r = self.r
         M = generators(labels, r, self.V, cone)
         gram, rhs = M.T @ gram @ M, M.T @ rhs

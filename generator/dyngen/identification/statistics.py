@@ -1,11 +1,6 @@
-"""What a user needs to trust the identified values: a standard deviation per column that holds for
-real data, the condition numbers, and the columns not excited (least_squares.py), of the
-unconstrained weighted fit of the same columns.
-
-The deviation is the sandwich (batch means) estimate Cov(x) = H^-1 S H^-1, H = A^T W A,
-S = sum_b s_b s_b^T, s_b = sum_{t in block b} a_t w_t e_t, over contiguous blocks of BLOCK_TIMES
-correlation times of the residual (at least MIN_BLOCKS, else the textbook deviation times the
-square root of the correlation time), never below the textbook deviation."""
+"""What a user needs to trust the identified values, from the unconstrained weighted fit of the same
+columns: the sandwich (batch means) deviation H^-1 S H^-1 over blocks of BLOCK_TIMES correlation
+times (at least MIN_BLOCKS; never below the textbook one), condition numbers, unexcited columns."""
 
 from __future__ import annotations
 
@@ -39,8 +34,7 @@ def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int)
 
 
 class _Correlation:
-    """data.correlation.integrated_time of a series given a block at a time (the lag products up to LAGS,
-    the sum, the first and last LAGS values)."""
+    """data.correlation.integrated_time of a series given a block at a time."""
 
     def __init__(self):
         self.n, self.total = 0, 0.0
@@ -82,8 +76,7 @@ def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
 
 
 def _score_blocks(spilled, length: int):
-    """(sum over blocks of s s^T, count): s the scores of a contiguous block of `length` samples of a
-    recording (a last, shorter one left out); spilled: per piece (source, first sample, its file)."""
+    """(sum over blocks of s s^T, count) of contiguous blocks of `length` score rows per recording."""
     S, count = 0.0, 0
     current, index, open_sum = None, -1, None
 

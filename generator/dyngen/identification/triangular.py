@@ -1,8 +1,6 @@
-"""Least squares accumulated block by block, per joint, memory independent of the row count: the
-rows [A_j | b_j] are folded into the triangular factor of their QR decomposition,
-R_j <- triu(qr([R_j; A_block b_block])) (the normal equations without squaring the condition).
-R_j holds all a fit needs (least_squares.fit_factor, which the in-memory fit also goes through),
-and factors of recordings, joints or machines stack the same way."""
+"""Least squares accumulated block by block, per joint: the rows [A_j | b_j] folded into the
+triangular factor of their QR, R_j <- triu(qr([R_j; A_block b_block])), all a fit needs
+(least_squares.fit_factor), memory independent of the row count; factors stack the same way."""
 
 from __future__ import annotations
 

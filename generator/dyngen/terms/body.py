@@ -122,8 +122,7 @@ class Payload(Term):
 
 
 class FixedShapePayload(Payload):
-    """A payload of a fixed shape (centre c0, inertia J0 about it per kg), its mass fitted: values m and
-    m c; its inertia about the origin m (J0 + |c0|^2 1 - c0 c0^T) is a body's for any m > 0."""
+    """A payload of a fixed shape (centre c0, inertia J0 about it per kg), its values m and m c."""
 
     values = Payload.values[:4]
 
@@ -162,8 +161,7 @@ def _point(c) -> np.ndarray:
 
 
 def nearest_body_inertia(I) -> np.ndarray:
-    """The inertia nearest to the symmetric I (principal moments, same axes) a body can have: moments
-    non-negative, none above the other two together; the nearest valid projection onto the cone's faces."""
+    """The body inertia nearest to the symmetric I (principal moments; the nearest valid face projection)."""
     e, V = np.linalg.eigh(I)
     faces = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], dtype=float)
     best, distance = np.zeros(3), np.inf

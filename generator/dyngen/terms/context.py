@@ -8,15 +8,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-# Bytes of columns the memo keeps: beyond it the least recently used go (and are computed again
-# if asked for: the same numbers, so no result depends on the bound). Unbounded, every setting
-# a refinement trial tried stayed for the whole diagnosis: 3.7 GB for 5 minutes at 200 Hz.
+# Bytes of columns the memo keeps (beyond, the least recently used go: computed again, the same
+# numbers). Unbounded, every refinement trial's columns stayed: 3.7 GB for 5 minutes at 200 Hz.
 MEMO_BYTES = 256 << 20
 
 
 class Memo:
-    """compute() once per key, kept while the values' bytes stay under `limit` (least recently used
-    evicted first); shared by a context and its dataclasses.replace copies."""
+    """compute() once per key, kept within `limit` bytes (least recently used evicted first)."""
 
     def __init__(self, limit: int | None = None):
         self.limit = MEMO_BYTES if limit is None else limit
@@ -57,11 +55,9 @@ class Context:
     sign_velocity: float  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity) (diagnosis Options)
     q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
     qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
-    # The arm and its torque sensor as the chosen terms have them (design.as_chosen): every
-    # other term's torque is measured `delay` s late (a time shift), and the arm's (terms
-    # not of the sensor) times `scale[j]` on joint j (1 + a sensor gain; None: 1 on every
-    # joint); `load`: (m, mx, my, mz) of a payload on the last link, whose gravity a tilt turns
-    # with the arm's.
+    # The arm and sensor as the chosen terms have them (moments.as_chosen): other terms' torques
+    # measured `delay` s late, the arm's times `scale[j]` on joint j (1 + a sensor gain; None: 1),
+    # `load` (m, mx, my, mz) of a payload on the last link, whose gravity a tilt turns too.
     delay: float = 0.0
     scale: tuple | None = None
     load: tuple | None = None

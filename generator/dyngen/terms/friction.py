@@ -202,8 +202,7 @@ def friction_torque(m, qd, f) -> list:
 
 
 def c_terms(names, v: str = "v", vector: str = "fj") -> list[dict]:
-    """The friction routine's terms for its template: doc line, fields and C on one joint (v its
-    velocity, vector[k] its k-th field; names: the C names of sgn, exp, abs and zero)."""
+    """The friction template's terms: doc, fields and C on one joint (v, vector[k]; names: sgn, exp, abs, zero)."""
     index = {name: k for k, name in enumerate(FRICTION_NAMES)}
     return [{"name": term.name, "doc": term.doc, "fields": term.friction,
              "c": term.c(v, lambda name: f"{vector}[{index[name]}]", names)} for term in IN_FRICTION]

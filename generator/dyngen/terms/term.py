@@ -15,8 +15,7 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Value:
-    """A fitted value or a setting: name, unit and the open interval (low, high) a physical one lies in,
-    in units of `per` ("" absolute, "g" the size of gravity, "arm mass")."""
+    """A fitted value or setting: name, unit, open interval (low, high) in units of `per` ("", "g", "arm mass")."""
 
     name: str
     unit: str
@@ -31,8 +30,7 @@ class Value:
 
 @dataclass(frozen=True)
 class FrictionField:
-    """One entry of a joint's emitted friction vector: a term's value or its velocity setting (a
-    scale; the plain sign or no term when <= 0)."""
+    """One entry of a joint's emitted friction vector: a term's value or velocity setting (<= 0: plain sign)."""
 
     name: str
     kind: str  # "value" | "velocity"
@@ -152,8 +150,7 @@ class Term:
         return {}
 
     def derived(self, robot, values: dict, std: dict, torque_rms) -> dict:
-        """What a reader wants beside the fitted values (None where undetermined); torque_rms(): RMS torque
-        of the values on the fit data (per-joint terms)."""
+        """What a reader wants beside the values; torque_rms(): RMS torque on the fit data (per-joint terms)."""
         return {}
 
     @classmethod

@@ -59,8 +59,7 @@ def tilt_axes(robot) -> tuple[str, str]:
 
 
 def angle_deg(g, a) -> float:
-    """The tilt angle [deg] that gives gravity g (vector or size) the components a across it:
-    |a| = |g| sin(angle). The one formula for identify and the diagnosis."""
+    """The tilt angle [deg] giving gravity g the components a across it, |a| = |g| sin(angle): the one formula."""
     return float(np.degrees(np.arcsin(min(np.hypot(*a[:2]) / np.linalg.norm(g), 1.0))))
 
 
@@ -97,8 +96,7 @@ def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
 
 
 def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
-    """B (T, N, 3, 4): G(q) of a body on the last link per unit of its (m, mx, my, mz): for a revolute
-    joint i, B_i = -[z x (o_N - o), z x R_N e_x, z x R_N e_y, z x R_N e_z]; prismatic [-z, 0, 0, 0]."""
+    """B (T, N, 3, 4): G(q) of a body on the last link per unit of (m, mx, my, mz): -z x (o_N - o), -z x R_N e_k."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     poses = poses or forward_kinematics(robot.joint_models, q)
     last = poses[-1]
