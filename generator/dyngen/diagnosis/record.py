@@ -91,7 +91,6 @@ class Diagnosis:
     selection_after: list
     selection_simple: list
     simple_wins: list  # 1-based joints where the simple model beat the effects on selection data
-    # (joint_models below: per joint "effects", "simple" or "effects + simple", joints.py)
     simple_values: list  # per joint b, Fc, Fv
     peak_before: list
     noise_rms: list  # per joint estimate of the white part of the final judged residual
@@ -104,13 +103,11 @@ class Diagnosis:
     unstable: list[Unstable]  # selected, kept in the model, but not claimed: unstable across blocks
     correlation_samples: float  # integrated autocorrelation time used to scale the deviations
     warnings: list = field(default_factory=list)
-    joint_models: list = field(default_factory=list)
+    joint_models: list = field(default_factory=list)  # per joint "effects", "simple", "effects + simple"... (joints.py)
     completed: dict = field(default_factory=dict)  # joint -> values of [its effects' columns, b, Fc, Fv]
     conditioning: list[RecordingNote] = field(default_factory=list)
     segments: list = field(default_factory=list)  # roles.Segment, for figures
-    # per joint on the judged data at the joint velocities the fit data covered: share of samples
-    # beyond them, RMS of the final and of the simple model there (velocity laws extrapolate beyond)
-    within_fit_speeds: dict = field(default_factory=dict)
+    within_fit_speeds: dict = field(default_factory=dict)  # share of judged samples beyond the fit speeds; RMS within
     consistent: LinksOff | None = None  # "link parameters off", where the consistent model won
     reidentified: object = None  # its identification.consistent.Consistent (for the written parameters)
     control: str = ""  # what the comparison with a control run (--control) found, "" without one

@@ -34,9 +34,6 @@ from .identify_options import BOUNDS, LAG_GRID, SMOOTHING_GRID, ConsistentOption
 from .solver import Solver
 from .statistics import estimate
 
-# ---------------------------------------------------------------------------------------------
-# step 2: the Coulomb term's smoothing and lag
-
 
 def _coulomb_search(normal, trials, fit, grid, tolerance: float):
     """Per joint, the grid value whose trial (normal with every Coulomb column at it) leaves joint j the
@@ -58,7 +55,7 @@ def _at(dof, smoothing, lags):
 
 
 def _coulomb(blocks, normal, fit, options, dof, swaps=None):
-    """(smoothing, lags, normal) chosen per joint on the fit data unless given; the blocks follow the choice."""
+    """Step 2: (smoothing, lags, normal) chosen per joint on the fit data unless given; the blocks follow."""
     smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     lags = np.zeros(dof)
     ks = [k for k, (kind, _) in enumerate(normal.labels) if kind == "coulomb"]
@@ -74,10 +71,6 @@ def _coulomb(blocks, normal, fit, options, dof, swaps=None):
         lags, normal = _coulomb_search(normal, trials, fit, LAG_GRID, 1e-3)
         blocks.lags = lags
     return smoothing, lags, normal
-
-
-# ---------------------------------------------------------------------------------------------
-# the identification
 
 
 def _labels(kinds, armature_ok, dof, with_tilt: bool) -> list:
