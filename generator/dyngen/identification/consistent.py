@@ -1,16 +1,10 @@
 """Physically consistent identification with friction: the extraction's convex problem with the
-data's cost,
-
-    min_{s, f}  || Y pi(s) + F f - tau ||_W^2  +  lambda || pi(s) - pi(prior) ||_D^2
-    s.t.  every link consistent, the YAML's bounds and total mass, per joint Fc, Fv, Ia >= 0,
-
-W weighting joint j's rows by 1 / sigma_j, F the columns of columns.py. The order of work, on the
-fit recordings only: 1. the columns and the normal equations per part and joint, once (normal.py);
-2. the Coulomb smoothing and lag per joint; 3. the noise per joint, the weights, and the columns
-the data cannot separate left out; 4. lambda on held-out data (held_out.py); 5. each optional
-group kept or left out there; 6. the consistent fit on all fit data (solver.py), a tilt refitted
-as a rotation; 7. the statistics of the same columns (statistics.py). docs/measured-data.md,
-"Excitation and physically consistent identification"."""
+data's cost, min || Y pi(s) + F f - tau ||_W^2 + lambda || pi(s) - pi(prior) ||_D^2 over consistent
+links within the YAML's bounds and mass, Fc, Fv, Ia >= 0 (W: 1 / sigma_j; F: columns.py). On the
+fit recordings only: 1. the normal equations per part and joint, once (normal.py); 2. the Coulomb
+smoothing and lag; 3. the weights and the columns the data cannot separate; 4. lambda and 5. the
+optional groups on held-out data (held_out.py); 6. the consistent fit (solver.py); 7. the
+statistics (statistics.py). docs/measured-data.md, "Excitation and physically consistent identification"."""
 
 from __future__ import annotations
 
@@ -230,10 +224,8 @@ def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam,
 
 
 def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior, g_vec, notes, dropped):
-    """Step 6: the consistent fit on all fit data; a tilt refitted as a rotation and refused beyond
-    tilt.MAX_TILT_DEG. The tilt's torques are the prior's links' (a horizontal gravity meets first
-    moments the data's gravity never shows: with the identified ones the tilt in MuJoCo data fell from
-    2 to 0.8 deg)."""
+    """Step 6: the consistent fit; a tilt refitted as a rotation, refused beyond tilt.MAX_TILT_DEG, its
+    torques the prior's links' (their first moments across gravity the data cannot give)."""
     labels, r = normal.labels, normal.r
 
     def fit_with(act):

@@ -1,12 +1,7 @@
-"""Stacked regressors and measurements of eq. (11), from conditioned recordings.
-
-kind "gravity":  Y_g(q_k) pi_g = tau_k, the recordings' torques read as gravity torques
-                 (static poses, or the FRI's g(q) as in the paper, eq. 9);
-kind "inertia":  Y_m(q_k) pi_m = m~_k, the stacked inertia matrix in columns M11, M12, ...
-                 (the FRI's M(q), eq. 10);
-kind "full":     Y(q_k, qd_k, qdd_k) pi = tau_k, torque trajectories;
-their least-squares fit (identify), and the identified coefficients as the YAML `identified:` block
-that `dyngen extract` reads (docs/conventions.md) and as a short table."""
+"""Least squares of eq. (11) from conditioned recordings: kind "gravity" Y_g(q) pi_g = tau (static
+poses, or the FRI's g(q), eq. 9), "inertia" Y_m(q) pi_m = the stacked M11, M12, ... columns (the
+FRI's M(q), eq. 10), "full" Y(q, qd, qdd) pi = tau; and the identified coefficients as the YAML
+`identified:` block that `dyngen extract` reads (docs/conventions.md) and as a short table."""
 
 from __future__ import annotations
 
