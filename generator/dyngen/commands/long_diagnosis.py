@@ -34,14 +34,15 @@ def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
 
 def read_windows(paths, robot, args, max_rows: int) -> list:
     """--select and --test recordings, read in blocks: whole within max_rows samples, else
-    evenly spread windows of them (streaming/sample.py); conditioned, each on its own."""
+    evenly spread windows of them (streaming/sample.py: those of --test judged over every row,
+    diagnosis/pipeline.py); conditioned, each on its own."""
     from ..data import condition
     from ..data.recording import check_informative
     from ..streaming.sample import windows
 
     recordings = []
     for path in paths:
-        got = windows(path, robot.dof, args.effort_topic, max_rows)
+        got = windows(path, robot.dof, args.effort_topic, max_rows, conditioning=conditioning_of(args))
         recordings += got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
     check_informative(recordings, True)
     return [condition(r, conditioning_of(args)) for r in recordings]

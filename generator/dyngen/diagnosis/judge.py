@@ -1,10 +1,14 @@
 """Stage 5, test: the figures on the judged data (the test recordings, or without them the
 selection data): RMS before, after, with the effects alone and with the simple model, per
-phase of the motion, the noise left, and within the speeds the fit data covered."""
+phase of the motion, the noise left, and within the speeds the fit data covered.
+
+Of a long test recording diagnosed on windows (streaming/sample.py), the four mean squares are
+over every row of it, read again in blocks (over_every_row); its peak, noise, phases and speed
+shares stay those of its windows."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -52,6 +56,22 @@ def judge(design, segments, chosen, final, simple) -> Judged:
     noise = np.std(np.diff(held_after, axis=0), axis=0) / np.sqrt(2)
     return Judged(on, before, after, effects_mse, simple_mse_, np.abs(held_before).max(axis=0), noise, where,
                   within_fit_speeds(segments, simple, used, mask), used)
+
+
+def over_every_row(judged: Judged, pieces, simple) -> Judged:
+    """judged with its mean squares before, after, with the effects alone and with the simple
+    model summed over `pieces`: (segment with its final correction, the effects' torques (T, N))
+    one at a time, over their test samples (the in-memory test segments, and every row of the
+    long test recordings block by block)."""
+    sse, count = np.zeros((4, judged.before.size)), 0
+    for seg, effects in pieces:
+        m = seg.test
+        r = seg.residual[m]
+        for row, x in zip(sse, (r, r - seg.correction[m], r - effects[m], r - simple_model.predict(simple, seg)[m])):
+            row += (x ** 2).sum(axis=0)
+        count += int(m.sum())
+    before, after, effects_mse, simple_mse_ = sse / max(count, 1)
+    return replace(judged, before=before, after=after, effects=effects_mse, simple=simple_mse_)
 
 
 def within_fit_speeds(segments, simple, used, mask) -> dict:

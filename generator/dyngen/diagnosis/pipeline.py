@@ -33,7 +33,7 @@ from . import moments as dz
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
-from .judge import judge, simple_mse
+from .judge import judge, over_every_row, simple_mse
 from .notes import notes
 from .record import CandidateGain, Diagnosis, RecordingNote, Unstable
 from .refine import restricted
@@ -62,6 +62,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     judged_segments, completed = joints.apply(final.context, final.segments, final.chosen, final.fit.x, final.simple,
                                               choice.modes, final.consistent)
     judged = judge(final.design, judged_segments, final.chosen, final.fit, final.simple)
+    judged = _every_test_row(model, final, choice.modes, completed, judged, judged_segments)
     # 6. report
     roles_of = (("fit", fit_signals), ("select", select_signals or []), ("test", test or []))
     result = _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
@@ -178,7 +179,7 @@ def _final_fit(robot, model, p, context, settled, choice, separate_selection) ->
             final = solve(design, chosen)
         if reid is not None:
             reid, consistent = choose.refit(robot, model, p, fitting, reid, consistent)
-    streams = _streams(fitting)
+    streams = _streams([seg for seg in fitting if seg.fit.any()])  # not the --select or --test windows
     if streams and chosen:  # windows of long recordings: the values from every row of them
         design = replace(design, fit=every_row(context, chosen, streams, design.fit.G.shape[1]))
         final = solve(design, chosen)
@@ -198,31 +199,64 @@ def _streams(segments) -> list:
 
 def every_row(context, chosen, tasks, size: int) -> dz.Moments:
     """The fit moments (size slots) of the chosen candidates over every row of the recordings
-    `tasks`, read again in blocks (repeated rows left out, as conditioning does): each block's
-    nominal residual and the chosen effects' columns at the windows' settings and ranges. Only
+    `tasks`, read again in blocks (block_segments): each block's nominal residual and the chosen
+    effects' columns at the windows' settings and ranges."""
+    effects = list({c.effect.key: c.effect for c in chosen}.values())
+    world = dz.as_chosen(context, chosen)
+    out = dz.empty(len(context.robot.joints), size)
+    for seg in block_segments(context, tasks, "fit"):
+        columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
+        for j in range(out.G.shape[0]):
+            acting = [c for c in chosen if c.joint is None or c.joint == j]
+            A, slots = dz.joint_matrix(acting, columns, j) if acting else (np.zeros((seg.residual.shape[0], 0)),
+                                                                           np.zeros(0, dtype=int))
+            dz.accumulate(out, A, slots, seg.residual[:, j], j)
+        out.count += seg.residual.shape[0]
+    return out
+
+
+def _every_test_row(model, final, modes, completed, judged, segments):
+    """The held-out figures over every row of the long test recordings whose windows were judged
+    (judge.over_every_row), each block corrected as apply corrected the windows; the other test
+    segments as they were. Without such recordings, judged as it is."""
+    held = [seg for seg in segments if seg.test.any()]
+    streams = _streams([seg for seg in held if not (seg.fit.any() or seg.select.any())])
+    if not streams:
+        return judged
+    kept = [seg for seg in held if getattr(getattr(seg.signals, "source", None), "stream", None) not in streams]
+    chosen, x = final.chosen, final.fit.x
+
+    def pieces():
+        for seg in kept:
+            yield seg, fit.predict(final.context, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
+        for seg in block_segments(final.context, streams, "test"):
+            context = replace(final.context, cache={})  # a memo per block, not kept
+            (effects,) = fit.corrected(context, chosen, x, [seg])
+            consistent = None if final.reidentified is None else reidentify.corrections(final.reidentified, model,
+                                                                                         [effects])
+            (seg,), _ = joints.apply(context, [effects], chosen, x, final.simple, modes, consistent, completed)
+            yield seg, effects.correction
+
+    return over_every_row(judged, pieces(), final.simple)
+
+
+def block_segments(context, tasks, role: str):
+    """Every row of the recordings `tasks` (streaming.gap.GapTask or alike: path, dof, rows,
+    effort_topic), read in blocks, repeated rows left out as conditioning does, one
+    roles.Segment per block with the nominal residual, all its samples in `role`. Only
     recordings whose blocks are conditioned on their own are marked so (qd and qdd recorded, no
     filter); a law that reads earlier samples (a time shift) starts each block afresh."""
     from ..data.chunks import chunks
     from ..data.conditioning import Signals
     from ..data.log_quality import Streamed
 
-    effects = list({c.effect.key: c.effect for c in chosen}.values())
-    world = dz.as_chosen(context, chosen)
-    out = dz.empty(len(context.robot.joints), size)
     for task in tasks:
         for block in Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)):
             signals = Signals(block.name, block.t, block.q, block.qd, block.qdd, block.tau, block.extra)
             tau_model = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, context.s)
             every = np.ones(block.t.size, dtype=bool)
-            seg = roles.Segment(signals, tau_model, signals.tau - tau_model, every, ~every, ~every)
-            columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
-            for j in range(out.G.shape[0]):
-                acting = [c for c in chosen if c.joint is None or c.joint == j]
-                A, slots = dz.joint_matrix(acting, columns, j) if acting else (np.zeros((block.t.size, 0)),
-                                                                               np.zeros(0, dtype=int))
-                dz.accumulate(out, A, slots, seg.residual[:, j], j)
-            out.count += block.t.size
-    return out
+            masks = {name: every if name == role else ~every for name in ("fit", "select", "test")}
+            yield roles.Segment(signals, tau_model, signals.tau - tau_model, **masks)
 
 
 def _why_not_tried(precision) -> str:
