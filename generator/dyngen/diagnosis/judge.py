@@ -58,20 +58,24 @@ def judge(design, segments, chosen, final, simple) -> Judged:
                   within_fit_speeds(segments, simple, used, mask), used)
 
 
-def over_every_row(judged: Judged, pieces, simple) -> Judged:
+def held_sums(seg, effects, simple) -> tuple[np.ndarray, int]:
+    """((4, N) sums of squares over the segment's test samples before, after its final
+    correction, after the effects' torques (T, N) alone and after the simple model; their count)."""
+    m = seg.test
+    r = seg.residual[m]
+    return np.array([((r - x) ** 2).sum(axis=0) for x in (0.0, seg.correction[m], effects[m],
+                                                          simple_model.predict(simple, seg)[m])]), int(m.sum())
+
+
+def over_every_row(judged: Judged, sums) -> Judged:
     """judged with its mean squares before, after, with the effects alone and with the simple
-    model summed over `pieces`: (segment with its final correction, the effects' torques (T, N))
-    one at a time, over their test samples (the in-memory test segments, and every row of the
-    long test recordings block by block)."""
-    sse, count = np.zeros((4, judged.before.size)), 0
-    for seg, effects in pieces:
-        m = seg.test
-        r = seg.residual[m]
-        for row, x in zip(sse, (r, r - seg.correction[m], r - effects[m], r - simple_model.predict(simple, seg)[m])):
-            row += (x ** 2).sum(axis=0)
-        count += int(m.sum())
-    before, after, effects_mse, simple_mse_ = sse / max(count, 1)
-    return replace(judged, before=before, after=after, effects=effects_mse, simple=simple_mse_)
+    model from `sums` (held_sums, one segment at a time: the in-memory test segments, and every
+    row of the long test recordings block by block), added in order."""
+    sse, count = 0.0, 0
+    for part, rows in sums:
+        sse, count = sse + part, count + rows
+    before, after, effects, simple = sse / max(count, 1)
+    return replace(judged, before=before, after=after, effects=effects, simple=simple)
 
 
 def within_fit_speeds(segments, simple, used, mask) -> dict:

@@ -22,18 +22,20 @@ effects, test_signals are used for nothing but the reported held-out residual (r
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
+from ..streaming.engine import in_order
 from ..terms import Context, library, simple_model
 from . import across, choose, findings_check, fit, joints, reidentify, roles, stable, trust
 from . import moments as dz
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
-from .judge import judge, over_every_row, simple_mse
+from .judge import held_sums, judge, over_every_row, simple_mse
 from .notes import notes
 from .record import CandidateGain, Diagnosis, RecordingNote, Unstable
 from .refine import restricted
@@ -199,20 +201,32 @@ def _streams(segments) -> list:
 
 def every_row(context, chosen, tasks, size: int) -> dz.Moments:
     """The fit moments (size slots) of the chosen candidates over every row of the recordings
-    `tasks`, read again in blocks (block_segments): each block's nominal residual and the chosen
-    effects' columns at the windows' settings and ranges."""
+    `tasks`, read again in blocks (blocks_of): each block's nominal residual and the chosen
+    effects' columns at the windows' settings and ranges, on both cores (streaming.engine.in_order:
+    the blocks' moments added in block order, as one process adds them)."""
     effects = list({c.effect.key: c.effect for c in chosen}.values())
     world = dz.as_chosen(context, chosen)
-    out = dz.empty(len(context.robot.joints), size)
-    for seg in block_segments(context, tasks, "fit"):
+    n = len(context.robot.joints)
+
+    def of_block(block) -> dz.Moments:
+        seg = block_segment(context, block, "fit")
         columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
-        for j in range(out.G.shape[0]):
+        out = dz.empty(n, size)
+        for j in range(n):
             acting = [c for c in chosen if c.joint is None or c.joint == j]
             A, slots = dz.joint_matrix(acting, columns, j) if acting else (np.zeros((seg.residual.shape[0], 0)),
                                                                            np.zeros(0, dtype=int))
             dz.accumulate(out, A, slots, seg.residual[:, j], j)
-        out.count += seg.residual.shape[0]
-    return out
+        out.count = seg.residual.shape[0]
+        return out
+
+    total = dz.empty(n, size)
+    for part in in_order(of_block, blocks_of(tasks)):  # a slot a block does not touch adds an exact zero
+        total.G += part.G
+        total.b += part.b
+        total.c += part.c
+        total.count += part.count
+    return total
 
 
 def _every_test_row(model, final, modes, completed, judged, segments):
@@ -226,37 +240,41 @@ def _every_test_row(model, final, modes, completed, judged, segments):
     kept = [seg for seg in held if getattr(getattr(seg.signals, "source", None), "stream", None) not in streams]
     chosen, x = final.chosen, final.fit.x
 
-    def pieces():
-        for seg in kept:
-            yield seg, fit.predict(final.context, chosen, x, seg) if chosen else np.zeros_like(seg.residual)
-        for seg in block_segments(final.context, streams, "test"):
-            context = replace(final.context, cache={})  # a memo per block, not kept
-            (effects,) = fit.corrected(context, chosen, x, [seg])
-            consistent = None if final.reidentified is None else reidentify.corrections(final.reidentified, model,
-                                                                                         [effects])
-            (seg,), _ = joints.apply(context, [effects], chosen, x, final.simple, modes, consistent, completed)
-            yield seg, effects.correction
+    def of_block(block):
+        seg = block_segment(final.context, block, "test")
+        context = replace(final.context, cache={})  # a memo per block, not kept
+        (effects,) = fit.corrected(context, chosen, x, [seg])
+        consistent = None if final.reidentified is None else reidentify.corrections(final.reidentified, model,
+                                                                                     [effects])
+        (seg,), _ = joints.apply(context, [effects], chosen, x, final.simple, modes, consistent, completed)
+        return held_sums(seg, effects.correction, final.simple)
 
-    return over_every_row(judged, pieces(), final.simple)
+    own = [held_sums(seg, fit.predict(final.context, chosen, x, seg) if chosen else np.zeros_like(seg.residual),
+                     final.simple) for seg in kept]
+    return over_every_row(judged, itertools.chain(own, in_order(of_block, blocks_of(streams))))
 
 
-def block_segments(context, tasks, role: str):
+def blocks_of(tasks):
     """Every row of the recordings `tasks` (streaming.gap.GapTask or alike: path, dof, rows,
-    effort_topic), read in blocks, repeated rows left out as conditioning does, one
-    roles.Segment per block with the nominal residual, all its samples in `role`. Only
-    recordings whose blocks are conditioned on their own are marked so (qd and qdd recorded, no
-    filter); a law that reads earlier samples (a time shift) starts each block afresh."""
+    effort_topic), read in blocks, repeated rows left out as conditioning does. Only recordings
+    whose blocks are conditioned on their own are marked so (qd and qdd recorded, no filter); a
+    law that reads earlier samples (a time shift) starts each block afresh."""
     from ..data.chunks import chunks
-    from ..data.conditioning import Signals
     from ..data.log_quality import Streamed
 
     for task in tasks:
-        for block in Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)):
-            signals = Signals(block.name, block.t, block.q, block.qd, block.qdd, block.tau, block.extra)
-            tau_model = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, context.s)
-            every = np.ones(block.t.size, dtype=bool)
-            masks = {name: every if name == role else ~every for name in ("fit", "select", "test")}
-            yield roles.Segment(signals, tau_model, signals.tau - tau_model, **masks)
+        yield from Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic))
+
+
+def block_segment(context, block, role: str):
+    """roles.Segment of one block (blocks_of) with its nominal residual, all its samples in `role`."""
+    from ..data.conditioning import Signals
+
+    signals = Signals(block.name, block.t, block.q, block.qd, block.qdd, block.tau, block.extra)
+    tau_model = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, context.s)
+    every = np.ones(block.t.size, dtype=bool)
+    masks = {name: every if name == role else ~every for name in ("fit", "select", "test")}
+    return roles.Segment(signals, tau_model, signals.tau - tau_model, **masks)
 
 
 def _why_not_tried(precision) -> str:

@@ -56,3 +56,38 @@ def _on_dask(function, tasks, scheduler: str) -> list:
     finally:
         if isinstance(scheduler, str):
             client.close()
+
+
+_FORKED = None  # the work of the in_order pass whose worker processes are forked now
+
+
+def _call(item):
+    return _FORKED(item)
+
+
+def in_order(work, items, workers: int = 2):
+    """work(item) for every item, yielded in the items' order: in `workers` processes forked
+    now (so that they see the caller's state as it is: the settings of this pass), a few items
+    ahead, not all (the results wait in memory); where forking is not possible, or in a pool's
+    worker (which may not start processes), in this process. What the caller sums in this order
+    is summed as in one process, bitwise. work and the items' results must be picklable only
+    as far as the items and results go: work itself is inherited by the fork."""
+    from concurrent.futures import ProcessPoolExecutor
+    from itertools import islice
+
+    global _FORKED
+    if workers < 2 or "fork" not in multiprocessing.get_all_start_methods() \
+            or multiprocessing.current_process().daemon or _FORKED is not None:
+        yield from map(work, items)
+        return
+    items = iter(items)
+    _FORKED = work
+    try:
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+            ahead = [pool.submit(_call, item) for item in islice(items, 2 * workers)]
+            while ahead:
+                done = ahead.pop(0).result()
+                ahead += [pool.submit(_call, item) for item in islice(items, 1)]
+                yield done
+    finally:
+        _FORKED = None
