@@ -71,6 +71,9 @@ class Source:
     def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS) -> "Source":
         """The file parsed once, its blocks kept for every pass: its length, time span and
         velocities, and whether it moves and has torques (data.recording.check_informative)."""
+        from ..streaming.engine import roomy_heap
+
+        roomy_heap()  # the passes' block-sized arrays reused, not mapped afresh
         source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
                      dof=dof, effort_topic=effort_topic, block_rows=block_rows)
         first, source.moved, source.torque = None, False, False

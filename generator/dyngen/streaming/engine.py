@@ -58,6 +58,26 @@ def _on_dask(function, tasks, scheduler: str) -> list:
             client.close()
 
 
+_HEAP = {"M_TRIM_THRESHOLD": (-1, 256 << 20), "M_MMAP_THRESHOLD": (-3, 32 << 20)}  # glibc's mallopt numbers
+
+
+def roomy_heap() -> None:
+    """Keep freed block-sized arrays in this process's heap (glibc), not unmapped and mapped
+    afresh: by default every array over the dynamic mmap threshold is a new mapping whose pages
+    fault in one by one, and a pass over an hour's blocks makes ~10^4 such arrays (the 1 kHz
+    hour's diagnose: 8.4 -> 1.6 s of system time). Peak memory is the same (the arrays are
+    reused, not added); the heap's top is returned beyond 256 MiB free. Elsewhere than glibc:
+    nothing."""
+    import ctypes
+
+    try:
+        mallopt = ctypes.CDLL("libc.so.6").mallopt
+    except (OSError, AttributeError):
+        return
+    for number, value in _HEAP.values():
+        mallopt(number, value)
+
+
 _FORKED = None  # the work of the in_order pass whose worker processes are forked now
 
 
@@ -81,6 +101,7 @@ def in_order(work, items, workers: int = 2):
         yield from map(work, items)
         return
     items = iter(items)
+    roomy_heap()  # before the fork: the workers inherit it
     _FORKED = work
     try:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .gap import VELOCITY, Gap, GapTask, Sums
+from .engine import roomy_heap
 from .gap import run as gap_run
 from .step import _local, _model
 
@@ -108,6 +109,7 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
     from ..data.chunks import chunks
     from ..data.log_quality import Streamed
 
+    roomy_heap()
     blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
     first = next(blocks)
     local = _local(first, task.conditioning)
