@@ -136,6 +136,12 @@ def test_split_pieces_read_in_blocks_never_mix_roles(tmp_path):
         assert len(names) >= 2 and all(n.startswith(f"long.csv [{a / 0.8:.0f}%-{b / 0.8:.0f}%]@") for n in names)
         starts = [float(n.rpartition("@")[2].rstrip("s")) for n in names]  # from the piece's start
         assert all(0 <= s < b - a for s in starts), (role, starts)
+    # the test piece (64-80 s, 3200 rows over the bound) judged on its windows, its held-out RMS over every row of it
+    r = read_recording(path, N)
+    piece = r.t >= r.t[0] + 0.8 * (r.t[-1] - r.t[0])
+    gap = (r.tau - rigid_torques(Arm.from_yaml(LWR), nominal_parameters(LWR), r.q, r.qd, r.qdd))[piece]
+    assert doc["judged_on"] == "test" and piece.sum() > 3000
+    assert np.allclose(doc["rms_before"], np.sqrt(np.mean(gap ** 2, axis=0)), rtol=1e-6)
     args = SimpleNamespace(effort_topic=None, cutoff="auto", order=4, differentiate=False)
     whole = split_recording(read_recording(path, N), (0.6, 0.2, 0.2))
     got = read_split([path], load_robot(LWR), args, (0.6, 0.2, 0.2), 10 ** 6)

@@ -256,14 +256,19 @@ def _every_test_row(model, final, modes, completed, judged, segments):
 
 def blocks_of(tasks):
     """Every row of the recordings `tasks` (streaming.gap.GapTask or alike: path, dof, rows,
-    effort_topic), read in blocks, repeated rows left out as conditioning does. Only recordings
+    effort_topic; a streaming.sample.Rows' span: those rows only), read in blocks, repeated rows left out as conditioning does. Only recordings
     whose blocks are conditioned on their own are marked so (qd and qdd recorded, no filter); a
     law that reads earlier samples (a time shift) starts each block afresh."""
     from ..data.chunks import chunks
     from ..data.log_quality import Streamed
+    from ..streaming.sample import _part
 
     for task in tasks:
-        yield from Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic))
+        blocks = Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic))
+        span = getattr(task, "span", None)
+        for block in blocks if span is None else (_part(b, (b.t >= span[0]) & (b.t < span[1])) for b in blocks):
+            if block.t.size:
+                yield block
 
 
 def block_segment(context, block, role: str):

@@ -85,6 +85,7 @@ class Rows:
     dof: int
     effort_topic: str | None = None
     rows: int = 8192
+    span: tuple | None = None  # (from, to) s: only the rows from <= t < to (a --split piece; to = inf: to the end)
 
 
 def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window: float = WINDOW,
