@@ -22,20 +22,18 @@ effects, test_signals are used for nothing but the reported held-out residual (r
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
-from ..streaming.engine import in_order
+from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import Context, library, simple_model
-from . import across, choose, findings_check, fit, joints, reidentify, roles, stable, trust
+from . import across, choose, every_row, findings_check, fit, joints, reidentify, roles, stable, trust
 from . import moments as dz
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
-from .judge import held_sums, judge, over_every_row, simple_mse
+from .judge import judge, simple_mse
 from .notes import notes
 from .record import CandidateGain, Diagnosis, RecordingNote, Unstable
 from .refine import restricted
@@ -64,7 +62,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     judged_segments, completed = joints.apply(final.context, final.segments, final.chosen, final.fit.x, final.simple,
                                               choice.modes, final.consistent)
     judged = judge(final.design, judged_segments, final.chosen, final.fit, final.simple)
-    judged = _every_test_row(model, final, choice.modes, completed, judged, judged_segments)
+    judged = every_row.every_test_row(model, final, choice.modes, completed, judged, judged_segments)
     # 6. report
     roles_of = (("fit", fit_signals), ("select", select_signals or []), ("test", test or []))
     result = _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
@@ -181,105 +179,14 @@ def _final_fit(robot, model, p, context, settled, choice, separate_selection) ->
             final = solve(design, chosen)
         if reid is not None:
             reid, consistent = choose.refit(robot, model, p, fitting, reid, consistent)
-    streams = _streams([seg for seg in fitting if seg.fit.any()])  # not the --select or --test windows
+    streams = every_row.streams_of([seg for seg in fitting if seg.fit.any()])  # not the --select or --test windows
     if streams and chosen:  # windows of long recordings: the values from every row of them
-        design = replace(design, fit=every_row(context, chosen, streams, design.fit.G.shape[1]))
+        design = replace(design, fit=every_row.every_row(context, chosen, streams, design.fit.G.shape[1]))
         final = solve(design, chosen)
     fitted = fit.corrected(context, chosen, final.x, fitting)
     tau_corr = fit.correlation_time(fitted, design.weights)
     findings = with_values(choice.described, design, chosen, final, tau_corr, robot)
     return Final(context, design, chosen, final, simple, fitted, reid, consistent, tau_corr, findings)
-
-
-def _streams(segments) -> list:
-    """The long recordings (streaming.gap.GapTask) whose windows (streaming/sample.py) the segments
-    are, where the windows kept their columns as recorded (trust.py may have filtered them since)."""
-    tasks = [getattr(getattr(seg.signals, "source", None), "stream", None) if seg.signals.lowpass is None else None
-             for seg in segments]
-    return [task for k, task in enumerate(tasks) if task is not None and task not in tasks[:k]]
-
-
-def every_row(context, chosen, tasks, size: int) -> dz.Moments:
-    """The fit moments (size slots) of the chosen candidates over every row of the recordings
-    `tasks`, read again in blocks (blocks_of): each block's nominal residual and the chosen
-    effects' columns at the windows' settings and ranges, on both cores (streaming.engine.in_order:
-    the blocks' moments added in block order, as one process adds them)."""
-    effects = list({c.effect.key: c.effect for c in chosen}.values())
-    world = dz.as_chosen(context, chosen)
-    n = len(context.robot.joints)
-
-    def of_block(block) -> dz.Moments:
-        seg = block_segment(context, block, "fit")
-        columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
-        out = dz.empty(n, size)
-        for j in range(n):
-            acting = [c for c in chosen if c.joint is None or c.joint == j]
-            A, slots = dz.joint_matrix(acting, columns, j) if acting else (np.zeros((seg.residual.shape[0], 0)),
-                                                                           np.zeros(0, dtype=int))
-            dz.accumulate(out, A, slots, seg.residual[:, j], j)
-        out.count = seg.residual.shape[0]
-        return out
-
-    total = dz.empty(n, size)
-    for part in in_order(of_block, blocks_of(tasks)):  # a slot a block does not touch adds an exact zero
-        total.G += part.G
-        total.b += part.b
-        total.c += part.c
-        total.count += part.count
-    return total
-
-
-def _every_test_row(model, final, modes, completed, judged, segments):
-    """The held-out figures over every row of the long test recordings whose windows were judged
-    (judge.over_every_row), each block corrected as apply corrected the windows; the other test
-    segments as they were. Without such recordings, judged as it is."""
-    held = [seg for seg in segments if seg.test.any()]
-    streams = _streams([seg for seg in held if not (seg.fit.any() or seg.select.any())])
-    if not streams:
-        return judged
-    kept = [seg for seg in held if getattr(getattr(seg.signals, "source", None), "stream", None) not in streams]
-    chosen, x = final.chosen, final.fit.x
-
-    def of_block(block):
-        seg = block_segment(final.context, block, "test")
-        context = replace(final.context, cache={})  # a memo per block, not kept
-        (effects,) = fit.corrected(context, chosen, x, [seg])
-        consistent = None if final.reidentified is None else reidentify.corrections(final.reidentified, model,
-                                                                                     [effects])
-        (seg,), _ = joints.apply(context, [effects], chosen, x, final.simple, modes, consistent, completed)
-        return held_sums(seg, effects.correction, final.simple)
-
-    own = [held_sums(seg, fit.predict(final.context, chosen, x, seg) if chosen else np.zeros_like(seg.residual),
-                     final.simple) for seg in kept]
-    return over_every_row(judged, itertools.chain(own, in_order(of_block, blocks_of(streams))))
-
-
-def blocks_of(tasks):
-    """Every row of the recordings `tasks` (streaming.gap.GapTask or alike: path, dof, rows,
-    effort_topic; a streaming.sample.Rows' span: those rows only), read in blocks, repeated rows left out as conditioning does. Only recordings
-    whose blocks are conditioned on their own are marked so (qd and qdd recorded, no filter); a
-    law that reads earlier samples (a time shift) starts each block afresh."""
-    from ..data.chunks import chunks
-    from ..data.log_quality import Streamed
-    from ..streaming.sample import _part
-
-    for task in tasks:
-        blocks = Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic))
-        span = getattr(task, "span", None)
-        for block in blocks if span is None else (_part(b, (b.t >= span[0]) & (b.t < span[1])) for b in blocks):
-            if block.t.size:
-                yield block
-
-
-def block_segment(context, block, role: str):
-    """roles.Segment of one block (blocks_of) with its nominal residual, all its samples in `role`."""
-    from ..data.conditioning import Signals
-
-    signals = Signals(block.name, block.t, block.q, block.qd, block.qdd, block.tau, block.extra)
-    tau_model = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, context.s)
-    every = np.ones(block.t.size, dtype=bool)
-    masks = {name: every if name == role else ~every for name in ("fit", "select", "test")}
-    return roles.Segment(signals, tau_model, signals.tau - tau_model, **masks)
 
 
 def _why_not_tried(precision) -> str:

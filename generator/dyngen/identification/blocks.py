@@ -71,7 +71,7 @@ class Source:
     def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS) -> "Source":
         """The file parsed once, its blocks kept for every pass: its length, time span and
         velocities, and whether it moves and has torques (data.recording.check_informative)."""
-        from ..streaming.engine import roomy_heap
+        from ..forked import roomy_heap
 
         roomy_heap()  # the passes' block-sized arrays reused, not mapped afresh
         source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
@@ -187,10 +187,10 @@ class Blocks:
 
     def each(self, work, workers: int = 2):
         """work(piece) for every piece, in order: for parsed files in two worker processes (both
-        cores, streaming.engine.in_order), forked now so that they see this pass's settings,
+        cores, forked.in_order), forked now so that they see this pass's settings,
         reading their blocks from the temporary folder; in block order, so what the caller sums
         is summed as in one process."""
-        from ..streaming.engine import in_order
+        from ..forked import in_order
 
         if workers < 2 or not all(s._parsed for s in self.sources):
             yield from map(work, self)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .gap import VELOCITY, Gap, GapTask, Sums
-from .engine import roomy_heap
+from ..forked import roomy_heap
 from .gap import run as gap_run
 from .step import _local, _model
 
