@@ -13,7 +13,7 @@ from conftest import ROOT
 PACKAGE = ROOT / "generator" / "dyngen"
 STAGES = (
     {"dyngen", "errors", "untrusted", "arguments", "options", "parameters", "atomic", "cache", "progress", "blas",
-     "yaml_policy", "output_paths"},
+     "yaml_policy", "output_paths", "forked"},
     {"description"},  # the robot, its joint model and kinematics
     {"terms"},  # the torque terms: columns, ranges and C of every term
     {"catalogue"},
@@ -38,7 +38,7 @@ DIAGNOSIS_STAGES = (
     {"forward_selection"},  # 2. select
     {"refine", "settle"},  # 3. settle
     {"joints", "reidentify", "choose"},  # 4. choose
-    {"judge"},  # 5. test
+    {"judge", "every_row"},  # 5. test (of long recordings: every row)
     {"findings", "findings_check", "stable", "across", "notes", "diagnose_options", "pipeline"},  # 6. report; the pipeline
     {"report", "updated_model", "figures", "outputs", ""},  # written out; the package
 )

@@ -136,6 +136,12 @@ def test_split_pieces_read_in_blocks_never_mix_roles(tmp_path):
         assert len(names) >= 2 and all(n.startswith(f"long.csv [{a / 0.8:.0f}%-{b / 0.8:.0f}%]@") for n in names)
         starts = [float(n.rpartition("@")[2].rstrip("s")) for n in names]  # from the piece's start
         assert all(0 <= s < b - a for s in starts), (role, starts)
+    # the test piece (64-80 s, 3200 rows over the bound) judged on its windows, its held-out RMS over every row of it
+    r = read_recording(path, N)
+    piece = r.t >= r.t[0] + 0.8 * (r.t[-1] - r.t[0])
+    gap = (r.tau - rigid_torques(Arm.from_yaml(LWR), nominal_parameters(LWR), r.q, r.qd, r.qdd))[piece]
+    assert doc["judged_on"] == "test" and piece.sum() > 3000
+    assert np.allclose(doc["rms_before"], np.sqrt(np.mean(gap ** 2, axis=0)), rtol=1e-6)
     args = SimpleNamespace(effort_topic=None, cutoff="auto", order=4, differentiate=False)
     whole = split_recording(read_recording(path, N), (0.6, 0.2, 0.2))
     got = read_split([path], load_robot(LWR), args, (0.6, 0.2, 0.2), 10 ** 6)
@@ -143,3 +149,36 @@ def test_split_pieces_read_in_blocks_never_mix_roles(tmp_path):
         assert signals.name == piece.name
         np.testing.assert_array_equal(signals.t, piece.t)
         np.testing.assert_array_equal(signals.tau, piece.tau)
+
+
+def test_held_out_figures_over_every_row_of_a_long_test_recording(tmp_path):
+    """--test longer than --max-rows: the diagnosis judges its windows, but the held-out RMS per
+    joint (nominal, the final model, the effects alone, the simple model) is summed block by
+    block over every row. Oracles: Pinocchio's torques at every recorded sample with the
+    reported values (numpy), and the in-memory diagnosis of the same files (test read whole)."""
+    fit = write_robot(tmp_path / "fit.csv", seed=4, seconds=10.0, offset=OFFSET)
+    test = write_robot(tmp_path / "test.csv", seed=8, seconds=40.0, offset=OFFSET)  # 8000 samples
+    run("--data", fit, "--test", test, "--max-rows", 3000, "--out", tmp_path / "d")
+    run("--data", fit, "--test", test, "--out", tmp_path / "whole")  # within the default bound: read whole
+    doc = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    whole = json.loads((tmp_path / "whole" / "diagnosis.json").read_text())
+    assert doc["judged_on"] == "test" and len(doc["test"]) >= 2 and whole["test"] == ["test.csv"]
+    r = read_recording(test, N)
+    gap = r.tau - rigid_torques(Arm.from_yaml(LWR), nominal_parameters(LWR), r.q, r.qd, r.qdd)
+    rms = (lambda x: np.sqrt(np.mean(x ** 2, axis=0)))
+    simple = np.array(doc["simple_values"])  # per joint b, Fc, Fv
+    simple_torque = simple[:, 0] + simple[:, 1] * np.tanh(r.qd / 0.02) + simple[:, 2] * r.qd
+    (offset,) = [e for e in doc["selected"] if e["effect"] == "offset"]
+    effects = np.zeros_like(gap)
+    effects[:, offset["joints"][0] - 1] = offset["values"]["b"]
+    after = np.where([m.startswith("simple") for m in doc["joint_models"]], simple_torque, effects)
+    assert [m for m in doc["joint_models"] if m not in ("effects", "simple (effects not shown better)")] == []
+    for key, correction in (("before", 0.0), ("after", after), ("effects", effects), ("simple", simple_torque)):
+        assert np.allclose(doc[f"rms_{key}"], rms(gap - correction), rtol=1e-6), key
+        assert np.allclose(doc[f"rms_{key}"], whole[f"rms_{key}"], rtol=1e-9), key
+    # the windows alone would not give it
+    in_windows = np.zeros(r.t.size, dtype=bool)
+    for name in doc["test"]:
+        start = float(name.rpartition("@")[2].rstrip("s"))
+        in_windows |= (r.t - r.t[0] >= start) & (r.t - r.t[0] < start + 6.0)
+    assert in_windows.sum() <= 3000 and np.abs(rms(gap[in_windows]) / rms(gap) - 1).max() > 1e-3

@@ -34,14 +34,15 @@ def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
 
 def read_windows(paths, robot, args, max_rows: int) -> list:
     """--select and --test recordings, read in blocks: whole within max_rows samples, else
-    evenly spread windows of them (streaming/sample.py); conditioned, each on its own."""
+    evenly spread windows of them (streaming/sample.py: those of --test judged over every row,
+    diagnosis/pipeline.py); conditioned, each on its own."""
     from ..data import condition
     from ..data.recording import check_informative
     from ..streaming.sample import windows
 
     recordings = []
     for path in paths:
-        got = windows(path, robot.dof, args.effort_topic, max_rows)
+        got = windows(path, robot.dof, args.effort_topic, max_rows, conditioning=conditioning_of(args))
         recordings += got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
     check_informative(recordings, True)
     return [condition(r, conditioning_of(args)) for r in recordings]
@@ -54,15 +55,16 @@ def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list
     from ..data import condition
     from ..data.chunks import chunks
     from ..errors import InputError
-    from ..streaming.sample import Spread, _part
+    from ..streaming.sample import Rows, Spread, _part
+    from ..streaming.step import _local
 
     roles = ([], [], [])
     edges = np.concatenate([[0.0], np.cumsum(fractions)])
     edges[-1] = 1.0
     for path in paths:
-        t0, t1 = None, None
+        t0, t1, first = None, None, None
         for block in chunks(path, robot.dof, True, (), 8192, args.effort_topic):
-            t0, t1, name = block.t[0] if t0 is None else t0, block.t[-1], block.name
+            t0, t1, name, first = block.t[0] if t0 is None else t0, block.t[-1], block.name, first or block
         spreads = [Spread(max_rows) if b > a else None for a, b in zip(edges[:-1], edges[1:])]
         for block in chunks(path, robot.dof, True, (), 8192, args.effort_topic):
             for k, spread in enumerate(spreads):
@@ -76,6 +78,10 @@ def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list
             if spread.rows < 8:
                 raise InputError(name, "--split", f"the piece {edges[k]:.0%}-{edges[k + 1]:.0%} has {spread.rows} samples")
             got = spread.windows(f"{name} [{edges[k]:.0%}-{edges[k + 1]:.0%}]")
+            if k == 2 and len(got) > 1 and _local(first, conditioning_of(args)):  # judged over every row
+                span = (t0 + edges[k] * (t1 - t0), t0 + edges[k + 1] * (t1 - t0) if edges[k + 1] < 1.0 else np.inf)
+                for w in got:
+                    w.stream = Rows(str(path), robot.dof, args.effort_topic, span=span)
             roles[k].extend(got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES])
     return tuple([condition(r, conditioning_of(args)) for r in role] for role in roles)
 

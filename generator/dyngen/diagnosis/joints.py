@@ -158,10 +158,12 @@ def _better(sse, size, best_sse, best_size, min_gain) -> bool:
     return sse <= best_sse / (1 - min_gain) ** (best_size - size)
 
 
-def apply(context, segments, chosen, x, simple, modes, consistent=None) -> tuple[list, dict]:
+def apply(context, segments, chosen, x, simple, modes, consistent=None, completed_values=None) -> tuple[list, dict]:
     """(segments with each joint's correction by its mode, {joint (1-based): values of the
     completed model} for the report). The segments' corrections hold the effects' torques;
-    consistent: per segment the consistent model's corrections."""
+    consistent: per segment the consistent model's corrections; completed_values: the completed
+    model's values as apply returned them on the fit segments (blocks of a test recording have
+    no fit samples to set them)."""
     completed, corrections = {}, [seg.correction.copy() for seg in segments]
     for j, mode in enumerate(modes):
         if mode == CONSISTENT:
@@ -171,7 +173,8 @@ def apply(context, segments, chosen, x, simple, modes, consistent=None) -> tuple
             for out, seg in zip(corrections, segments):
                 out[:, j] = baseline.predict(simple, seg)[:, j]
         elif mode == COMPLETED:
-            values = _completed_fit(context, chosen, x, segments, j)
+            values = _completed_fit(context, chosen, x, segments, j) if completed_values is None else \
+                np.asarray(completed_values[j + 1])
             completed[j + 1] = values.tolist()
             for out, seg in zip(corrections, segments):
                 out[:, j] = _completed_predict(context, chosen, x, values, seg, j)

@@ -1,10 +1,14 @@
 """Stage 5, test: the figures on the judged data (the test recordings, or without them the
 selection data): RMS before, after, with the effects alone and with the simple model, per
-phase of the motion, the noise left, and within the speeds the fit data covered."""
+phase of the motion, the noise left, and within the speeds the fit data covered.
+
+Of a long test recording diagnosed on windows (streaming/sample.py), the four mean squares are
+over every row of it, read again in blocks (over_every_row); its peak, noise, phases and speed
+shares stay those of its windows."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -52,6 +56,26 @@ def judge(design, segments, chosen, final, simple) -> Judged:
     noise = np.std(np.diff(held_after, axis=0), axis=0) / np.sqrt(2)
     return Judged(on, before, after, effects_mse, simple_mse_, np.abs(held_before).max(axis=0), noise, where,
                   within_fit_speeds(segments, simple, used, mask), used)
+
+
+def held_sums(seg, effects, simple) -> tuple[np.ndarray, int]:
+    """((4, N) sums of squares over the segment's test samples before, after its final
+    correction, after the effects' torques (T, N) alone and after the simple model; their count)."""
+    m = seg.test
+    r = seg.residual[m]
+    return np.array([((r - x) ** 2).sum(axis=0) for x in (0.0, seg.correction[m], effects[m],
+                                                          simple_model.predict(simple, seg)[m])]), int(m.sum())
+
+
+def over_every_row(judged: Judged, sums) -> Judged:
+    """judged with its mean squares before, after, with the effects alone and with the simple
+    model from `sums` (held_sums, one segment at a time: the in-memory test segments, and every
+    row of the long test recordings block by block), added in order."""
+    sse, count = 0.0, 0
+    for part, rows in sums:
+        sse, count = sse + part, count + rows
+    before, after, effects, simple = sse / max(count, 1)
+    return replace(judged, before=before, after=after, effects=effects, simple=simple)
 
 
 def within_fit_speeds(segments, simple, used, mask) -> dict:

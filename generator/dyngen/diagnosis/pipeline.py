@@ -26,9 +26,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..catalogue import RNEA, STANDARD_FROM_DYNAMIC
+from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import Context, library, simple_model
-from . import across, choose, findings_check, fit, joints, reidentify, roles, stable, trust
+from . import across, choose, every_row, findings_check, fit, joints, reidentify, roles, stable, trust
 from . import moments as dz
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
@@ -62,6 +62,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     judged_segments, completed = joints.apply(final.context, final.segments, final.chosen, final.fit.x, final.simple,
                                               choice.modes, final.consistent)
     judged = judge(final.design, judged_segments, final.chosen, final.fit, final.simple)
+    judged = every_row.every_test_row(model, final, choice.modes, completed, judged, judged_segments)
     # 6. report
     roles_of = (("fit", fit_signals), ("select", select_signals or []), ("test", test or []))
     result = _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
@@ -178,51 +179,14 @@ def _final_fit(robot, model, p, context, settled, choice, separate_selection) ->
             final = solve(design, chosen)
         if reid is not None:
             reid, consistent = choose.refit(robot, model, p, fitting, reid, consistent)
-    streams = _streams(fitting)
+    streams = every_row.streams_of([seg for seg in fitting if seg.fit.any()])  # not the --select or --test windows
     if streams and chosen:  # windows of long recordings: the values from every row of them
-        design = replace(design, fit=every_row(context, chosen, streams, design.fit.G.shape[1]))
+        design = replace(design, fit=every_row.every_row(context, chosen, streams, design.fit.G.shape[1]))
         final = solve(design, chosen)
     fitted = fit.corrected(context, chosen, final.x, fitting)
     tau_corr = fit.correlation_time(fitted, design.weights)
     findings = with_values(choice.described, design, chosen, final, tau_corr, robot)
     return Final(context, design, chosen, final, simple, fitted, reid, consistent, tau_corr, findings)
-
-
-def _streams(segments) -> list:
-    """The long recordings (streaming.gap.GapTask) whose windows (streaming/sample.py) the segments
-    are, where the windows kept their columns as recorded (trust.py may have filtered them since)."""
-    tasks = [getattr(getattr(seg.signals, "source", None), "stream", None) if seg.signals.lowpass is None else None
-             for seg in segments]
-    return [task for k, task in enumerate(tasks) if task is not None and task not in tasks[:k]]
-
-
-def every_row(context, chosen, tasks, size: int) -> dz.Moments:
-    """The fit moments (size slots) of the chosen candidates over every row of the recordings
-    `tasks`, read again in blocks (repeated rows left out, as conditioning does): each block's
-    nominal residual and the chosen effects' columns at the windows' settings and ranges. Only
-    recordings whose blocks are conditioned on their own are marked so (qd and qdd recorded, no
-    filter); a law that reads earlier samples (a time shift) starts each block afresh."""
-    from ..data.chunks import chunks
-    from ..data.conditioning import Signals
-    from ..data.log_quality import Streamed
-
-    effects = list({c.effect.key: c.effect for c in chosen}.values())
-    world = dz.as_chosen(context, chosen)
-    out = dz.empty(len(context.robot.joints), size)
-    for task in tasks:
-        for block in Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)):
-            signals = Signals(block.name, block.t, block.q, block.qd, block.qdd, block.tau, block.extra)
-            tau_model = context.model.batch(RNEA.name, signals.q, signals.qd, signals.qdd, context.s)
-            every = np.ones(block.t.size, dtype=bool)
-            seg = roles.Segment(signals, tau_model, signals.tau - tau_model, every, ~every, ~every)
-            columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
-            for j in range(out.G.shape[0]):
-                acting = [c for c in chosen if c.joint is None or c.joint == j]
-                A, slots = dz.joint_matrix(acting, columns, j) if acting else (np.zeros((block.t.size, 0)),
-                                                                               np.zeros(0, dtype=int))
-                dz.accumulate(out, A, slots, seg.residual[:, j], j)
-            out.count += block.t.size
-    return out
 
 
 def _why_not_tried(precision) -> str:

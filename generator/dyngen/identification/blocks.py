@@ -71,6 +71,9 @@ class Source:
     def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS) -> "Source":
         """The file parsed once, its blocks kept for every pass: its length, time span and
         velocities, and whether it moves and has torques (data.recording.check_informative)."""
+        from ..forked import roomy_heap
+
+        roomy_heap()  # the passes' block-sized arrays reused, not mapped afresh
         source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
                      dof=dof, effort_topic=effort_topic, block_rows=block_rows)
         first, source.moved, source.torque = None, False, False
@@ -184,27 +187,16 @@ class Blocks:
 
     def each(self, work, workers: int = 2):
         """work(piece) for every piece, in order: for parsed files in two worker processes (both
-        cores), forked now so that they see this pass's settings, reading their blocks from the
-        temporary folder; in block order, so what the caller sums is summed as in one process."""
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+        cores, forked.in_order), forked now so that they see this pass's settings,
+        reading their blocks from the temporary folder; in block order, so what the caller sums
+        is summed as in one process."""
+        from ..forked import in_order
 
-        global _PASS
-        if workers < 2 or not all(s._parsed for s in self.sources) or "fork" not in multiprocessing.get_all_start_methods() \
-                or multiprocessing.current_process().daemon:  # a pool's worker may not start processes
+        if workers < 2 or not all(s._parsed for s in self.sources):
             yield from map(work, self)
             return
-        tasks = iter([(i, n) for i, s in enumerate(self.sources) for n in range(len(s._starts))])
-        _PASS = (self, work)
-        try:
-            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
-                ahead = [pool.submit(_work_on, task) for task in itertools.islice(tasks, 2 * workers)]
-                while ahead:  # a few blocks ahead, not all: the results wait in memory
-                    done = ahead.pop(0).result()
-                    ahead += [pool.submit(_work_on, task) for task in itertools.islice(tasks, 1)]
-                    yield done
-        finally:
-            _PASS = None
+        tasks = [(i, n) for i, s in enumerate(self.sources) for n in range(len(s._starts))]
+        yield from in_order(lambda task: work(_piece_of(self, task)), tasks, workers)
 
     def piece(self, source, part, block, before, number, start) -> Piece:
         Y = self.model.batch("regressor", block.q, block.qd, block.qdd)
@@ -227,19 +219,15 @@ class Blocks:
         return p
 
 
-_PASS = None  # (Blocks, work) of the pass whose worker processes are forked (Blocks.each)
-
-
-def _work_on(task):
-    """In a worker process: the pass's work on block `number` of source i."""
-    blocks, work = _PASS
+def _piece_of(blocks, task) -> Piece:
+    """In a worker process: the piece of block `number` of source i, read from the temporary folder."""
     i, number = task
     source = blocks.sources[i]
     # the Coulomb column's lag (at most LAG_GRID's 40 ms) reaches into the block before: its last rows suffice
     before = source.block(number - 1, last=BEFORE) if number else None
     if before is not None and before.t[-1] - before.t[0] <= max(LAG_GRID):  # a fast recording: all of it
         before = source.block(number - 1)
-    return work(blocks.piece(source, blocks.parts[i], source.block(number), before, number, source._starts[number]))
+    return blocks.piece(source, blocks.parts[i], source.block(number), before, number, source._starts[number])
 
 
 def sources_of(recordings, block_rows: int = ROWS) -> list:

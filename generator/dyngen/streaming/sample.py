@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .gap import VELOCITY, Gap, GapTask, Sums
+from ..forked import roomy_heap
 from .gap import run as gap_run
 from .step import _local, _model
 
@@ -77,21 +78,39 @@ class Spread:
         return [_joined(f"{name}@{w[0].t[0] - self.t0:.0f}s", w) for w in kept]
 
 
-def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window: float = WINDOW) -> list:
-    """The recording whole (within max_rows samples), else its evenly spread windows, read in blocks."""
+@dataclass(frozen=True)
+class Rows:
+    """Every row of a recording, for a pass over it in blocks (diagnosis/pipeline.py block_segments)."""
+    path: str
+    dof: int
+    effort_topic: str | None = None
+    rows: int = 8192
+    span: tuple | None = None  # (from, to) s: only the rows from <= t < to (a --split piece; to = inf: to the end)
+
+
+def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window: float = WINDOW,
+            conditioning=None) -> list:
+    """The recording whole (within max_rows samples), else its evenly spread windows, read in
+    blocks; windows whose blocks are conditioned on their own (step._local under `conditioning`)
+    are marked with their recording's Rows (w.stream), so that the test figures can read every row."""
     from ..data.chunks import chunks
 
-    spread, name = Spread(max_rows, window), None
+    spread, name, first = Spread(max_rows, window), None, None
     for block in chunks(path, dof, True, (), 8192, effort_topic):
         spread.add(block)
-        name = block.name
-    return spread.windows(name)
+        name, first = block.name, first or block
+    got = spread.windows(name)
+    if len(got) > 1 and conditioning is not None and _local(first, conditioning):
+        for w in got:
+            w.stream = Rows(str(path), dof, effort_topic)
+    return got
 
 
 def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> Sampled:
     from ..data.chunks import chunks
     from ..data.log_quality import Streamed
 
+    roomy_heap()
     blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
     first = next(blocks)
     local = _local(first, task.conditioning)
