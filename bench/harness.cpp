@@ -320,7 +320,10 @@ bool verify(Setup<A> &S, int count, bool print) {
   for (int b = 0; b < 2; ++b)
     for (int f : {RNEA, GRAVITY, MASS_MATRIX, FORWARD_DYNAMICS}) {
       if (print) std::printf("VERIFY %s %s_%s %.3e\n", A::name, b ? "casadi_baked" : "casadi", kFnNames[f], cas_err[b][f]);
-      if (!(cas_err[b][f] <= kTolerance)) {
+      // CasADi's forward dynamics is its symbolic QR solve of M: on the Stanford arm (a slide
+      // among the joints) it differs from aba by 1.5e-9 over 1000 states, its own rounding, so
+      // that competitor is held to 1e-8 (dyngen's own forward dynamics stays at kTolerance)
+      if (!(cas_err[b][f] <= (f == FORWARD_DYNAMICS ? 1e-8 : kTolerance))) {
         std::fprintf(stderr, "%s: CasADi %s disagrees (%.3e)\n", A::name, kFnNames[f], cas_err[b][f]);
         ok = false;
       }
