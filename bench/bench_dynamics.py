@@ -15,6 +15,7 @@ states:
     <name>_regressor_inertia, then Y_m pi_m     vs pinocchio::crba (Y_m pi_m is the stacked upper triangle)
     <name>_regressor (n x base coefficients)    vs pinocchio::computeJointTorqueRegressor (n x 10n)
     <name>_rnea_nominal (nominal p folded in)   vs pinocchio::rnea (and CasADi baked: like for like)
+    <name>_forward_dynamics(q, qd, tau)         vs pinocchio::aba (and CasADi's solve(M, tau - h))
 
 Reported: the median over batches of the per-batch ns/call, the ratio pinocchio/dyngen and
 dyngen's operation counts (manifest.json). --callgrind adds instructions per call measured
@@ -63,6 +64,7 @@ PAIRS = {
     "ym_pim": ("Y_m(q) pi_m", "crba"),
     "regressor": ("base regressor Y(q, qd, qdd)", "computeJointTorqueRegressor"),
     "rnea_nominal": ("rnea_nominal (nominal p folded in)", "rnea"),
+    "forward_dynamics": ("forward_dynamics FD(q, qd, tau)", "aba"),
 }
 FUNCTIONS = tuple(PAIRS)
 # A pair that multiplies a generated regressor by its coefficients: (regressor function,
@@ -70,13 +72,14 @@ FUNCTIONS = tuple(PAIRS)
 PRODUCTS = {"yg_pig": ("regressor_gravity", "pi_gravity"), "ym_pim": ("regressor_inertia", "pi_inertia")}
 DEFAULT_FLAGS = "-O2 -DNDEBUG"
 SIDES = ("dyngen", "pinocchio", "casadi", "casadi_baked")  # harness.cpp's order
-CASADI_FUNCTIONS = ("rnea", "gravity", "mass_matrix", "rnea_nominal")  # the pairs with CasADi sides
-CASADI_CODE = ("rnea", "gravity", "mass_matrix")  # CasADi's own functions (rnea_nominal is timed against rnea's)
+CASADI_FUNCTIONS = ("rnea", "gravity", "mass_matrix", "rnea_nominal", "forward_dynamics")  # pairs with CasADi sides
+# CasADi's own functions (rnea_nominal is timed against rnea's; forward_dynamics is bench_controller's fd)
+CASADI_CODE = ("rnea", "gravity", "mass_matrix", "forward_dynamics")
 # The like-for-like CasADi variant of each dyngen function: parameters read as an input on both
 # sides, or folded in as numbers on both; gravity and M have no dyngen variant with the
 # parameters folded in, so they meet the better of the two.
 LIKE_FOR_LIKE = {"rnea": "CasADi (parameters as input)", "rnea_nominal": "CasADi baked",
-                 "gravity": "better CasADi", "mass_matrix": "better CasADi"}
+                 "gravity": "better CasADi", "mass_matrix": "better CasADi", "forward_dynamics": "better CasADi"}
 
 
 def run(cmd, **kw) -> subprocess.CompletedProcess:
@@ -233,7 +236,7 @@ def prepare_arm(yaml_path: Path, gen_root: Path, model_dir: Path) -> dict:
     shapes = {f["name"][len(name) + 1:]: f["output"]["shape"] for f in manifest["functions"]}
     lo, hi = joint_ranges(yaml_path)
     return {"name": name, "n": n, "folder": folder, "p": p, "p_source": p_source, "ops": ops, "shapes": shapes,
-            "casadi": casadi,
+            "casadi": casadi, "model": model,
             "qlo": lo, "qhi": hi, "joint_types": "".join("R" if t == "revolute" else "P"
                                                          for t in manifest["joint_types"])}
 
@@ -261,9 +264,19 @@ def arms_inc(arms: list) -> str:
                     f"    {name}_{variant}_{fn}(arg, res, iw, w, 0);",
                     "  }",
                 ]
+        for variant in casadi_side.VARIANTS:  # bench_controller's fd, one object each (casadi_objects.py)
+            info, ins = a["casadi_fd"][f"{name}_{variant}_fd"], ["q", "qd", "tau"] + (["params"] if variant == "cas" else [])
+            cas += [f"  static void {variant}_fd({', '.join(f'const double *{x}' for x in ins)}, double *qdd) {{",
+                    f"    const double *arg[{len(ins)}] = {{{', '.join(ins)}}};",
+                    "    double *res[1] = {qdd};",
+                    f"    static casadi_int iw[{max(1, info['iw'])}];",
+                    f"    static double w[{max(1, info['w'])}];",
+                    f"    {name}_{variant}_fd(arg, res, iw, w, 0);",
+                    "  }"]
         out += [
             f'#include "{name}.h"',
             f'#include "{name}_casadi.h"',
+            *(f'#include "{a["casadi_fd"][f"{name}_{v}_fd"]["header"].name}"' for v in casadi_side.VARIANTS),
             f"struct Arm_{name} {{",
             f'  static constexpr const char *name = "{name}";',
             f"  static constexpr int n = {n};",
@@ -276,6 +289,10 @@ def arms_inc(arms: list) -> str:
             "  }",
             "  static void rnea_nominal(const double *q, const double *qd, const double *qdd, double *tau) {",
             f"    {name}_rnea_nominal(q, qd, qdd, tau);",
+            "  }",
+            "  static void forward_dynamics(const double *q, const double *qd, const double *tau, const double *s, "
+            "double *qdd) {",
+            f"    {name}_forward_dynamics(q, qd, tau, s, qdd);",
             "  }",
             f"  static void gravity(const double *q, const double *s, double *g) {{ {name}_gravity(q, s, g); }}",
             f"  static void mass_matrix(const double *q, const double *s, double *M) {{ {name}_mass_matrix(q, s, M); }}",
@@ -355,10 +372,18 @@ def finish_pinocchio_object(proc) -> None:
     os.replace(proc.bench_tmp, proc.bench_obj)
 
 
-def build(arms: list, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path, pin_proc, libs: list) -> Path:
-    objs = []
+def build(arms: list, work: Path, cc: str, cxx: str, flags: list, pin_obj: Path, pin_proc, libs: list,
+          tool: dict) -> Path:
+    import casadi_side
+    from bench_controller import controller_object  # pin_aba; bench_controller imports this module
+
+    objs = [controller_object(cxx, flags, tool)]
     for a in arms:
-        for src in (f"{a['name']}_dynamics.c", f"{a['name']}_parameters.c", f"{a['name']}_regressors.c"):
+        a["casadi_fd"] = casadi_side.generate_controller(a["model"], a["name"], a["folder"] / "casadi", cc, flags,
+                                                         which=("fd",))
+        objs += [info["object"] for info in a["casadi_fd"].values()]
+        for src in (f"{a['name']}_dynamics.c", f"{a['name']}_parameters.c", f"{a['name']}_regressors.c",
+                    f"{a['name']}_forward.c"):
             obj = work / "obj" / (src[:-2] + ".o")
             run([cc, "-std=c99", *flags, "-c", str(a["folder"] / src), "-o", str(obj)])
             objs.append(obj)
@@ -662,7 +687,7 @@ def bench(args, work: Path) -> int:
             log(f"generating {name} ...")
             arms.append(prepare_arm(arm_yaml(name), work / "gen", work / "models"))
         log("compiling the benchmark ...")
-        exe = build(arms, work, cc, cxx, flags, pin_obj, pin_proc, libs)
+        exe = build(arms, work, cc, cxx, flags, pin_obj, pin_proc, libs, tool)
         pin_proc = None
     finally:
         if pin_proc is not None and pin_proc.poll() is None:

@@ -130,7 +130,7 @@ def main(argv=None) -> int:
         arms = []
         for name in names:
             log(f"generating {name} ...")
-            arms.append(arm_counts(arm_yaml(name), Path(tmp) / name, args.states))
+            arms.append(arm_counts(arm_yaml(name), Path(tmp) / Path(name).stem, args.states))  # a YAML path: its stem
     text = ("# Operation counts of the generated functions\n\n"
             "Written by `python bench/bench_opcounts.py`. Each cell: multiplications / additions (subtractions "
             "included) / sin and cos calls, counted in the emitted C (divisions noted where there are any); "

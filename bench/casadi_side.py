@@ -168,9 +168,10 @@ def _christoffel(M, q, qd, n: int):
     return C
 
 
-def controller_functions(model, name: str) -> list:
-    """The controller casadi.Function objects of one arm: both variants of every function but
-    slotine_li, which has only the parameters-as-input one (<name>_cas_slotine_li)."""
+def controller_functions(model, name: str, which=tuple(CONTROLLER_FUNCTIONS)) -> list:
+    """The controller casadi.Function objects of one arm: both variants of every function in
+    `which` but slotine_li, which has only the parameters-as-input one (<name>_cas_slotine_li).
+    bench_dynamics.py asks for ("fd",) alone: the same functions, so the same C and cached objects."""
     n = model.nv
     sym = {x: ca.SX.sym(x, n) for x in ("q", "qd", "qdd", "tau", "qrd", "qrdd")}
     q, qd = sym["q"], sym["qd"]
@@ -182,28 +183,33 @@ def controller_functions(model, name: str) -> list:
     for variant, P in (("cas", params), ("casb", ca.SX(ca.DM(body_parameters(model))))):
         extra = [params] if variant == "cas" else []
         M = ca.jacobian(rnea(model, q, zero, sym["qdd"], P, [0.0, 0.0, 0.0]), sym["qdd"])
-        C = _christoffel(M, q, qd, n)
+        C = _christoffel(M, q, qd, n) if {"coriolis", "slotine_li"} & set(which) else None
         bias = rnea(model, q, qd, zero, P, gravity)
         qdd = ca.solve(M, sym["tau"] - bias)
         x = ca.vertcat(q, qd)
-        outputs = {"coriolis": _row_major(C), "mass_matrix_dot": _row_major(ca.jtimes(M, q, qd)),
-                   "fd": qdd, "rnea_derivatives": _row_major(ca.jacobian(rnea(model, q, qd, sym["qdd"], P, gravity), x)),
-                   "fd_derivatives": _row_major(ca.jacobian(qdd, x))}
+        outputs = {"coriolis": lambda: _row_major(C), "mass_matrix_dot": lambda: _row_major(ca.jtimes(M, q, qd)),
+                   "fd": lambda: qdd,
+                   "rnea_derivatives": lambda: _row_major(ca.jacobian(rnea(model, q, qd, sym["qdd"], P, gravity), x)),
+                   "fd_derivatives": lambda: _row_major(ca.jacobian(qdd, x))}
         if variant == "cas":
             g = rnea(model, q, zero, zero, P, gravity)
-            outputs["slotine_li"] = _row_major(ca.jacobian(ca.mtimes(M, sym["qrdd"]) + ca.mtimes(C, sym["qrd"]) + g, params))
-        for fn, value in outputs.items():
+            outputs["slotine_li"] = lambda: _row_major(
+                ca.jacobian(ca.mtimes(M, sym["qrdd"]) + ca.mtimes(C, sym["qrd"]) + g, params))
+        for fn in CONTROLLER_FUNCTIONS:  # the dict's order, whatever the order of `which`
+            if fn not in which or fn not in outputs:
+                continue
             ins = [sym[i] for i in CONTROLLER_FUNCTIONS[fn][0]]
-            out.append(ca.Function(f"{name}_{variant}_{fn}", ins + extra, [value], opts))
+            out.append(ca.Function(f"{name}_{variant}_{fn}", ins + extra, [outputs[fn]()], opts))
     return out
 
 
-def generate_controller(model, name: str, folder: Path, cc: str, flags: list) -> dict:
+def generate_controller(model, name: str, folder: Path, cc: str, flags: list,
+                        which=tuple(CONTROLLER_FUNCTIONS)) -> dict:
     """One C file per controller function in folder, each compiled (or found in the private
     cache: casadi_objects.py); returns {function name: {iw, w, n_instructions, header, object}}."""
     import casadi_objects
 
-    fns = controller_functions(model, name)
+    fns = controller_functions(model, name, which)
     built = casadi_objects.compile_functions(fns, folder, cc, flags)
     return {k: {**v, "header": built[k][0], "object": built[k][1]} for k, v in casadi_objects.info(fns).items()}
 

@@ -14,7 +14,7 @@ from sympy.printing.c import C99CodePrinter
 from ..derivation.program import Assignment
 from .factoring import factored
 from .opcount import OpCount, count_all
-from .schedule import scheduled
+from .schedule import NOT_SUNK, scheduled
 from .shared import shared_products
 
 
@@ -128,7 +128,8 @@ def straight_line(prefix: str, joint_models, model, outputs) -> StraightLine:
     """Declarations of everything `outputs` (expressions of the model's program) need."""
     outputs_free = set().union(*(sp.sympify(o).free_symbols for o in outputs))
     written = [Assignment(a.symbol, factored(a.expr), a.section) for a in model.program.pruned(outputs)]
-    pruned = scheduled(shared_products(written, outputs_free), outputs_free, model.trig)
+    pruned = scheduled(shared_products(written, outputs_free), outputs_free, model.trig,
+                       sink=getattr(model, "name", None) not in NOT_SUNK)
     names = input_names(model)
     names.update({a.symbol: f"x{k}" for k, a in enumerate(pruned)})  # dense numbering: stable diffs
     printer = Printer(prefix, names)

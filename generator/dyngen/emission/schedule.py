@@ -15,11 +15,20 @@ results to the bit: only the order of independent statements changes.
 from __future__ import annotations
 
 LARGEST = 4000  # statements; above it the quadratic search costs more generation time than it saves
+# Functions whose statements are not sunk (_sunk): measured per call at -O2, gcc 12, in a probe
+# loop of the function alone (issue 24, h40), sinking costs rnea instructions on every example
+# arm (PUMA 560 1740 -> 1769, UR5 1743 -> 1757, Stanford 1529 -> 1541, LWR 1921 -> 1929, Panda
+# 1995 -> 1996) while it saves them on forward dynamics (PUMA 2794 -> 2779, Panda 3356 -> 3314,
+# LWR 3110 -> 3096), M and gravity on nearly every arm. An estimate of the stack traffic (Belady's
+# allocation with 16 registers) ranks rnea's two orders the other way round, so the choice rests
+# on the measurement, per function.
+NOT_SUNK = frozenset({"rnea"})
 
 
-def scheduled(assignments: list, outputs_free: set, trig: dict) -> list:
+def scheduled(assignments: list, outputs_free: set, trig: dict, sink: bool = True) -> list:
     """assignments reordered (a topological order of their dependencies). outputs_free: the
-    symbols the outputs read (they stay live to the end); trig: symbol -> (joint, fn)."""
+    symbols the outputs read (they stay live to the end); trig: symbol -> (joint, fn); sink:
+    then move statements down to their first reader (_sunk)."""
     n = len(assignments)
     if n > LARGEST or n < 3:
         return assignments
@@ -65,7 +74,7 @@ def scheduled(assignments: list, outputs_free: set, trig: dict) -> list:
             waiting[r] -= 1
             if waiting[r] == 0:
                 ready.add(r)
-    return _sunk(order, outputs_free, set(trig))
+    return _sunk(order, outputs_free, set(trig)) if sink else order
 
 
 def _sunk(order: list, outputs_free: set, trig: set) -> list:
