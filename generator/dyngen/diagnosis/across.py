@@ -5,8 +5,10 @@ than min_gain of the selection data's mean square beside their rigid body alone 
 offsets, rotor inertias and tilt left out: those are the arm's own), fitted alone to what the
 re-identified links leave, is explained by them: not told apart from the link parameters being
 off, so not claimed (explained_by_links; a payload, a rotor inertia on joint 1 and a gain are
-all changes the links can make). And a run is compared with a control run of the same arm
-without what is looked for (e.g. unloaded beside loaded):
+all changes the links can make); where the links ran and won no joint, those effects stay
+claimed, flagged with the same reason (pipeline.py). The gate that decides whether they run
+looks also at what gains and gravity scales took up (gated). And a run is compared with a
+control run of the same arm without what is looked for (e.g. unloaded beside loaded):
 
     result = compared(result, control, "unloaded.csv")
 
