@@ -5,8 +5,10 @@ than min_gain of the selection data's mean square beside their rigid body alone 
 offsets, rotor inertias and tilt left out: those are the arm's own), fitted alone to what the
 re-identified links leave, is explained by them: not told apart from the link parameters being
 off, so not claimed (explained_by_links; a payload, a rotor inertia on joint 1 and a gain are
-all changes the links can make). And a run is compared with a control run of the same arm
-without what is looked for (e.g. unloaded beside loaded):
+all changes the links can make); where the links ran and won no joint, those effects stay
+claimed, flagged with the same reason (pipeline.py). The gate that decides whether they run
+looks also at what gains and gravity scales took up (gated). And a run is compared with a
+control run of the same arm without what is looked for (e.g. unloaded beside loaded):
 
     result = compared(result, control, "unloaded.csv")
 
@@ -26,10 +28,16 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
+from . import reidentify
+from .fit import predict
 from .forward_selection import selection_gain, selection_mse
+from .moments import split_values
 from .refine import restricted
 
 DIFFERS = ("gain", "payload", "gravity_scale")
+RIGID_LIKE = ("gain", "gravity_scale")  # a torque the rigid body's base columns can largely make
 LINKS = "not told apart from the link parameters being off"
 
 
@@ -51,7 +59,8 @@ def compared(result, control, control_name: str):
                       "sensor or a payload")
             e = replace(e, suspect=reason + (f"; {e.suspect}" if e.suspect else ""))
         selected.append(e)
-    apart = [e for e in result.superseded if e.effect == "payload" and e.suspect == LINKS
+    # a payload the run's links explain (superseded, or flagged where they won no joint)
+    apart = [e for e in [*result.superseded, *selected] if e.effect == "payload" and e.suspect == LINKS
              and not any(c.effect == "payload" for c in [*control.selected, *control.superseded])]
     warnings = [*result.warnings]
     if both:
@@ -64,7 +73,8 @@ def compared(result, control, control_name: str):
                     for e in control.selected) or "none"
     note = (f"compared with the control run {control_name} (its own findings: {own}); in common: "
             f"{'; '.join(both) or 'none'}" + ("; payload told apart from the link parameters" if apart else ""))
-    return replace(result, selected=selected + [replace(e, suspect="") for e in apart],
+    told = [replace(e, suspect="") for e in apart]
+    return replace(result, selected=[e for e in selected if all(e is not a for a in apart)] + told,
                    superseded=[e for e in result.superseded if all(e is not a for a in apart)], warnings=warnings,
                    control=note)
 
@@ -80,3 +90,26 @@ def explained_by_links(context, segments, links, design, chosen, min_gain) -> li
         if selection_gain(one, selection_mse(alone, []), selection_mse(alone, [one])) < min_gain:
             out.append(i)
     return out
+
+
+
+def gated(model, context, segments, chosen, x, min_gain) -> tuple[list[int], float, list[int]]:
+    """reidentify.gate twice: on what the chosen effects leave (segments: their torques at values
+    x as correction), and on that with the torques of those the rigid body's base columns can
+    largely make put back (RIGID_LIKE: a gain, a gravity scale). Links that are off are first
+    taken up by such effects (gains of -11 % on five joints and a gravity scale of -10 % on the
+    withheld "coefficients" case logged by a polling logger), and what is left then shows the gate
+    nothing to re-identify. (joints, precision, hint): the joints either flags, the better
+    precision (the re-identification runs by default where it is reidentify.PRECISION or better),
+    and the joints the first flags (the links hint where it does not run: a true sensor gain put
+    back is itself a torque the base columns partly make). A payload stays taken: it is exactly a
+    change of the last link, which a control run tells apart (compared)."""
+    own = [seg.residual - seg.correction for seg in segments]
+    hint, precision = reidentify.gate(model, segments, own, min_gain)
+    if not any(c.effect.name in RIGID_LIKE for c in chosen):
+        return hint, precision, hint
+    values = split_values(chosen, x)
+    kept = np.concatenate([0 * v if c.effect.name in RIGID_LIKE else v for c, v in zip(chosen, values)])
+    taken, taken_precision = reidentify.gate(model, segments, [seg.residual - predict(context, chosen, kept, seg)
+                                                               for seg in segments], min_gain)
+    return sorted(set(hint) | set(taken)), min(precision, taken_precision), hint

@@ -35,9 +35,12 @@ def on_folds(context, segments, design, chosen, final, options) -> list[str]:
 
 
 def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, min_gain, flagged):
-    """(Consistent result, corrections, modes) where consistent links win a flagged joint; else no result."""
+    """(Consistent result, its corrections per segment, modes, tried) where the consistent link
+    parameters win a joint on selection data, else (None, None, modes, tried) (reidentify.py);
+    only on the joints `flagged` by reidentify.gate. tried: the result wherever it ran (what its
+    links explain is not told apart from them, across.explained_by_links, won or not)."""
     if not flagged:
-        return None, None, modes
+        return None, None, modes, None
     result = reidentify.identify(robot, model, p, reidentify.pieces(segments, "fit"),
                                  reidentify.pieces(segments, "select"))
     consistent = reidentify.corrections(result, model, segments)
@@ -45,8 +48,8 @@ def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, m
     # only on joints whose residual the link parameters were shown to explain (the gate)
     new = [m if m != joints.CONSISTENT or j in flagged else old for j, (m, old) in enumerate(zip(new, modes))]
     if joints.CONSISTENT not in new:
-        return None, None, modes
-    return result, consistent, new
+        return None, None, modes, result
+    return result, consistent, new, result
 
 
 def refit(robot, model, p, segments, reid, consistent):

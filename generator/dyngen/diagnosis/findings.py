@@ -50,15 +50,16 @@ def _torque_rms(design, cand, x) -> float:
     return float(np.sqrt(max(x @ G @ x, 0.0) / max(design.fit.count, 1)))
 
 
-def identifiable(design, chosen) -> np.ndarray:
-    """Per value of the chosen, whether the data determine it (not in the weighted normal matrix's null space)."""
+def identifiable(design, chosen, most: float = 0.5) -> np.ndarray:
+    """Per value of the chosen (in their order), whether the data determine it: less than `most`
+    of it in the null space of the weighted normal matrix."""
     slots = np.concatenate([c.slots for c in chosen])
     H = design.H[np.ix_(slots, slots)]
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
     vals, vecs = np.linalg.eigh(H / np.outer(d, d))
     weak = vals <= 1e-10 * max(vals.max(), 1e-300)
     loading = (vecs[:, weak] ** 2).sum(axis=1)
-    return loading < 0.5
+    return loading < most
 
 
 def reported(chosen, described, replaced) -> tuple[list[Finding], list[Finding]]:

@@ -118,6 +118,7 @@ class Choice:
     precision: float | None  # reidentify.gate's precision where it left the re-identification off by default
     described: list  # record.Finding per chosen effect, values not yet filled in
     selection_mse: dict  # "before", "effects", "simple": per joint, on the selection samples
+    tried: object = None  # the re-identification's result wherever it ran, won a joint or not
 
 
 def _choose(robot, model, p, context, segments, settled, separate_selection, options) -> Choice:
@@ -135,18 +136,17 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
         modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
         modes = choose.on_folds(context, selecting, design, chosen, final, options)
-    reid, consistent, links_hint, off_by_default = None, None, [], None
+    reid, consistent, links_hint, off_by_default, tried = None, None, [], None, None
     if design.select.count:  # the gate: where the rigid body's columns explain what the effects leave
-        flagged, precision = reidentify.gate(model, selecting, [seg.residual - seg.correction for seg in selecting],
-                                             options.min_gain)
+        flagged, precision, hint = across.gated(model, context, selecting, chosen, final.x, options.min_gain)
         run_reid = precision <= reidentify.PRECISION if options.reidentify is None else options.reidentify
         if run_reid:
-            reid, consistent, modes = choose.reidentified(robot, model, p, context, selecting, chosen, final.x, simple,
-                                                          modes, options.min_gain, flagged)
+            reid, consistent, modes, tried = choose.reidentified(robot, model, p, context, selecting, chosen, final.x,
+                                                                 simple, modes, options.min_gain, flagged)
         else:  # the link parameters may be off there
-            links_hint, off_by_default = flagged, (None if options.reidentify is False else precision)
+            links_hint, off_by_default = hint, (None if options.reidentify is False else precision)
     described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
-    return Choice(selecting, simple, modes, reid, consistent, links_hint, off_by_default, described, mse)
+    return Choice(selecting, simple, modes, reid, consistent, links_hint, off_by_default, described, mse, tried)
 
 
 @dataclass(frozen=True)
@@ -210,25 +210,31 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
                               final.correlation_samples)
     claimed = [i for i, c in enumerate(final.chosen) if i not in flagged or c.joint in replaced]
-    explained = [] if choice.reidentified is None else across.explained_by_links(
-        final.context, choice.segments, reidentify.link_corrections(choice.reidentified, model, choice.segments),
+    explained = [] if choice.tried is None else across.explained_by_links(
+        final.context, choice.segments, reidentify.link_corrections(choice.tried, model, choice.segments),
         settled.design, settled.chosen, min_gain)
     explained = [i for i in explained if final.chosen[i].joint not in replaced]  # those are superseded anyway
+    # links that won no joint explain them as well as they do: claimed, flagged (a true sensor gain
+    # on joint 2 of the LWR is also a change of its links); links that won a joint supersede them
+    marked, explained = (explained, []) if choice.reidentified is None else ([], explained)
+    findings = [replace(f, suspect=across.LINKS) if i in marked else f for i, f in enumerate(final.findings)]
     selected, superseded = reported([final.chosen[i] for i in claimed if i not in explained],
-                                    [final.findings[i] for i in claimed if i not in explained], replaced)
+                                    [findings[i] for i in claimed if i not in explained], replaced)
     unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed))]
     superseded += [replace(final.findings[i], suspect=across.LINKS) for i in explained if i in claimed]
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
     fit_signals = roles_of[0][1]
     selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
-    if explained:
-        apart.append("not told apart from the link parameters being off (the re-identified links' rigid body explains "
-                     f"them: beside it each gains less than {min_gain:g} of the selection data's mean square), so not "
-                     "claimed: "
-                     + "; ".join(final.chosen[i].effect.name + ("" if final.chosen[i].joint is None else
-                                 f" on joint {final.chosen[i].joint + 1}") for i in explained)
-                     + ("; a payload is a change of the last link's parameters: a control run without it (--control) "
-                        "tells them apart" if any(final.chosen[i].effect.name == "payload" for i in explained) else ""))
+    for which, so in ((explained, "so not claimed"), (marked, "flagged (those links won no joint)")):
+        if which:
+            apart.append("not told apart from the link parameters being off (the re-identified links' rigid body "
+                         f"explains them: beside it each gains less than {min_gain:g} of the selection data's mean "
+                         f"square), {so}: "
+                         + "; ".join(final.chosen[i].effect.name + ("" if final.chosen[i].joint is None else
+                                     f" on joint {final.chosen[i].joint + 1}") for i in which)
+                         + ("; a payload is a change of the last link's parameters: a control run without it "
+                            "(--control) tells them apart" if any(final.chosen[i].effect.name == "payload"
+                                                                  for i in which) else ""))
     if choice.links_hint:
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in choice.links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "

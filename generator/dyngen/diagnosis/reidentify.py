@@ -82,42 +82,54 @@ def _gate_columns(model, seg, k):
     return model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
 
 
+def sampled(model, segments, remaining) -> dict:
+    """role ("fit", "select") -> [(A, r, (segment index, sample indices))]: the rigid body's base
+    columns A (m, N, P) and `remaining` r (m, N) on each segment's samples of that role at about
+    GATE_RATE."""
+    out = {"fit": [], "select": []}
+    for i, (seg, rest) in enumerate(zip(segments, remaining)):
+        step = max(1, int(round(seg.signals.rate / GATE_RATE)))
+        for role in out:
+            k = np.flatnonzero(getattr(seg, role))[::step]
+            if k.size:
+                out[role].append((_gate_columns(model, seg, k), rest[k], (i, k)))
+    return out
+
+
+def rigid_fit(fit) -> tuple:
+    """(x, scale, V, ev): the unconstrained least squares of the base columns to r over the fit
+    pieces `fit` (sampled's), in the columns' scale, with the eigen-directions it kept."""
+    G = sum(A.reshape(-1, A.shape[2]).T @ A.reshape(-1, A.shape[2]) for A, _, _ in fit)
+    g = sum(A.reshape(-1, A.shape[2]).T @ r.reshape(-1) for A, r, _ in fit)
+    scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
+    ev, V = np.linalg.eigh(G / np.outer(scale, scale))
+    keep = ev > 1e-10 * ev[-1]
+    V, ev = V[:, keep], ev[keep]
+    return (V @ ((V.T @ (g / scale)) / ev)) / scale, scale, V, ev
+
+
 def gate(model, segments, remaining, min_gain: float) -> tuple[list[int], float]:
     """(joints, precision): the joints (0-based) on whose selection samples the unconstrained
     fit of the rigid body's base columns to `remaining` (per segment, the residual left by the
     per-joint models) gains at least `min_gain` of the mean square; and the largest relative
     standard deviation of the base coefficients that fit moves (inf if it moves none)."""
-    G = g = None
-    sel, fit = [], []
-    for seg, rest in zip(segments, remaining):
-        step = max(1, int(round(seg.signals.rate / GATE_RATE)))
-        for role in ("fit", "select"):
-            k = np.flatnonzero(getattr(seg, role))[::step]
-            if not k.size:
-                continue
-            A, r = _gate_columns(model, seg, k), rest[k]
-            (fit if role == "fit" else sel).append((A, r))
-            if role == "fit":
-                A2 = A.reshape(-1, A.shape[2])
-                G = A2.T @ A2 if G is None else G + A2.T @ A2
-                g = A2.T @ r.reshape(-1) if g is None else g + A2.T @ r.reshape(-1)
-    if G is None:
+    parts = sampled(model, segments, remaining)
+    if not parts["fit"]:
         return [], float("inf")
-    scale = np.sqrt(np.maximum(np.diag(G), 1e-300))
-    ev, V = np.linalg.eigh(G / np.outer(scale, scale))
-    keep = ev > 1e-10 * ev[-1]
-    x = (V[:, keep] @ ((V[:, keep].T @ (g / scale)) / ev[keep])) / scale
+    x, scale, V, ev = rigid_fit(parts["fit"])
     # the coefficients it moves (their torque at least MOVED of the residual's) and their precision:
     # correlation-scaled standard deviation over value, from the residual the fit leaves
-    A, r = (np.concatenate(part) for part in zip(*fit))
+    A, r = (np.concatenate(part) for part in list(zip(*parts["fit"]))[:2])
     left = r - A @ x
     tau = np.median([integrated_time(left[:, j]) for j in range(left.shape[1])])
-    std = np.sqrt(tau * np.sum(left ** 2) / max(left.size - keep.sum(), 1) * np.sum(V[:, keep] ** 2 / ev[keep], axis=1))
+    std = np.sqrt(tau * np.sum(left ** 2) / max(left.size - ev.size, 1) * np.sum(V ** 2 / ev, axis=1))
     moved = np.abs(x) * scale >= MOVED * np.sqrt(np.sum(r ** 2))
     precision = float(np.max(std[moved] / scale[moved] / np.abs(x[moved]))) if moved.any() else float("inf")
+    sel = parts["select"]
     if not sel:
         return [], precision
-    before, after = (sum(np.sum(m, axis=0) for m in ms) for ms in ([r ** 2 for _, r in sel], [(r - A @ x) ** 2 for A, r in sel]))
+    before, after = (sum(np.sum(m, axis=0) for m in ms) for ms in ([r ** 2 for _, r, _ in sel],
+                                                                   [(r - A @ x) ** 2 for A, r, _ in sel]))
     return [j for j in range(before.size) if after[j] < (1 - min_gain) * before[j]], precision
 
 
