@@ -14,7 +14,8 @@ from ..options import add_arguments, resolve
 from ..progress import Progress
 from ..arguments import whole
 from ..streaming.sample import MAX_ROWS
-from .recordings import MIN_DIAGNOSIS_SAMPLES, add_data_options, check_enough, compiled_model, conditioning_of, conditioning_text, read_all
+from .recordings import (MIN_DIAGNOSIS_SAMPLES, add_data_options, check_enough, check_headers, compiled_model,
+                         conditioning_text, read_all)
 
 
 def parser(prog="dyngen diagnose") -> argparse.ArgumentParser:
@@ -100,23 +101,22 @@ def main(argv, prog="dyngen diagnose") -> int:
     check_folder(out, [args.robot, args.params, *args.data, *(args.select or []), *tests, *(args.control or []),
                        args.model], args.force)
     # bad input fails before anything is announced or written
+    max_rows = args.max_rows or MAX_ROWS
     if args.split:
         if args.select or tests:
             raise InputError("--split", "", "cuts the --data recordings into fit, select and test: give no "
                              "--select, --test or --holdout with it")
         from .long_diagnosis import read_split
 
-        fit, select, test = read_split(args.data, robot, args, parse_fractions(args.split), args.max_rows or MAX_ROWS)
-        for recording in [*fit, *select, *test]:
-            check_enough(recording.name, recording.t)
+        fit, select, test = read_split(args.data, robot, args, parse_fractions(args.split), max_rows)
+        check_enough([*fit, *select, *test])
     else:  # --data read in blocks once the model is compiled (long_diagnosis.py); their headers now
-        from .long_diagnosis import check_headers, read_windows
+        from .long_diagnosis import read_windows
 
         check_headers(args.data, robot, args)
-        select = read_windows(args.select or [], robot, args, args.max_rows or MAX_ROWS)
-        test = read_windows(tests, robot, args, args.max_rows or MAX_ROWS)
-        for recording in [*select, *test]:
-            check_enough(recording.name, recording.t)
+        select = read_windows(args.select or [], robot, args, max_rows)
+        test = read_windows(tests, robot, args, max_rows)
+        check_enough([*select, *test])
     progress.say(f"dyngen diagnose: {robot.name} with {Path(args.params).name}, {len(args.data)} fit, {len(select)} "
                  f"select and {len(test)} test recording(s)")
     model = compiled_model(args, robot, progress)
@@ -125,9 +125,8 @@ def main(argv, prog="dyngen diagnose") -> int:
         from .long_diagnosis import read_fit
 
         with progress.step("read the --data recordings (in blocks)"):
-            fit, sampled = read_fit(args.data, robot, args, model, p, args.max_rows or MAX_ROWS)
-        for recording in fit:
-            check_enough(recording.name, recording.t)
+            fit, sampled = read_fit(args.data, robot, args, model, p, max_rows)
+        check_enough(fit)
     sources = {"params": printable(Path(args.params).name), "fit": [s.name for s in fit], "select": [s.name for s in select],
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
     if sampled:
@@ -150,7 +149,7 @@ def main(argv, prog="dyngen diagnose") -> int:
         from ..diagnosis.across import compared
 
         control = read_all([path], robot, args)
-        check_enough(Path(path).name, control[0].t)
+        check_enough(control)
         try:
             with progress.step(f"control run {control[0].name}"):
                 result = compared(result, diagnose(robot, model, p, control, None, options), control[0].name)

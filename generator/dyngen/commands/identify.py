@@ -68,7 +68,7 @@ def main(argv, prog="dyngen identify") -> int:
     sources = read_sources(args.data, robot, args)  # in blocks where they can be (identification/blocks.py)
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
-    return run_consistent(args, robot, model, sources, progress)
+    return run_consistent(args, robot, model, sources, progress, out)
 
 
 def check_outputs(args, robot, kind: str, ols: bool) -> Path:

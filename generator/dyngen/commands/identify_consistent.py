@@ -10,8 +10,9 @@ from pathlib import Path
 from ..options import resolve
 
 
-def run_consistent(args, robot, model, signals, progress) -> int:
-    """signals: identification.blocks.Source of every --data recording (commands/recordings.py)."""
+def run_consistent(args, robot, model, signals, progress, out: Path) -> int:
+    """signals: identification.blocks.Source of every --data recording (commands/recordings.py); `out`: the
+    YAML to write, already checked against the output-path policy (identify.py)."""
     from ..atomic import write_file
     from ..data.parameters_file import read_link_parameters
     from ..export import write_all
@@ -39,7 +40,6 @@ def run_consistent(args, robot, model, signals, progress) -> int:
     sanity, sanity_table, result = check(robot, model, result, _sampled(signals, robot, args),
                                         _sampled(select, robot, args), prior)
     # ---
-    out = Path(args.output) if args.output else Path("out") / robot.name / "identified_consistent.yaml"
     sources = [s.name for s in signals]  # printable: data/recording.py
     write_file(out, consistent_yaml(robot, result, sources, conditioning_text(signals)))
     table = out.with_suffix(".md")
@@ -66,7 +66,7 @@ def _sampled(sources, robot, args):
     windows of it (the ranges and the simple model's comparison on a sample, not every row)."""
     from ..data import condition
     from ..streaming.sample import windows
-    from .recordings import MIN_DIAGNOSIS_SAMPLES, conditioning_of
+    from .recordings import conditioning_of, long_enough
 
     if sources is None:
         return None
@@ -75,6 +75,6 @@ def _sampled(sources, robot, args):
         if s.signals is not None:
             out.append(s.signals)
             continue
-        out += [condition(w, conditioning_of(args)) for w in windows(s.path, robot.dof, s.effort_topic)
-                if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+        out += [condition(w, conditioning_of(args)) 
+                for w in long_enough(windows(s.path, robot.dof, s.effort_topic))]
     return out

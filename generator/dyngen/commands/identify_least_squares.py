@@ -8,21 +8,18 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import printable
-from .recordings import compiled_model, conditioning_of, conditioning_text
+from .recordings import check_headers, compiled_model, conditioning_of, conditioning_text
 
 
 def run_least_squares(args, robot, kind, required, progress, out: Path) -> int:
     """`out`: the YAML to write, already checked against the output-path policy (identify.py)."""
     from ..atomic import write_file
-    from ..data.chunks import chunks
     from ..identification import identified_yaml, summary_table
     from ..identification.samples import stacked_inertia_columns
     from ..streaming.pooled import identify_recordings, table
     from ..streaming.step import Task
 
-    need_tau = kind != "inertia"
-    for path in args.data:  # headers and the first rows: a bad file fails before anything is announced
-        next(chunks(path, robot.dof, need_tau, required, 64, args.effort_topic))
+    check_headers(args.data, robot, args, kind != "inertia", required)
     progress.say(f"dyngen identify: {robot.name}, {kind} coefficients from {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
     if kind == "inertia":

@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .recordings import MIN_DIAGNOSIS_SAMPLES, conditioning_of
+from .recordings import conditioning_of, long_enough
 
 
 def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
     """(the fit signals in the order of `paths`, the sampled recordings' summaries for the report)."""
-    from ..data import condition, read_recording
-    from ..data.recording import check_informative
+    from ..data import read_recording
     from ..streaming.gap import GapTask
     from ..streaming.sample import sample
 
@@ -25,25 +24,30 @@ def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
         if not got.sampled:  # the whole-file reader and its checks, as before
             recordings.append(read_recording(path, robot.dof, True, (), args.effort_topic))
             continue
-        windows = [w for w in got.recordings if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+        windows = long_enough(got.recordings)
         recordings += windows
         sampled.append(summary(got, windows))
-    check_informative(recordings, True)
-    return [condition(r, conditioning_of(args)) for r in recordings], sampled
+    return _conditioned(recordings, args), sampled
 
 
 def read_windows(paths, robot, args, max_rows: int) -> list:
     """--select and --test recordings, read in blocks: whole within max_rows samples, else
     evenly spread windows of them (streaming/sample.py: those of --test judged over every row,
     diagnosis/pipeline.py); conditioned, each on its own."""
-    from ..data import condition
-    from ..data.recording import check_informative
     from ..streaming.sample import windows
 
     recordings = []
     for path in paths:
         got = windows(path, robot.dof, args.effort_topic, max_rows, conditioning=conditioning_of(args))
-        recordings += got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+        recordings += got if len(got) == 1 else long_enough(got)
+    return _conditioned(recordings, args)
+
+
+def _conditioned(recordings, args) -> list:
+    """The recordings checked together (data.recording.check_informative), then each conditioned on its own."""
+    from ..data import condition
+    from ..data.recording import check_informative
+
     check_informative(recordings, True)
     return [condition(r, conditioning_of(args)) for r in recordings]
 
@@ -82,7 +86,7 @@ def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list
                 span = (t0 + edges[k] * (t1 - t0), t0 + edges[k + 1] * (t1 - t0) if edges[k + 1] < 1.0 else np.inf)
                 for w in got:
                     w.stream = Rows(str(path), robot.dof, args.effort_topic, span=span)
-            roles[k].extend(got if len(got) == 1 else [w for w in got if w.t.size >= MIN_DIAGNOSIS_SAMPLES])
+            roles[k].extend(got if len(got) == 1 else long_enough(got))
     return tuple([condition(r, conditioning_of(args)) for r in role] for role in roles)
 
 
@@ -114,11 +118,3 @@ def markdown(sampled: list) -> str:
                   "| after the simple model [Nm] | " + " | ".join(f"{x:.3g}" for x in s["simple_rms"]) + " |",
                   ""]
     return "\n".join(lines)
-
-
-def check_headers(paths, robot, args) -> None:
-    """Headers and first rows: a bad file fails before anything is announced."""
-    from ..data.chunks import chunks
-
-    for path in paths:
-        next(chunks(path, robot.dof, True, (), 64, args.effort_topic))

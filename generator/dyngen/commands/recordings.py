@@ -54,10 +54,24 @@ class Recordings(argparse._AppendAction):
             super().__call__(parser, namespace, path, option_string)
 
 
-def check_enough(name: str, t) -> None:
-    if len(t) < MIN_DIAGNOSIS_SAMPLES:
-        raise InputError(name, "", f"{len(t)} samples; a diagnosis needs at least {MIN_DIAGNOSIS_SAMPLES} "
-                         "(seconds of motion at the recording's rate)")
+def check_enough(recordings) -> None:
+    for r in recordings:
+        if len(r.t) < MIN_DIAGNOSIS_SAMPLES:
+            raise InputError(r.name, "", f"{len(r.t)} samples; a diagnosis needs at least {MIN_DIAGNOSIS_SAMPLES} "
+                             "(seconds of motion at the recording's rate)")
+
+
+def long_enough(windows) -> list:
+    """The windows of a recording read in blocks that can be diagnosed (a last short one is left out)."""
+    return [w for w in windows if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
+
+
+def check_headers(paths, robot, args, require_torques: bool = True, required: tuple = ()) -> None:
+    """Headers and first rows: a bad file fails before anything is announced."""
+    from ..data.chunks import chunks
+
+    for path in paths:
+        next(chunks(path, robot.dof, require_torques, required, 64, args.effort_topic))
 
 
 def conditioning_of(args):

@@ -8,12 +8,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .recordings import compiled_model, conditioning_of
+from .recordings import check_headers, compiled_model, conditioning_of
 
 
 def run_survey(args, robot, p, progress) -> int:
     from ..atomic import write_file
-    from ..data.chunks import chunks
     from ..errors import InputError
     from ..streaming.gap import GapTask, survey, table
 
@@ -24,8 +23,7 @@ def run_survey(args, robot, p, progress) -> int:
 
     out = Path(args.out) if args.out else Path("out") / robot.name / "survey"
     check_folder(out, [args.robot, args.params, *args.data, args.model], args.force)  # before any work
-    for path in args.data:  # headers and the first rows: a bad file fails before anything is announced
-        next(chunks(path, robot.dof, True, (), 64, args.effort_topic))
+    check_headers(args.data, robot, args)
     progress.say(f"dyngen diagnose --survey: {robot.name} with {Path(args.params).name}, {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
     tasks = [GapTask(str(x), robot.dof, str(model.folder), tuple(float(v) for v in p), conditioning_of(args),
