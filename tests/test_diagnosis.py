@@ -441,7 +441,7 @@ def test_a_local_effects_column_on_a_joint_needs_that_joint_alone(lwr):
     model, robot, arm, p, trajectories = lwr
     t, at, q, qd, qdd, tau = trajectories["fit"]
     s = model(STANDARD_FROM_DYNAMIC.name, p)
-    context = Context(model, robot, p, s, 0.01, (q.min(axis=0), q.max(axis=0)), (qd.min(axis=0), qd.max(axis=0)))
+    context = Context(model, robot, p, s, 0.01, (q.min(axis=0), q.max(axis=0)))
     whole = signals("fit", t, q, qd, qdd, tau)
     local = [e for e in library(context) if e.local]
     assert {e.name for e in local} >= {"coulomb", "stribeck", "viscous", "offset"}

@@ -13,7 +13,7 @@ from .record import Finding
 from .forward_selection import relative_change, selection_gain, selection_mse
 
 
-def describe(robot, design, chosen, final, cand, min_gain) -> Finding:
+def describe(design, chosen, cand, min_gain) -> Finding:
     """What an effect does on the selection data (its gain, the joints it helps); values come in with_values."""
     mse_without = selection_mse(design, [c for c in chosen if c is not cand])
     mse_with = selection_mse(design, chosen)

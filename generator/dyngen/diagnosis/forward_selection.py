@@ -20,7 +20,7 @@ class Fit:
     x: np.ndarray  # values at the chosen slots
     slots: np.ndarray
     covariance: np.ndarray | None  # white-residual covariance (scaled later for correlation), or only
-    sigma2: float                  # the block of `block` (see solve)
+    # the block of `block` (see solve)
     block: slice | None = None
 
     def covariance_of(self, k: slice) -> np.ndarray:
@@ -48,7 +48,7 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
     apply, d = _factored(design.H[np.ix_(slots, slots)])
     x = apply(design.g[slots] / d) / d
     if not covariance:
-        return Fit(x, slots, None, float("nan"), block)
+        return Fit(x, slots, None, block)
     fit = design.fit
     w2 = design.weights ** 2
     G = fit.G[:, slots][:, :, slots]
@@ -57,7 +57,7 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
     middle = np.einsum("j,jkl->kl", w2 ** 2 * s2, G)
     unit = np.eye(len(slots))[:, block if block is not None else slice(None)]
     columns = apply(unit / d[:, None]) / d[:, None]  # the needed columns of H^-1
-    return Fit(x, slots, columns.T @ middle @ columns, float(w2 @ s2) / len(s2), block)
+    return Fit(x, slots, columns.T @ middle @ columns, block)
 
 
 def _factored(H: np.ndarray):

@@ -1,15 +1,4 @@
-"""The diagnosis as a pipeline of stages, each a module with its inputs and outputs:
-
-    0. roles      the recordings cut into fit, selection and test samples (roles.py)
-    1. fit        the moments of every candidate effect (fit.py, moments.py)
-    2. select     forward selection on the selection data (forward_selection.py)
-    3. settle     settings refined, insignificant effects pruned, implausible ones refused
-                  (settle.py, refine.py), once more with each joint weighted by what is left
-    4. choose     per joint: the effects, the simple model (terms/simple_model.py), both, or re-identified
-                  link parameters (choose.py, joints.py, reidentify.py); then the final fit on
-                  every fit sample
-    5. test       the figures on the judged data (judge.py, phases.py)
-    6. report     the findings (findings.py) and warnings (notes.py) in one record (record.py)
+"""The diagnosis's stages run in order (listed with their modules in diagnosis/__init__.py):
 
     result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
 
@@ -29,7 +18,6 @@ import numpy as np
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import Context, library, simple_model
 from . import across, choose, every_row, findings_check, fit, joints, reidentify, roles, stable, trust
-from . import moments as dz
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve
@@ -72,11 +60,9 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
 
 
 def _context(model, robot, p, s, options, segments) -> Context:
-    """Position- and velocity-dependent laws are known only over what the fit data cover."""
+    """Position-dependent laws are known only over the positions the fit data cover."""
     fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
-    fit_qd = np.vstack([seg.signals.qd[seg.fit] for seg in segments if seg.fit.any()])
-    return Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)),
-                   (fit_qd.min(axis=0), fit_qd.max(axis=0)))
+    return Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)))
 
 
 @dataclass(frozen=True)
@@ -145,7 +131,7 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
                                                                  simple, modes, options.min_gain, flagged)
         else:  # the link parameters may be off there
             links_hint, off_by_default = hint, (None if options.reidentify is False else precision)
-    described = [describe(robot, design, chosen, final, c, options.min_gain) for c in chosen]
+    described = [describe(design, chosen, c, options.min_gain) for c in chosen]
     return Choice(selecting, simple, modes, reid, consistent, links_hint, off_by_default, described, mse, tried)
 
 

@@ -54,7 +54,6 @@ class Context:
     s: np.ndarray
     sign_velocity: float  # rad/s (m/s): sign(qd) is smoothed as tanh(qd / sign_velocity) (diagnosis Options)
     q_range: tuple | None = None  # (low, high) per joint: the positions the fit data cover
-    qd_range: tuple | None = None  # (low, high) per joint: the velocities the fit data cover
     # The arm and sensor as the chosen terms have them (moments.as_chosen): other terms' torques
     # measured `delay` s late, the arm's times `scale[j]` on joint j (1 + a sensor gain; None: 1),
     # `load` (m, mx, my, mz) of a payload on the last link, whose gravity a tilt turns too.
