@@ -61,38 +61,38 @@ def figures(d, out_dir, robot_name: str) -> dict:
     n = measured.shape[1]
     out = Path(out_dir)
 
-    fig, axes = _grid(n)
-    for j in range(n):
-        ax = axes[j]
-        for name, color in SHADED.items():
-            _shade(ax, t, labels[name][:, j], color)
+    def torques(ax, j) -> str:
         ax.plot(t, measured[:, j], color="tab:blue", lw=1.4, label="measured")
         ax.plot(t, model[:, j], color="tab:red", lw=1.0, ls="--", label="model (Newton-Euler)")
         ax.plot(t, model[:, j] + seg.correction[m][:, j], color="tab:green", lw=0.9, label="model + selected effects")
-        ax.set_title(f"joint {j + 1}", loc="left", fontsize=10)
-        ax.set_ylabel("torque [Nm]")
-        ax.grid(True, alpha=0.3)
-    _legend(fig, axes[0])
-    paths = {"torques": _save(fig, out / "torques.png", f"{robot_name}: measured and model torques on "
-                                                          f"{label} ({seg.signals.name})")}
+        return f"joint {j + 1}"
 
+    def residuals(ax, j) -> str:
+        ax.plot(t, before[:, j], color="tab:red", lw=1.0, label="residual, nominal model")
+        ax.plot(t, after[:, j], color="tab:green", lw=1.0, label="residual with the selected effects")
+        ax.axhline(0, color="0.3", lw=0.6)
+        rms_b, rms_a = np.sqrt(np.mean(before[:, j] ** 2)), np.sqrt(np.mean(after[:, j] ** 2))
+        return f"joint {j + 1}: RMS {rms_b:.3f} -> {rms_a:.3f}"
+
+    shown = f"{label} ({seg.signals.name})"
+    return {"torques": _save(_panels(n, t, labels, torques, "torque [Nm]"), out / "torques.png",
+                             f"{robot_name}: measured and model torques on {shown}"),
+            "residuals": _save(_panels(n, t, labels, residuals, "residual [Nm]"), out / "residuals.png",
+                               f"{robot_name}: residual tau_measured - tau_model on {shown}")}
+
+
+def _panels(n, t, labels, draw, ylabel):
+    """One panel per joint, reversals and standstill shaded; draw(ax, j) plots joint j and returns its title."""
     fig, axes = _grid(n)
     for j in range(n):
         ax = axes[j]
         for name, color in SHADED.items():
             _shade(ax, t, labels[name][:, j], color)
-        ax.plot(t, before[:, j], color="tab:red", lw=1.0,
-                label="residual, nominal model")
-        ax.plot(t, after[:, j], color="tab:green", lw=1.0, label="residual with the selected effects")
-        ax.axhline(0, color="0.3", lw=0.6)
-        rms_b, rms_a = np.sqrt(np.mean(before[:, j] ** 2)), np.sqrt(np.mean(after[:, j] ** 2))
-        ax.set_title(f"joint {j + 1}: RMS {rms_b:.3f} -> {rms_a:.3f}", loc="left", fontsize=10)
-        ax.set_ylabel("residual [Nm]")
+        ax.set_title(draw(ax, j), loc="left", fontsize=10)
+        ax.set_ylabel(ylabel)
         ax.grid(True, alpha=0.3)
     _legend(fig, axes[0])
-    paths["residuals"] = _save(fig, out / "residuals.png", f"{robot_name}: residual tau_measured - tau_model "
-                                                             f"on {label} ({seg.signals.name})")
-    return paths
+    return fig
 
 
 def _legend(fig, ax):
