@@ -1,40 +1,21 @@
-"""Per joint, the final model: the selected effects, the simple model, or both together.
-
-The simple model (terms/simple_model.py) is what every diagnosis must beat. On each joint three models
-are fitted on the fit samples and compared on the selection samples:
+"""Per joint, the final model, fitted on the fit samples and compared on the selection samples
+(the rules and the cases behind them: docs/measured-data.md, "Never worse than the simple model"):
 
   effects    the selected effects as fitted together (the diagnosis's findings);
-  simple     b + Fc tanh(qd/0.02) + Fv qd alone;
+  simple     b + Fc tanh(qd/0.02) + Fv qd alone (terms/simple_model.py, what every diagnosis must beat);
   completed  the effects acting on the joint as fitted, plus the simple model's three columns
-             fitted to what they leave on that joint: a joint whose effects
-             were each chosen for a large gain may still lack an offset or a plain friction
-             term that none of them covers.
+             fitted to what they leave on that joint (an offset or a plain friction term that
+             none of the effects covers);
+  consistent the re-identified, physically consistent link parameters (reidentify.py), where
+             computed: counted as reidentify.JOINT_VALUES values, and gaining at least `min_gain`
+             of the mean square over the best of the three others in any case.
 
-  consistent the link parameters re-identified, physically consistent, with their own friction
-             (reidentify.py), where they were computed: counted as its per-joint values plus one
-             (reidentify.JOINT_VALUES), and it must gain at least `min_gain` of the mean square
-             over the best of the three others on the joint's selection data in any case.
-
-The effects stay unless another model does better on the selection data, where the model with
-more values on the joint must gain `min_gain` of the mean square per extra value (what an
-effect must gain to be selected at all), so that three numbers fitting noise do not replace a
-one-value finding, and six ripple harmonics do not displace the simple model on a whim. The decision is made with the values fitted on the fit samples only;
-`apply` then sets each joint's correction with the final values.
-
-That margin decides what is *claimed*. What *predicts* the joint's torque is the simple model
-unless the model chosen beats it by `min_gain` of the mean square on the selection data (else
-TIED): the effects stay findings, but where the data cannot tell the two apart the baseline
-every diagnosis is measured against is the one used. (A joint that no effect acts on keeps the
-nominal model, which claims nothing, unless the simple model wins by its margin.) The burden of proof is the diagnosis's:
-on the real LWR's joint 5 (fit on measurement 1) Coulomb + offset and the simple model differ
-by 0-1.5 % on the fit trajectory, depending on the selection blocks, and only extrapolate
-differently to a faster one.
-
-With selection on blocks of the fit data, the errors are summed over the three cuts
-(choose.on_folds), so every fit sample is judged once and the sums are far less noisy
-than one selection set's: there an extra value must gain FOLDS_PER_VALUE (2 %) instead. Values
-that fit noise change a held-out error by about 2 sqrt(k) / N_eff of it (N_eff: independent
-samples, a few hundred in 25 s at 200 Hz), so 2 % per value is still several times that.
+A model with more values on the joint must gain `min_gain` of the mean square per extra value
+(what an effect must gain to be selected), so that three numbers fitting noise do not replace a
+one-value finding. That margin decides what is *claimed*; what *predicts* the joint's torque is
+the simple model unless the model chosen beats it by `min_gain` (else TIED: the effects stay
+findings, and where the data cannot tell the two apart, the baseline is the one used). `apply`
+then sets each joint's correction with the final values.
 """
 
 from __future__ import annotations
@@ -48,7 +29,11 @@ from . import moments as dz
 
 EFFECTS, SIMPLE, COMPLETED, CONSISTENT = "effects", "simple", "effects + simple", "consistent parameters"
 TIED = "simple (effects not shown better)"  # the simple model predicts; the effects stay findings
-FOLDS_PER_VALUE = 0.02  # least gain per extra value on errors summed over the three cuts (see above)
+# Least gain per extra value on errors summed over the three cuts of the fit recordings
+# (choose.on_folds): every fit sample is judged once, so the sums are far less noisy than one
+# selection set's. Values that fit noise change a held-out error by about 2 sqrt(k) / N_eff of it
+# (N_eff: independent samples, a few hundred in 25 s at 200 Hz): 2 % per value is several times that.
+FOLDS_PER_VALUE = 0.02
 
 
 def _parts(context, chosen, x, seg, j):

@@ -8,20 +8,18 @@ import numpy as np
 
 from ..parameters import PER_LINK, dynamic_from_standard, standard_from_dynamic
 from ..terms import effect_class
-from ..terms.friction import FRICTION_NAMES
+from ..terms.friction import FRICTION_NAMES  # the emitted <robot>_friction's vector, per joint
 from .joints import COMPLETED, SIMPLE, TIED
-
-FRICTION_FIELDS = FRICTION_NAMES  # the emitted <robot>_friction's vector, per joint
 
 
 def friction_vector(diagnosis, sign_velocity: float) -> np.ndarray:
     """f for <robot>_friction: the laws as fitted, velocity scales included (signs at sign_velocity)."""
-    f = np.zeros((diagnosis.joints, len(FRICTION_FIELDS)))
+    f = np.zeros((diagnosis.joints, len(FRICTION_NAMES)))
     for name in ("vc", "es", "ed"):
-        f[:, FRICTION_FIELDS.index(name)] = sign_velocity
+        f[:, FRICTION_NAMES.index(name)] = sign_velocity
     for e in diagnosis.selected:
         for name, value in effect_class(e.effect).friction_terms(e.values, e.variant).items():
-            f[e.joints[0] - 1, FRICTION_FIELDS.index(name)] = value
+            f[e.joints[0] - 1, FRICTION_NAMES.index(name)] = value
     return f.ravel()
 
 
@@ -58,7 +56,7 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
         "parameters": sources.get("params"),
         "effects": [{"effect": e.effect, "joints": list(e.joints), **({"variant": e.variant} if e.variant else {}),
                      "values": e.values, "std": e.std, "units": e.units} for e in diagnosis.selected],
-        "friction": {"layout": "per joint: " + ", ".join(FRICTION_FIELDS) + " (generated <robot>_friction)",
+        "friction": {"layout": "per joint: " + ", ".join(FRICTION_NAMES) + " (generated <robot>_friction)",
                      "f": [[float(x) for x in row] for row in f]},
     }
     modes = list(enumerate(diagnosis.joint_models, start=1))
