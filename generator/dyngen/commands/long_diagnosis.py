@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .recordings import conditioning_of, long_enough
+from .recordings import conditioned, conditioning_of, long_enough
 
 
 def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
@@ -27,7 +27,7 @@ def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
         windows = long_enough(got.recordings)
         recordings += windows
         sampled.append(summary(got, windows))
-    return _conditioned(recordings, args), sampled
+    return conditioned(recordings, args), sampled
 
 
 def read_windows(paths, robot, args, max_rows: int) -> list:
@@ -40,16 +40,7 @@ def read_windows(paths, robot, args, max_rows: int) -> list:
     for path in paths:
         got = windows(path, robot.dof, args.effort_topic, max_rows, conditioning=conditioning_of(args))
         recordings += got if len(got) == 1 else long_enough(got)
-    return _conditioned(recordings, args)
-
-
-def _conditioned(recordings, args) -> list:
-    """The recordings checked together (data.recording.check_informative), then each conditioned on its own."""
-    from ..data import condition
-    from ..data.recording import check_informative
-
-    check_informative(recordings, True)
-    return [condition(r, conditioning_of(args)) for r in recordings]
+    return conditioned(recordings, args)
 
 
 def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list, list]:

@@ -109,11 +109,18 @@ def compiled_model(args, robot, progress):
 def read_all(paths, robot, args, require_torques=True, required=(), need_motion=True):
     """need_motion: the recordings must move some joint (a model of motion is fitted), not only
     hold one pose; with torques, some torque must be nonzero (an all-zero file fits nothing)."""
-    from ..data import condition, read_recording
-    from ..data.recording import check_informative
+    from ..data import read_recording
 
     topic = getattr(args, "effort_topic", None)
-    recordings = [read_recording(p, robot.dof, require_torques, required, topic) for p in paths]
+    return conditioned([read_recording(p, robot.dof, require_torques, required, topic) for p in paths], args,
+                       need_motion)
+
+
+def conditioned(recordings, args, need_motion: bool = True) -> list:
+    """The recordings checked together (data.recording.check_informative), then each conditioned on its own."""
+    from ..data import condition
+    from ..data.recording import check_informative
+
     check_informative(recordings, need_motion)
     return [condition(r, conditioning_of(args)) for r in recordings]
 

@@ -17,7 +17,7 @@ class Options:
         f"{', '.join(n for n in NAMES if n not in DEFAULT_NAMES)})", metavar="LIST", listed=True)
     min_gain: float = option(MIN_GAIN, "least selection gain to select an effect, as a share of a joint's mean "
                              "square", metavar="G", bounds=(0.0, 1.0))
-    alpha: float = ALPHA  # significance level of the selection and the pruning (selection.py)
+    alpha: float = ALPHA  # significance level of the selection and the pruning (forward_selection.py)
     sign_velocity: float = option(SIGN_SCALE, "sign(qd) of the Stribeck and direction terms is smoothed as tanh(qd / V), "
                                   "V in rad/s (Coulomb's own scale is fitted)", metavar="V", bounds=(0.0, 1e3),
                                   above=True)

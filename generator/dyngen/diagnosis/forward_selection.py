@@ -82,10 +82,6 @@ def _solver(Hs: np.ndarray):
     return lambda b: inverse @ b
 
 
-def significant(fit: Fit, candidate, chosen, alpha: float = ALPHA, correlation: float = 1.0) -> bool:
-    return p_value(fit, candidate, chosen, correlation) < alpha
-
-
 def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     """Chi-square test of the candidate's values against zero, the covariance scaled by the correlation time."""
     offset = sum(c.size for c in chosen[:chosen.index(candidate)])
@@ -140,7 +136,6 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
     """Forward steps; their significance test assumes uncorrelated residuals (prune() scales it)."""
     selection = Selection([])
     current = selection_mse(design, [])
-    tau = 1.0
     while len(selection.chosen) < max_steps:
         families = {c.family for c in selection.chosen}
         trials = []
@@ -158,7 +153,7 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
                 size = len(fit.x)
                 fit = solve(design, chosen, block=slice(size - cand.size, size))
                 trials.append((gain, cand, mse, fit, chosen))
-        qualified = [t for t in trials if significant(t[3], t[1], t[4], alpha, tau)]
+        qualified = [t for t in trials if p_value(t[3], t[1], t[4]) < alpha]
         if not qualified:
             break
         earned = lambda t: t[0] / np.sqrt(t[1].size)  # noqa: E731  gain over its price of entry
