@@ -35,7 +35,7 @@ from dyngen.data import Conditioning, condition, read_recording  # noqa: E402
 from dyngen.data.parameters_file import read_link_parameters  # noqa: E402
 from dyngen.description import load_robot  # noqa: E402
 from dyngen.diagnosis import diagnose  # noqa: E402
-from dyngen.diagnosis.outputs import write_outputs  # noqa: E402
+from dyngen.diagnosis.diagnosis_files import write_outputs  # noqa: E402
 from dyngen.runtime import load  # noqa: E402
 
 RATE, DURATION, NOISE = 1000.0, 30.0, 0.02

@@ -40,11 +40,12 @@ DIAGNOSIS_STAGES = (
     {"joints", "reidentify", "choose"},  # 4. choose
     {"judge", "every_row"},  # 5. test (of long recordings: every row)
     {"findings", "findings_check", "stable", "across", "notes", "diagnose_options", "pipeline"},  # 6. report; the pipeline
-    {"report", "updated_model", "figures", "outputs", ""},  # written out; the package
+    {"report_text", "updated_model", "residual_figures", "diagnosis_files", ""},  # written out; the package
 )
 DIAGNOSIS_RANK = {name: k for k, names in enumerate(DIAGNOSIS_STAGES) for name in names}
 MEASURED_DATA = ("data", "diagnosis", "terms", "identification", "excitation", "streaming")
-MEASURED_COMMANDS = ("diagnose", "identify", "identify_consistent", "excite", "recordings", "identify_least_squares", "survey")
+MEASURED_COMMANDS = ("diagnose", "identify", "identify_consistent", "excite", "recordings", "identify_least_squares", "survey",
+                     "long_diagnosis")
 MAX_LINES = 300
 
 

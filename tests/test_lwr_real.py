@@ -133,7 +133,7 @@ def test_the_terminal_says_where_the_simple_model_is_better(setup):
     selection data to predict the joint, and on m3 ends above the simple model: that joint is
     named with both figures, and with both at the velocities the fit data covered (where the
     final model is the better one)."""
-    from dyngen.diagnosis.report import summary_lines
+    from dyngen.diagnosis.report_text import summary_lines
 
     robot, model, p = setup
     d = diagnose(robot, model, p, [recording(1)], None, Options(block_seconds=1.5), test=[recording(3)])

@@ -23,7 +23,7 @@ from simulation.withheld_cases import CASES, nominal_model, write_cases
 from dyngen.data import condition, read_recording
 from dyngen.description import load_robot
 from dyngen.diagnosis import diagnose
-from dyngen.diagnosis.report import markdown, summary_lines
+from dyngen.diagnosis.report_text import markdown, summary_lines
 from dyngen.runtime import load
 
 GAIN = 0.08  # relative, on joint 2's torque

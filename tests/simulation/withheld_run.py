@@ -16,7 +16,7 @@ import numpy as np
 
 from dyngen.data import condition, read_recording
 from dyngen.diagnosis import diagnose
-from dyngen.diagnosis.report import to_json
+from dyngen.diagnosis.report_text import to_json
 
 from .perfect import perfect_rms
 from .withheld_cases import CASES, COMPOSED_CASES, OFF_GRID_CASES, TRACKED_CASES, nominal_model, simulated_parameters

@@ -75,8 +75,8 @@ def main(argv, prog="dyngen diagnose") -> int:
     from ..description import load_robot
     from ..diagnosis import Options, diagnose
     from ..terms import check_names
-    from ..diagnosis.outputs import write_outputs
-    from ..diagnosis.report import summary_lines
+    from ..diagnosis.diagnosis_files import write_outputs
+    from ..diagnosis.report_text import summary_lines
     from ..data.parameters_file import read_link_parameters
 
     options = resolve(Options, args, {})
@@ -132,7 +132,7 @@ def main(argv, prog="dyngen diagnose") -> int:
     if sampled:
         sources["sampled"] = sampled
     from ..diagnosis.trust import EXIT_UNUSABLE, Unusable  # the diagnosis loads only once it runs
-    from ..diagnosis.outputs import write_unusable
+    from ..diagnosis.diagnosis_files import write_unusable
 
     try:
         with progress.step("residual, effects, selection, test"):

@@ -2,7 +2,7 @@
 unmodelled effect explains it (chosen on held-out data), and how far it shrinks.
 
     result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
-    write_outputs(result, robot, p, out_dir, sources, sign_velocity)   # outputs.py
+    write_outputs(result, robot, p, out_dir, sources, sign_velocity)   # diagnosis_files.py
 
 The stages, in order (pipeline.py runs them):
 
@@ -16,7 +16,8 @@ The stages, in order (pipeline.py runs them):
                      link parameters (joints.py, reidentify.py)
     5. judge.py      the figures on the judged data, per phase of the motion (phases.py)
     6. findings.py   the findings, notes.py the warnings, record.py the result (Diagnosis);
-                     report.py, figures.py and updated_model.py write them (outputs.py)
+                     report_text.py, residual_figures.py and updated_model.py write them
+                     (diagnosis_files.py)
 """
 
 from .diagnose_options import Options

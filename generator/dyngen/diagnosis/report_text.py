@@ -1,5 +1,5 @@
-"""The diagnosis as a readable markdown report and as JSON for scripts (schema:
-docs/conventions.md, "Diagnosis JSON")."""
+"""The diagnosis as text: a readable markdown report (report.md), JSON for scripts (diagnosis.json,
+schema: docs/conventions.md, "Diagnosis JSON") and the terminal's summary lines."""
 
 from __future__ import annotations
 

@@ -10,19 +10,19 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_figure, write_file
-from . import reidentify, report, updated_model
+from . import reidentify, report_text, updated_model
 
 
 def write_outputs(diagnosis, robot, p, out_dir, sources: dict, sign_velocity: float) -> dict:
     out = Path(out_dir)
-    texts = {"report.md": report.markdown(diagnosis, sources),
-             "diagnosis.json": report.to_json(diagnosis, sources),
+    texts = {"report.md": report_text.markdown(diagnosis, sources),
+             "diagnosis.json": report_text.to_json(diagnosis, sources),
              "effects.yaml": updated_model.effects_yaml(diagnosis, sources, sign_velocity)}
     paths = {}
     for name, text in texts.items():  # every text is built before the first is written
         write_file(out / name, text)
         paths[name] = out / name
-    from .figures import figures
+    from .residual_figures import figures
 
     paths.update(figures(diagnosis, out, robot.name))
     if not robot.gravity_symbols:
@@ -64,7 +64,7 @@ FIGURE = "conditioning.png"
 
 def _figure(record, path: Path) -> Path:
     """conditioning.png: per joint the measured torque's RMS beside each trial's nominal residual."""
-    from .figures import plt  # with the Agg backend
+    from .residual_figures import plt  # with the Agg backend
 
     trials = record.trials
     n = trials[0].torque.size
@@ -90,7 +90,7 @@ def write_unusable(err, out_dir, sources: dict) -> dict:
     out = Path(out_dir)
     lines = ["# Diagnosis not possible: the conditioning cannot be trusted", "", f"**{err.line}**", "",
              f"![the nominal residual against the torque]({FIGURE})", ""]
-    doc = {"schema": report.SCHEMA_VERSION, "usable": False, "reason": err.line, **sources, "recordings": []}
+    doc = {"schema": report_text.SCHEMA_VERSION, "usable": False, "reason": err.line, **sources, "recordings": []}
     for r in err.recordings:
         lines += [f"## {r.recording}", "", "| conditioning | cutoff [Hz] | " + " | ".join(
             f"J{j + 1}" for j in range(r.trials[0].torque.size)) + " |",
