@@ -22,6 +22,7 @@ from __future__ import annotations
 import itertools
 import os
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
@@ -114,13 +115,21 @@ class Source:
             yield from map(self.block, range(len(self._starts)))
             return
         self._log = Streamed()  # repeated rows left out as data.conditioning does
-        for number, block in enumerate(self._log.blocks(chunks(self.path, self.dof, True, (), self.block_rows,
-                                                               self.effort_topic))):
-            np.save(os.path.join(folder, f"{number}.npy"), np.column_stack([block.t, block.q, block.qd, block.qdd,
-                                                                            block.tau]))
-            self._starts.append(sum(self._sizes))
-            self._sizes.append(block.t.size)
-            yield block
+        # each block written by a thread while the next is read (the write is system time in the
+        # kernel, without the GIL: the parse is one process, the other core free); one write at a time
+        with ThreadPoolExecutor(1) as writer:
+            written = None
+            for number, block in enumerate(self._log.blocks(chunks(self.path, self.dof, True, (), self.block_rows,
+                                                                   self.effort_topic))):
+                data = np.column_stack([block.t, block.q, block.qd, block.qdd, block.tau])
+                if written is not None:
+                    written.result()
+                written = writer.submit(np.save, os.path.join(folder, f"{number}.npy"), data)
+                self._starts.append(sum(self._sizes))
+                self._sizes.append(block.t.size)
+                yield block
+            if written is not None:
+                written.result()
         self._parsed = True
 
     def block(self, number: int, last: int | None = None) -> SimpleNamespace:
