@@ -103,17 +103,21 @@ def gated(model, context, segments, chosen, x, min_gain, floor=None) -> tuple[li
     precision (the re-identification runs by default where it is reidentify.PRECISION or better),
     and the joints the first flags (the links hint where it does not run: a true sensor gain put
     back is itself a torque the base columns partly make). A payload stays taken: it is exactly a
-    change of the last link, which a control run tells apart (compared). The hint names only joints
-    where what the links would change exceeds `floor` (per joint, Nm: findings_check.floor): a
-    share of a residual at the sensor's noise is not a sign of wrong links (the Panda trial with
-    the exact links: 5 % of a 0.023 Nm residual, 0.005 Nm against a 0.02 Nm floor, on joints 1-4)."""
+    change of the last link, which a control run tells apart (compared). `floor` (per joint, Nm:
+    findings_check.floor): a share of a residual at the sensor's noise is not a sign of wrong
+    links (the Panda trial with the exact links: 5 % of a 0.023 Nm residual, 0.005 Nm against a
+    0.02 Nm floor, on joints 1-4, hinted; with identify's links, re-identified, whose links then
+    "explained" every true rotor inertia)."""
+    def above(joints, explained):
+        return [j for j in joints if floor is None or explained[j] >= floor[j]]
+
     own = [seg.residual - seg.correction for seg in segments]
     first, precision, explained = reidentify.gate(model, segments, own, min_gain)
-    hint = [j for j in first if floor is None or explained[j] >= floor[j]]
+    hint = above(first, explained)
     if not any(c.effect.name in RIGID_LIKE for c in chosen):
-        return first, precision, hint
+        return hint, precision, hint
     values = split_values(chosen, x)
     kept = np.concatenate([0 * v if c.effect.name in RIGID_LIKE else v for c, v in zip(chosen, values)])
-    taken, taken_precision, _ = reidentify.gate(model, segments, [seg.residual - predict(context, chosen, kept, seg)
-                                                                  for seg in segments], min_gain)
-    return sorted(set(first) | set(taken)), min(precision, taken_precision), hint
+    taken, taken_precision, more = reidentify.gate(model, segments, [seg.residual - predict(context, chosen, kept, seg)
+                                                                     for seg in segments], min_gain)
+    return sorted(set(hint) | set(above(taken, more))), min(precision, taken_precision), hint

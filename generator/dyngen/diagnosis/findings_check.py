@@ -56,6 +56,24 @@ def below_floor(context, segments, chosen, x, floors) -> dict[int, float]:
     return out
 
 
+def _links_column(model, fit_signals, j) -> str | None:
+    """Why a rotor inertia on joint j (0-based) is a link parameter, or None: its torque (Ia qdd_j
+    on joint j alone) lies in the span of the rigid body's base columns (a first joint turning
+    about the fixed vertical: ZZ1's column), so no data tell it from the links' inertia, and
+    links identified from the same kind of data already carry it (identify writes Ia: null)."""
+    sig = fit_signals[0]
+    k = np.arange(sig.t.size)[sig.inner()][:: max(sig.t.size // 400, 1)]
+    Y = model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
+    a = np.zeros(Y.shape[:2])
+    a[:, j] = sig.qdd[k, j]
+    A = Y.reshape(-1, Y.shape[2])
+    left = A @ np.linalg.lstsq(A, a.ravel(), rcond=None)[0] - a.ravel()
+    if np.linalg.norm(left) > 1e-6 * np.linalg.norm(a):
+        return None
+    return (f"on joint {j + 1}, a rotor inertia is one column with the links' base coefficients (its torque lies in "
+            "their span): not told apart from the link parameters, which carry it")
+
+
 def _size(e) -> float | None:
     """The size [Nm] of a per-joint finding's torque, where it has one of its own."""
     if e.effect == "offset" and e.values.get("b") is not None:
@@ -87,7 +105,7 @@ def check(selected, selection_before, model, s, fit_signals) -> tuple[list, list
             ia = e.values["Ia"]
             qdd, torque = (np.sqrt(np.mean(np.concatenate([getattr(sig, x)[sig.inner(), j] for sig in fit_signals]) ** 2))
                            for x in ("qdd", "tau"))
-            reason = rotor_inertia_range(j, ia, inertia[j], qdd, torque)
+            reason = rotor_inertia_range(j, ia, inertia[j], qdd, torque) or _links_column(model, fit_signals, j)
             if not reason and ia * qdd > LARGER * before[j]:
                 reason = (f"on joint {j + 1}, its torque ({ia * qdd:.3g} Nm) is larger than the joint's whole nominal "
                           f"residual ({before[j]:.3g} Nm on the selection data): it makes up for another term")
