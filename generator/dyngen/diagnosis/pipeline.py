@@ -214,7 +214,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     claimed = [i for i, c in enumerate(final.chosen) if (i not in flagged or c.joint in replaced) and i not in low]
     explained = [] if choice.tried is None else across.explained_by_links(
         final.context, choice.segments, reidentify.link_corrections(choice.tried, model, choice.segments),
-        settled.design, settled.chosen, min_gain)
+        settled.design, settled.chosen, min_gain, model, settled.fit.x)
     explained = [i for i in explained if final.chosen[i].joint not in replaced]  # those are superseded anyway
     # links that won no joint explain them as well as they do: claimed, flagged (a true sensor gain
     # on joint 2 of the LWR is also a change of its links); links that won a joint supersede them
