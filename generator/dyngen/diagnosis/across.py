@@ -79,29 +79,33 @@ def compared(result, control, control_name: str):
                    control=note)
 
 
-def explained_by_links(context, segments, links, design, chosen, min_gain, model=None, x=None) -> list[int]:
+def explained_by_links(context, segments, links, design, chosen, min_gain) -> list[int]:
     """Indices of the chosen effects that gain less than min_gain on the selection samples of
     the residual the re-identified links leave (links: per segment their rigid body's
-    correction, reidentify.link_corrections); and, given the model and the chosen values x, the
-    gains and gravity scales (RIGID_LIKE) on joints whose residual with their torques put back
-    the rigid body's base columns explain (reidentify.gate, as `gated`'s second look): consistent
-    links regularised toward the diagnosed ones can leave a wrist's share (the withheld
-    "coefficients" case at 100 Hz: -11 % to -12 % gains on joints 1-4 explained, joint 5's -15 %
-    not, although the base columns make it)."""
+    correction, reidentify.link_corrections)."""
     left = [replace(seg, residual=seg.residual - c) for seg, c in zip(segments, links)]
     out = []
     for i, c in enumerate(chosen):
         alone, (one,) = restricted(context, left, design, [c])
         if selection_gain(one, selection_mse(alone, []), selection_mse(alone, [one])) < min_gain:
             out.append(i)
-    rigid = [i for i, c in enumerate(chosen) if c.effect.name in RIGID_LIKE and i not in out]
-    if model is None or x is None or not rigid:
-        return out
+    return out
+
+
+def made_by_base_columns(model, context, segments, chosen, x, min_gain) -> list[int]:
+    """Indices of the gains and gravity scales (RIGID_LIKE) on joints whose residual with their
+    torques put back the rigid body's base columns explain (reidentify.gate, as `gated`'s second
+    look): flagged where the re-identification ran, never superseded by it (a true gain on the
+    wrist beside a payload is such a torque too). Consistent links regularised toward the
+    diagnosed ones can leave a wrist's share: on the withheld "coefficients" case at 100 Hz they
+    explained the -11 % to -12 % gains on joints 1-4, not joint 5's -15 %, which the base columns make."""
+    rigid = [i for i, c in enumerate(chosen) if c.effect.name in RIGID_LIKE]
+    if not rigid:
+        return []
     kept = np.concatenate([0 * v if c.effect.name in RIGID_LIKE else v for c, v in zip(chosen, split_values(chosen, x))])
     joints, _, _ = reidentify.gate(model, segments, [seg.residual - predict(context, chosen, kept, seg)
                                                      for seg in segments], min_gain)
-    return sorted(out + [i for i in rigid if (chosen[i].joint in joints if chosen[i].joint is not None else joints)])
-
+    return [i for i in rigid if (chosen[i].joint in joints if chosen[i].joint is not None else joints)]
 
 
 def gated(model, context, segments, chosen, x, min_gain, floor=None) -> tuple[list[int], float, list[int]]:

@@ -49,7 +49,11 @@ def below_floor(context, segments, chosen, x, floors) -> dict[int, float]:
     fitting = [seg for seg in segments if seg.fit.any()]
     out = {}
     for i, (c, v) in enumerate(zip(chosen, split_values(chosen, x))):
-        torque = np.concatenate([predict(context, [c], v, seg)[seg.fit] for seg in fitting])
+        if c.effect.scales:  # a gain scales every torque on its joint, the other effects' included
+            torque = np.concatenate([v[0] * np.where(np.arange(seg.signals.tau.shape[1]) == c.joint,
+                                                     seg.signals.tau[seg.fit], 0.0) for seg in fitting])
+        else:
+            torque = np.concatenate([predict(context, [c], v, seg)[seg.fit] for seg in fitting])
         rms = np.sqrt(np.mean(torque ** 2, axis=0))
         if np.all(rms < floors):
             out[i] = float(rms.max())

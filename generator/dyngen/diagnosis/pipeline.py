@@ -214,11 +214,15 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     claimed = [i for i, c in enumerate(final.chosen) if (i not in flagged or c.joint in replaced) and i not in low]
     explained = [] if choice.tried is None else across.explained_by_links(
         final.context, choice.segments, reidentify.link_corrections(choice.tried, model, choice.segments),
-        settled.design, settled.chosen, min_gain, model, settled.fit.x)
+        settled.design, settled.chosen, min_gain)
     explained = [i for i in explained if final.chosen[i].joint not in replaced]  # those are superseded anyway
     # links that won no joint explain them as well as they do: claimed, flagged (a true sensor gain
     # on joint 2 of the LWR is also a change of its links); links that won a joint supersede them
     marked, explained = (explained, []) if choice.reidentified is None else ([], explained)
+    if choice.tried is not None:  # gains the base columns make: flagged, not superseded
+        marked = sorted(set(marked) | {i for i in across.made_by_base_columns(
+            model, final.context, choice.segments, settled.chosen, settled.fit.x, min_gain)
+            if i not in explained and final.chosen[i].joint not in replaced})
     findings = [replace(f, suspect=across.LINKS) if i in marked else f for i, f in enumerate(final.findings)]
     selected, superseded = reported([final.chosen[i] for i in claimed if i not in explained],
                                     [findings[i] for i in claimed if i not in explained], replaced)
