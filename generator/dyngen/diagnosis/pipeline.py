@@ -44,7 +44,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # 3. settle
     settled = _settle(context, segments, design, selection.chosen, options)
     # 4. choose, per joint; then the final fit
-    choice = _choose(robot, model, p, context, segments, settled, bool(select_signals), options)
+    floors = findings_check.floor(fit_signals)  # Nm per joint: a torque below it is no finding
+    choice = _choose(robot, model, p, context, segments, settled, bool(select_signals), options, floors)
     final = _final_fit(robot, model, p, context, settled, choice, bool(select_signals))
     # 5. test: each joint's correction by the model it was given, judged on the judged data
     judged_segments, completed = joints.apply(final.context, final.segments, final.chosen, final.fit.x, final.simple,
@@ -54,7 +55,7 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # 6. report
     roles_of = (("fit", fit_signals), ("select", select_signals or []), ("test", test or []))
     result = _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
-                     roles_of, options.min_gain)
+                     roles_of, options.min_gain, floors)
     return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
                                           judged.used) + result.warnings)
 
@@ -107,7 +108,7 @@ class Choice:
     tried: object = None  # the re-identification's result wherever it ran, won a joint or not
 
 
-def _choose(robot, model, p, context, segments, settled, separate_selection, options) -> Choice:
+def _choose(robot, model, p, context, segments, settled, separate_selection, options, floors=None) -> Choice:
     """The effects, the simple model or both, all fitted on the fit samples only and compared
     on the selection samples (joints.py; on folds of the fit recordings without separate
     selection recordings, choose.py), or re-identified link parameters (--reidentify)."""
@@ -124,7 +125,7 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
         modes = choose.on_folds(context, selecting, design, chosen, final, options)
     reid, consistent, links_hint, off_by_default, tried = None, None, [], None, None
     if design.select.count:  # the gate: where the rigid body's columns explain what the effects leave
-        flagged, precision, hint = across.gated(model, context, selecting, chosen, final.x, options.min_gain)
+        flagged, precision, hint = across.gated(model, context, selecting, chosen, final.x, options.min_gain, floors)
         run_reid = precision <= reidentify.PRECISION if options.reidentify is None else options.reidentify
         if run_reid:
             reid, consistent, modes, tried = choose.reidentified(robot, model, p, context, selecting, chosen, final.x,
@@ -187,7 +188,7 @@ def _why_not_tried(precision) -> str:
 
 
 def _result(robot, model, s, split, selection, settled, choice, final, judged, judged_segments, completed,
-            roles_of, min_gain) -> Diagnosis:
+            roles_of, min_gain, floors=None) -> Diagnosis:
     """The record: the findings (those on joints another model won superseded; those outside
     their range marked suspect, findings_check.py), the figures, and the warnings of the checks
     (notes.py's are added by diagnose)."""
@@ -195,7 +196,8 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
     flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
                               final.correlation_samples)
-    claimed = [i for i, c in enumerate(final.chosen) if i not in flagged or c.joint in replaced]
+    low = findings_check.below_floor(final.context, final.segments, final.chosen, final.fit.x, floors)
+    claimed = [i for i, c in enumerate(final.chosen) if (i not in flagged or c.joint in replaced) and i not in low]
     explained = [] if choice.tried is None else across.explained_by_links(
         final.context, choice.segments, reidentify.link_corrections(choice.tried, model, choice.segments),
         settled.design, settled.chosen, min_gain)
@@ -203,10 +205,16 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     # links that won no joint explain them as well as they do: claimed, flagged (a true sensor gain
     # on joint 2 of the LWR is also a change of its links); links that won a joint supersede them
     marked, explained = (explained, []) if choice.reidentified is None else ([], explained)
+    if choice.tried is not None:  # gains the base columns make: flagged, not superseded
+        marked = sorted(set(marked) | {i for i in across.made_by_base_columns(
+            model, final.context, choice.segments, settled.chosen, settled.fit.x, min_gain)
+            if i not in explained and final.chosen[i].joint not in replaced})
     findings = [replace(f, suspect=across.LINKS) if i in marked else f for i, f in enumerate(final.findings)]
     selected, superseded = reported([final.chosen[i] for i in claimed if i not in explained],
                                     [findings[i] for i in claimed if i not in explained], replaced)
-    unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed))]
+    unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed) - set(low))]
+    faint = [f"{final.chosen[i].key} (a torque of {rms:.2g} Nm RMS, below the significance floor of "
+             f"{floors[final.chosen[i].joint or 0]:.2g} Nm)" for i, rms in low.items()]
     superseded += [replace(final.findings[i], suspect=across.LINKS) for i in explained if i in claimed]
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
     fit_signals = roles_of[0][1]
@@ -221,6 +229,10 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
                          + ("; a payload is a change of the last link's parameters: a control run without it "
                             "(--control) tells them apart" if any(final.chosen[i].effect.name == "payload"
                                                                   for i in which) else ""))
+    if faint:
+        apart.append(f"below the significance floor, not findings (kept in the model): {'; '.join(faint)}; the floor is "
+                     f"{findings_check.FLOOR:g} of the torque sensor's noise sigma per joint, from the raw torques: "
+                     + " ".join(f"{x:.2g}" for x in floors) + " Nm")
     if choice.links_hint:
         apart.append("the link parameters may be off: on joint(s) " + ", ".join(str(j + 1) for j in choice.links_hint)
                      + " the rigid body's own columns explain what the effects leave on selection data, so the "
@@ -238,7 +250,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=final.simple.values.tolist(),
         peak_before=judged.peak_before.tolist(), noise_rms=judged.noise.tolist(), where=judged.where,
         candidates=[CandidateGain(k, g) for k, g in sorted(selection.first_gains.items(), key=lambda kv: -kv[1])],
-        steps=selection.steps, dropped=settled.dropped, refused=settled.refused, superseded=superseded, unstable=unstable,
+        steps=selection.steps, dropped=settled.dropped + faint, refused=settled.refused, superseded=superseded, unstable=unstable,
         correlation_samples=final.correlation_samples, segments=judged_segments, joint_models=modes,
         within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(

@@ -108,14 +108,16 @@ def rigid_fit(fit) -> tuple:
     return (V @ ((V.T @ (g / scale)) / ev)) / scale, scale, V, ev
 
 
-def gate(model, segments, remaining, min_gain: float) -> tuple[list[int], float]:
-    """(joints, precision): the joints (0-based) on whose selection samples the unconstrained
-    fit of the rigid body's base columns to `remaining` (per segment, the residual left by the
-    per-joint models) gains at least `min_gain` of the mean square; and the largest relative
-    standard deviation of the base coefficients that fit moves (inf if it moves none)."""
+def gate(model, segments, remaining, min_gain: float) -> tuple[list[int], float, np.ndarray]:
+    """(joints, precision, explained): the joints (0-based) on whose selection samples the
+    unconstrained fit of the rigid body's base columns to `remaining` (per segment, the residual
+    left by the per-joint models) gains at least `min_gain` of the mean square; the largest
+    relative standard deviation of the base coefficients that fit moves (inf if it moves none);
+    and per joint the RMS [Nm] of what that fit explains there (the torque the links would change)."""
     parts = sampled(model, segments, remaining)
+    none = np.zeros(remaining[0].shape[1] if remaining else 0)
     if not parts["fit"]:
-        return [], float("inf")
+        return [], float("inf"), none
     x, scale, V, ev = rigid_fit(parts["fit"])
     # the coefficients it moves (their torque at least MOVED of the residual's) and their precision:
     # correlation-scaled standard deviation over value, from the residual the fit leaves
@@ -127,10 +129,11 @@ def gate(model, segments, remaining, min_gain: float) -> tuple[list[int], float]
     precision = float(np.max(std[moved] / scale[moved] / np.abs(x[moved]))) if moved.any() else float("inf")
     sel = parts["select"]
     if not sel:
-        return [], precision
+        return [], precision, none
     before, after = (sum(np.sum(m, axis=0) for m in ms) for ms in ([r ** 2 for _, r, _ in sel],
                                                                    [(r - A @ x) ** 2 for A, r, _ in sel]))
-    return [j for j in range(before.size) if after[j] < (1 - min_gain) * before[j]], precision
+    explained = np.sqrt(np.maximum(before - after, 0.0) / sum(r.shape[0] for _, r, _ in sel))
+    return [j for j in range(before.size) if after[j] < (1 - min_gain) * before[j]], precision, explained
 
 
 def identify(robot, model, p, fit_pieces, select_pieces=None, regularisation=None):
