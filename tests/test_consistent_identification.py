@@ -171,25 +171,6 @@ def test_tilt_is_a_rotation():
         assert ours[k] == pytest.approx(expected, abs=1e-12)
 
 
-def test_compiled_gravity_matrix_is_pinocchio():
-    """G(q) from the compiled link poses (identification/gravity.py, the tilt's columns) against
-    Pinocchio's gravity torques with the gravity vector along x, y and z: g(q) = G(q) gvec."""
-    from oracles import pinocchio_arm
-    from oracles.arm import Arm
-
-    from dyngen.identification.gravity import gravity_matrix_of
-
-    robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(FOLDER)
-    arm = Arm.from_yaml(ROOT / "examples" / "lwr.yaml")
-    p = random_parameters(7, 12, mass=(0.5, 3.0), second_moment=(0.002, 0.02))
-    q = np.random.default_rng(5).uniform(-2, 2, (20, 7))
-    G = gravity_matrix_of(model, robot, p)(q)
-    for c in range(3):
-        along = replace(arm, gravity=np.eye(3)[c])
-        for k in range(q.shape[0]):
-            assert G[k, :, c] == pytest.approx(pinocchio_arm.gravity(along, p, q[k]), abs=1e-12)
-
-
 @pytest.mark.parametrize("degrees, refused", [(2.0, False), (15.0, True)])
 def test_tilt_found_or_refused(tmp_path, degrees, refused):
     """MuJoCo's base turned by `degrees` about the base axis (1, 2, 0): with default options the

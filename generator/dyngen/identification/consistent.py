@@ -21,7 +21,6 @@ from ..terms.friction import SIMPLE_SCALE
 from . import held_out
 from .blocks import Blocks, sources_of, tilt_columns, velocity_limits
 from .columns import PER_JOINT, group_of, kinds_of, name_of
-from .gravity import gravity_matrix_of
 from .consistent_output import Consistent
 from .least_squares import WEAK
 from .normal import Normal, Swaps, solve_unconstrained
@@ -130,7 +129,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     fit = list(range(folds))
     smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
-                    smoothing0, np.zeros(dof), gravity_matrix_of(model, robot, prior) if with_tilt else None, g_vec)
+                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), g_vec)
     ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
     swaps = None  # 2. the Coulomb term's smoothing: every value of its grid summed in the same pass
     if ks and options.smoothing is None:
