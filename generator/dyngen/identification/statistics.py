@@ -4,6 +4,9 @@ times (at least MIN_BLOCKS; never below the textbook one), condition numbers, un
 
 from __future__ import annotations
 
+import os
+import tempfile
+
 import numpy as np
 from scipy import signal
 
@@ -72,22 +75,24 @@ def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
     return out
 
 
-def _score_blocks(summed, length: int, rows_of):
-    """(sum over blocks of s s^T, count) of contiguous blocks of `length` score rows per recording,
-    from each block's (recording, [(number of the batch, partial sum)]) in block order."""
+def _score_blocks(spilled, length: int):
+    """(sum over blocks of s s^T, count) of contiguous blocks of `length` score rows per recording."""
     S, count = 0.0, 0
     current, index, open_sum = None, -1, None
 
     def close():
         nonlocal S, count
-        if open_sum is not None and (index + 1) * length <= rows_of(current):
+        if open_sum is not None and (index + 1) * length <= current.rows:
             S, count = S + np.outer(open_sum, open_sum), count + 1
 
-    for source, parts in summed:
-        if source != current:
+    for source, start, path in spilled:
+        if source is not current:
             close()
             current, index, open_sum = source, -1, None
-        for number, part in parts:
+        rows = np.load(path)
+        at = (start + np.arange(rows.shape[0])) // length
+        starts = np.r_[0, np.flatnonzero(np.diff(at)) + 1]
+        for number, part in zip(at[starts], np.add.reduceat(rows, starts)):
             if number == index:
                 open_sum = open_sum + part
             else:
@@ -97,14 +102,10 @@ def _score_blocks(summed, length: int, rows_of):
     return S, count
 
 
-def _source_of(blocks, piece) -> int:
-    return next(i for i, s in enumerate(blocks.sources) if s is piece.source)
-
-
 def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     """The weighted unconstrained fit of the columns keep on the parts, with the deviations above: two
-    passes over the blocks (the residuals' size and correlation time; their score rows summed in
-    batches of the length that time gives, in the workers)."""
+    passes over the blocks (the residuals' size and correlation time; their score rows, kept in a
+    temporary folder until the correlation time gives the blocks' length)."""
     G, g = normal.total(parts, weights, keep)
     cols = len(keep)
     norms = np.sqrt(np.maximum(np.diag(G), 0.0))
@@ -117,34 +118,28 @@ def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     x = inverse @ g
     rows = int(normal.n[parts].sum())
     labels, r = normal.labels, normal.r
-    sse, correlation = 0.0, {}
+    sse, correlation, spilled = 0.0, {}, []
+    folder = tempfile.TemporaryDirectory(prefix="dyngen-scores-")
 
-    def residual(piece):  # the residuals of a block of the fit parts (blocks.each)
+    def scored(piece):  # the residuals of a block of the fit parts, its score rows written (blocks.each)
         if not np.isin(piece.part, parts).all():
             return None
-        return _source_of(blocks, piece), residuals([piece], labels, r, x, keep, dof)[0]
+        e = residuals([piece], labels, r, x, keep, dof)[0]
+        at = (next(i for i, s in enumerate(blocks.sources) if s is piece.source), piece.start)
+        np.save(os.path.join(folder.name, "%d-%d.npy" % at), _score_rows(piece, labels, r, weights, e, dof)[:, keep])
+        return at, e
 
-    for i, e in filter(None, blocks.each(residual)):
+    for at, e in filter(None, blocks.each(scored)):
         sse += float(((e * weights) ** 2).sum())
         for j in range(dof):
-            correlation.setdefault((i, j), _Correlation()).add(e[:, j])
+            correlation.setdefault((at[0], j), _Correlation()).add(e[:, j])
+        spilled.append((blocks.sources[at[0]], at[1], os.path.join(folder.name, "%d-%d.npy" % at)))
     sigma2 = sse / max(rows - int(strong.sum()), 1)
     textbook = np.sqrt(np.maximum(sigma2 * np.diag(inverse), 0.0))
     times = [c.time() for c in correlation.values() if c.n > 8]
     tau = max(times) if times else 1.0
-    length = int(np.ceil(BLOCK_TIMES * tau))
-
-    def summed(piece):  # a block's score rows summed over each batch of `length` they fall in, in the worker
-        if not np.isin(piece.part, parts).all():
-            return None
-        e = residuals([piece], labels, r, x, keep, dof)[0]  # as in the first pass, bitwise
-        rows = _score_rows(piece, labels, r, weights, e, dof)[:, keep]
-        at = (piece.start + np.arange(rows.shape[0])) // length
-        starts = np.r_[0, np.flatnonzero(np.diff(at)) + 1]
-        return _source_of(blocks, piece), list(zip(at[starts], np.add.reduceat(rows, starts)))
-
-    # a second pass, not the first's score rows kept (2 GB for the 1 kHz hour): the batches' length is known only now
-    S, count = _score_blocks(filter(None, blocks.each(summed)), length, lambda i: blocks.sources[i].rows)
+    with folder:
+        S, count = _score_blocks(spilled, int(np.ceil(BLOCK_TIMES * tau)))
     if count >= MIN_BLOCKS:
         std = np.maximum(np.sqrt(np.maximum(np.diag(inverse @ S @ inverse), 0.0)), textbook)
     else:
