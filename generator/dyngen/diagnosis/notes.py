@@ -53,10 +53,12 @@ def notes(d, model, s, fit_signals, select_signals, test_signals, used) -> list[
     if d.consistent:
         c = d.consistent
         out.append("link parameters off: on joint(s) " + ", ".join(map(str, c.joints)) + " physically consistent "
-                   "link parameters re-identified from the fit data (with friction, offsets, rotor inertia and a "
-                   f"tilted base; regularised toward the given parameters with weight {c.regularisation:g}, chosen "
-                   "on selection data) did better than every effect and the simple model on selection data, and "
-                   "are used there; they are written out (consistent/)")
+                   "link parameters re-identified from the fit data (every link's pseudo-inertia positive definite; "
+                   "with per-joint Coulomb, viscous, offset, rotor inertia, position ripple and a tilted base; "
+                   f"regularised toward the given parameters with weight {c.regularisation:g}, chosen on selection "
+                   "data from " + ", ".join(f"{s['regularisation']:g}" for s in c.selection) + ") did better than "
+                   "every effect and the simple model on selection data, and are used there; they are in "
+                   "consistent/identified.yaml (URDF and MJCF beside it)")
     if d.simple_wins:
         out.append("on joint(s) " + ", ".join(map(str, d.simple_wins)) + " the simple model (offset + Coulomb + viscous) "
                    "did better than the selected effects on selection data and is kept there")

@@ -179,16 +179,8 @@ def markdown(d, sources: dict) -> str:
                   + ".", ""]
     if d.dropped:
         lines += [f"Selected at first, then dropped as not significant: {', '.join(d.dropped)}.", ""]
-    if d.consistent:
-        c = d.consistent
-        lines += ["## Link parameters off", "",
-                  f"On joint(s) {', '.join(map(str, c.joints))}, physically consistent link parameters "
-                  "re-identified from the fit data (every link's pseudo-inertia positive definite; with per-joint "
-                  "Coulomb, viscous, offset, rotor inertia, position ripple and a tilted base; regularised toward the "
-                  f"given parameters with weight {c.regularisation:g}, chosen on selection data from "
-                  + ", ".join(f"{s['regularisation']:g}" for s in c.selection)
-                  + ") did better than every effect and the simple model on selection data, and are used there. "
-                  "The parameters are in consistent/identified.yaml (URDF and MJCF beside it).", ""]
+    if d.consistent:  # what they are and why: the warning "link parameters off" (notes.py)
+        lines += ["## Link parameters off", ""]
         if d.reidentified is not None:
             from types import SimpleNamespace
 
@@ -235,9 +227,6 @@ def summary_lines(d) -> list[str]:
         joints = ",".join(map(str, e.joints)) or "-"
         out.append(f"  {e.effect:<12} joints {joints:<14} gain {e.selection_gain:.3f}  {_value_text(e)}")
     out += [f"  unstable across blocks, not claimed: {_named(u.finding)}" for u in d.unstable]
-    if d.consistent:
-        out.append(f"  link parameters off: consistent re-identified parameters used on joint(s) "
-                   f"{', '.join(map(str, d.consistent.joints))} (consistent/identified.yaml)")
     if d.control:
         out.append(f"  control: {d.control}")
     out += [f"  warning: {w}" for w in d.warnings]
