@@ -44,7 +44,7 @@ def notes(d, model, s, fit_signals, select_signals, test_signals, used) -> list[
     for e in d.selected:
         out += effect_class(e.effect).warnings(e)
         if e.suspect:
-            out.append(f"{e.effect} is a symptom, not a cause: {e.suspect}")
+            out.append(f"{e.effect} may be a symptom rather than a cause: {e.suspect}")
     for r in d.refused:
         shown = ", ".join(f"{v:.3g}" for v in r.values[:4])
         because = "; ".join(x for x in (shown, r.reason) if x)
