@@ -41,6 +41,7 @@ import dataclasses
 import numpy as np
 
 from ..data.correlation import integrated_time
+from ..parameters import PER_LINK
 from .record import LinksOff
 
 RATE = 200.0  # Hz: samples used by the re-identification (the motion's band is far below)
@@ -77,22 +78,18 @@ def pieces(segments, role: str) -> list:
     return out
 
 
-def _gate_columns(model, seg, k):
-    sig = seg.signals
-    return model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k])
-
-
 def sampled(model, segments, remaining) -> dict:
     """role ("fit", "select") -> [(A, r, (segment index, sample indices))]: the rigid body's base
     columns A (m, N, P) and `remaining` r (m, N) on each segment's samples of that role at about
     GATE_RATE."""
     out = {"fit": [], "select": []}
     for i, (seg, rest) in enumerate(zip(segments, remaining)):
-        step = max(1, int(round(seg.signals.rate / GATE_RATE)))
+        sig = seg.signals
+        step = max(1, int(round(sig.rate / GATE_RATE)))
         for role in out:
             k = np.flatnonzero(getattr(seg, role))[::step]
             if k.size:
-                out[role].append((_gate_columns(model, seg, k), rest[k], (i, k)))
+                out[role].append((model.batch("regressor", sig.q[k], sig.qd[k], sig.qdd[k]), rest[k], (i, k)))
     return out
 
 
@@ -160,8 +157,6 @@ def link_corrections(result, model, segments) -> list:
 
 def finding(robot, result, joints: list) -> LinksOff:
     """The finding: joints where the consistent parameters won, and the parameters."""
-    from ..parameters import PER_LINK
-
     links = np.asarray(result.p).reshape(-1, PER_LINK)
     f = {k: [None if not np.isfinite(x) else float(x) for x in np.atleast_1d(v)] for k, v in result.friction.items()}
     return LinksOff(

@@ -9,6 +9,7 @@ import numpy as np
 from ..parameters import PER_LINK, dynamic_from_standard, standard_from_dynamic
 from ..terms import effect_class
 from ..terms.friction import FRICTION_NAMES  # the emitted <robot>_friction's vector, per joint
+from ..terms.simple_model import NAMES, VELOCITY
 from .joints import COMPLETED, SIMPLE, TIED
 
 
@@ -49,8 +50,6 @@ def effects_yaml(diagnosis, sources: dict, sign_velocity: float) -> str:
     import yaml
 
     f = friction_vector(diagnosis, sign_velocity).reshape(diagnosis.joints, -1)
-    from ..terms.simple_model import NAMES, VELOCITY
-
     doc = {
         "robot": diagnosis.robot,
         "parameters": sources.get("params"),

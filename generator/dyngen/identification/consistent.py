@@ -43,25 +43,23 @@ def _coulomb_search(normal, trials, fit, grid, tolerance: float):
     return choice, Normal.per_joint([trials[i] for i in which])
 
 
-def _at(dof, smoothing, lags):
-    """make(piece, value): the piece's Coulomb columns at smoothing(value), lags(value)."""
-    return lambda p, value: p.coulomb(np.broadcast_to(smoothing(value), (dof,)), np.broadcast_to(lags(value), (dof,)))
+def _at(dof, smoothing, lag):
+    """make(piece): the piece's Coulomb columns at this smoothing and lag (scalars or per joint)."""
+    return lambda p: p.coulomb(np.broadcast_to(smoothing, (dof,)), np.broadcast_to(lag, (dof,)))
 
 
-def _coulomb(blocks, normal, fit, options, dof, swaps=None):
-    """Step 2: (smoothing, lags, normal) chosen per joint on the fit data unless given; the blocks follow."""
-    smoothing = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
-    lags = np.zeros(dof)
-    ks = [k for k, (kind, _) in enumerate(normal.labels) if kind == "coulomb"]
+def _coulomb(blocks, normal, fit, options, dof, ks, swaps=None):
+    """Step 2: (smoothing, lags, normal) chosen per joint on the fit data unless given (ks: the Coulomb
+    labels); the blocks follow."""
+    smoothing, lags = blocks.smoothing, blocks.lags
     if not ks:
         return smoothing, lags, normal
     if swaps is not None:
         smoothing, normal = _coulomb_search(normal, swaps.normals(normal), fit, SMOOTHING_GRID, 0.0)
         blocks.smoothing = smoothing
     if options.friction_lag:
-        make = _at(dof, lambda v: smoothing, lambda v: v)
         zero = LAG_GRID[0] == 0.0  # the trial of no lag is the normal equations at hand: no variant for it
-        trials = [normal] * zero + normal.swapped(blocks, ks, [lambda p, v=v: make(p, v) for v in LAG_GRID[zero:]])
+        trials = [normal] * zero + normal.swapped(blocks, ks, [_at(dof, smoothing, v) for v in LAG_GRID[zero:]])
         lags, normal = _coulomb_search(normal, trials, fit, LAG_GRID, 1e-3)
         blocks.lags = lags
     return smoothing, lags, normal
@@ -127,16 +125,15 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     folds = max(2, int(options.folds))
     parts = folds + (1 if select else 0)
     fit = list(range(folds))
-    smoothing0 = np.full(dof, float(options.smoothing or SIMPLE_SCALE))
     blocks = Blocks(model, sources + select_sources, [(folds,)] * len(sources) + [folds] * len(select_sources), labels,
-                    smoothing0, np.zeros(dof), lambda q: tilt.gravity_matrix(robot, prior, q), g_vec)
+                    np.full(dof, float(options.smoothing or SIMPLE_SCALE)), np.zeros(dof),
+                    lambda q: tilt.gravity_matrix(robot, prior, q), g_vec)
     ks = [k for k, (kind, _) in enumerate(labels) if kind == "coulomb"]
     swaps = None  # 2. the Coulomb term's smoothing: every value of its grid summed in the same pass
     if ks and options.smoothing is None:
-        make = _at(dof, lambda v: v, lambda v: 0.0)
-        swaps = Swaps(labels, r, parts, dof, ks, [lambda p, v=v: make(p, v) for v in SMOOTHING_GRID], int(with_tilt))
+        swaps = Swaps(labels, r, parts, dof, ks, [_at(dof, v, 0.0) for v in SMOOTHING_GRID], int(with_tilt))
     normal = Normal.build(blocks, labels, r, parts, dof, swaps, int(with_tilt))
-    smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof, swaps)
+    smoothing, lags, normal = _coulomb(blocks, normal, fit, options, dof, ks, swaps)
 
     # 3. noise per joint, weights; columns the data cannot separate
     n_fit = normal.n[fit].sum(axis=0)

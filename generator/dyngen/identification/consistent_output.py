@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..extraction.report import links_yaml
-from ..terms import tilt
+from ..terms import simple_model, tilt
 from .columns import coulomb_matrix
 
 
@@ -66,8 +66,6 @@ class Consistent:
             robot, p = self.tilt_model
             out = out + tilt.torque(robot, p, signals.q, tilt.gravity_of(robot), self.friction["tilt"])
         if self.simple:  # the prior's rigid body + b + Fc tanh(qd / 0.02) + Fv qd there
-            from ..terms import simple_model
-
             j = list(self.simple["joints"])
             rigid = model.batch("rnea", signals.q, signals.qd, signals.qdd, self.simple["standard"])
             terms = np.einsum("tjk,jk->tj", simple_model.columns(signals), self.simple["values"])
