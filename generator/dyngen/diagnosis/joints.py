@@ -86,27 +86,22 @@ def decide(context, segments, chosen, x, simple, min_gain: float, consistent=Non
 def errors(context, segments, chosen, x, simple, consistent=None) -> list[dict]:
     """Per joint {model: sum of squared residuals on the selection samples}, every model
     fitted on the fit samples (seg.correction holds the effects' torques at values x)."""
-    n = segments[0].residual.shape[1]
     out = []
-    for j in range(n):
+    for j in range(segments[0].residual.shape[1]):
         acting = any(c.joint is None or c.joint == j for c in chosen)
         values = _completed_fit(context, chosen, x, segments, j) if acting else None
-        sse = {EFFECTS: 0.0, SIMPLE: 0.0}
-        if acting:
-            sse[COMPLETED] = 0.0
-        if consistent is not None:
-            sse[CONSISTENT] = 0.0
+        sse = dict.fromkeys([EFFECTS, SIMPLE] + [COMPLETED] * acting + [CONSISTENT] * (consistent is not None), 0.0)
         for i, seg in enumerate(segments):
             m = seg.select
             if not m.any():
                 continue
-            r = seg.residual[m, j]
-            sse[EFFECTS] += float(np.sum((r - seg.correction[m, j]) ** 2))
-            sse[SIMPLE] += float(np.sum((r - baseline.predict(simple, seg)[m, j]) ** 2))
+            predicted = {EFFECTS: seg.correction[m, j], SIMPLE: baseline.predict(simple, seg)[m, j]}
             if acting:
-                sse[COMPLETED] += float(np.sum((r - _completed_predict(context, chosen, x, values, seg, j)[m]) ** 2))
+                predicted[COMPLETED] = _completed_predict(context, chosen, x, values, seg, j)[m]
             if consistent is not None:
-                sse[CONSISTENT] += float(np.sum((r - consistent[i][m, j]) ** 2))
+                predicted[CONSISTENT] = consistent[i][m, j]
+            for model, torque in predicted.items():
+                sse[model] += float(np.sum((seg.residual[m, j] - torque) ** 2))
         out.append(sse)
     return out
 

@@ -1,7 +1,4 @@
-"""The diagnosis's stages run in order (listed with their modules in diagnosis/__init__.py):
-
-    result = diagnose(robot, model, p, fit_signals, select_signals, options, test=test_signals)
-
+"""The diagnosis's stages run in order (listed with their modules, and the call, in diagnosis/__init__.py).
 Each stage's result is a new value (the segments frozen: roles.Segment); stages 3 and 4 and the
 final fit are the functions below diagnose, each returning one record (Settled, Choice, Final).
 
@@ -217,8 +214,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
              f"{floors[final.chosen[i].joint or 0]:.2g} Nm)" for i, rms in low.items()]
     superseded += [replace(final.findings[i], suspect=across.LINKS) for i in explained if i in claimed]
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
-    fit_signals = roles_of[0][1]
-    selected, apart = findings_check.check(selected, selection_rms["before"], model, s, fit_signals)
+    selected, apart = findings_check.check(selected, selection_rms["before"], model, s, roles_of[0][1])
     for which, so in ((explained, "so not claimed"), (marked, "flagged (those links won no joint)")):
         if which:
             apart.append("not told apart from the link parameters being off (the re-identified links' rigid body "

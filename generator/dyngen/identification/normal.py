@@ -74,11 +74,9 @@ class Normal:
             at = touched(piece)
             return (at, own.G[at], own.g[at], own.bb[at], own.n[at]), None if swaps is None else swaps.of_block(piece)
 
-        for (at, G, g, bb, n), swapped in (pieces.each(of_block) if hasattr(pieces, "each") else map(of_block, pieces)):
-            out.G[at] += G
-            out.g[at] += g
-            out.bb[at] += bb
-            out.n[at] += n
+        for (at, *sums), swapped in (pieces.each(of_block) if hasattr(pieces, "each") else map(of_block, pieces)):
+            for total, part in zip((out.G, out.g, out.bb, out.n), sums):
+                total[at] += part
             if swapped is not None:
                 swaps.added(*swapped)
         return out
