@@ -15,7 +15,7 @@ from .refine import restricted
 from .forward_selection import solve
 
 
-def on_folds(context, segments, design, chosen, final, options) -> list[str]:
+def on_folds(context, segments, design, chosen, options) -> list[str]:
     """Per joint model (joints.py) from selection errors summed over the roles.FOLDS cuts, refitted per cut."""
     totals = None
     for phase in range(roles.FOLDS):

@@ -119,7 +119,7 @@ def _choose(robot, model, p, context, segments, settled, separate_selection, opt
     elif separate_selection:
         modes = joints.decide(context, selecting, chosen, final.x, simple, options.min_gain)
     else:
-        modes = choose.on_folds(context, selecting, design, chosen, final, options)
+        modes = choose.on_folds(context, selecting, design, chosen, options)
     reid, consistent, links_hint, off_by_default, tried = None, None, [], None, None
     if design.select.count:  # the gate: where the rigid body's columns explain what the effects leave
         flagged, precision, hint = across.gated(model, context, selecting, chosen, final.x, options.min_gain, floors)
@@ -249,8 +249,7 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         steps=selection.steps, dropped=settled.dropped + faint, refused=settled.refused, superseded=superseded, unstable=unstable,
         correlation_samples=final.correlation_samples, segments=judged_segments, joint_models=modes,
         within_fit_speeds=judged.within_fit_speeds, completed=completed,
-        consistent=None if reid is None else reidentify.finding(
-            robot, reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
+        consistent=None if reid is None else reidentify.finding(reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
         reidentified=reid,
         conditioning=[RecordingNote(sig.name, role, sig.note, sig.trim) for role, group in roles_of for sig in group],
         warnings=apart)

@@ -155,7 +155,7 @@ def link_corrections(result, model, segments) -> list:
             for seg in segments]
 
 
-def finding(robot, result, joints: list) -> LinksOff:
+def finding(result, joints: list) -> LinksOff:
     """The finding: joints where the consistent parameters won, and the parameters."""
     links = np.asarray(result.p).reshape(-1, PER_LINK)
     f = {k: [None if not np.isfinite(x) else float(x) for x in np.atleast_1d(v)] for k, v in result.friction.items()}

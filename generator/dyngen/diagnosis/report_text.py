@@ -158,27 +158,20 @@ def markdown(d, sources: dict) -> str:
                   "without this effect (all other selected effects kept), on its joint (per-joint effects) or summed "
                   "over joints (arm-wide effects). Standard deviations "
                   f"are scaled for the residual's correlation in time ({d.correlation_samples:.0f} samples).", ""]
-    beaten = [e for e in d.superseded if not e.suspect]  # the others: not told apart from wrong links (across.LINKS)
-    if beaten:
-        lines += ["Not kept (another model did better on these joints' selection data): "
-                  + ", ".join(_named(e) for e in beaten) + ".", ""]
-    if len(beaten) < len(d.superseded):
-        lines += ["Not claimed, not told apart from the link parameters being off (see the warnings): "
-                  + ", ".join(_named(e) for e in d.superseded if e.suspect) + ".", ""]
-    if d.unstable:
-        lines += ["Unstable across blocks, so not claimed (kept in the model): "
-                  + "; ".join(f"{_named(u.finding)}: {u.reason}" for u in d.unstable) + ".", ""]
-    tied = [j + 1 for j, m in enumerate(d.joint_models) if m == TIED]
-    if tied:
-        lines += [f"On joint(s) {', '.join(map(str, tied))} the simple model predicts the torque: on the selection "
-                  "data the effects acting there did not beat it by the margin a value must gain. Findings there "
-                  "stay findings; the data cannot tell the two apart, and beyond the fit data they may "
-                  "extrapolate differently.", ""]
-    if d.refused:
-        lines += ["Refused as physically impossible once fitted: " + ", ".join(r.candidate for r in d.refused)
-                  + ".", ""]
-    if d.dropped:
-        lines += [f"Selected at first, then dropped as not significant: {', '.join(d.dropped)}.", ""]
+    said = (  # (a paragraph, the list it names; nothing is said of an empty list)
+        ("Not kept (another model did better on these joints' selection data): {}.",
+         ", ".join(_named(e) for e in d.superseded if not e.suspect)),  # suspect: not told apart from wrong links
+        ("Not claimed, not told apart from the link parameters being off (see the warnings): {}.",
+         ", ".join(_named(e) for e in d.superseded if e.suspect)),
+        ("Unstable across blocks, so not claimed (kept in the model): {}.",
+         "; ".join(f"{_named(u.finding)}: {u.reason}" for u in d.unstable)),
+        ("On joint(s) {} the simple model predicts the torque: on the selection data the effects acting there did not "
+         "beat it by the margin a value must gain. Findings there stay findings; the data cannot tell the two apart, "
+         "and beyond the fit data they may extrapolate differently.",
+         ", ".join(str(j + 1) for j, m in enumerate(d.joint_models) if m == TIED)),
+        ("Refused as physically impossible once fitted: {}.", ", ".join(r.candidate for r in d.refused)),
+        ("Selected at first, then dropped as not significant: {}.", ", ".join(d.dropped)))
+    lines += [line for text, names in said if names for line in (text.format(names), "")]
     if d.consistent:  # what they are and why: the warning "link parameters off" (notes.py)
         lines += ["## Link parameters off", ""]
         if d.reidentified is not None:

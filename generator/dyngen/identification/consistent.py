@@ -171,8 +171,7 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
 
     # 6. the consistent fit on all fit data
     notes = []
-    result, x, rounds, normal, active = _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior,
-                                               g_vec, notes, dropped)
+    result, x, normal, active = _final(solver, normal, blocks, fit, weights, active, cone, lam, g_vec, notes, dropped)
     final_labels = [labels[k] for k in active]
     keep = np.r_[np.arange(r), r + np.asarray(active, dtype=int)]
 
@@ -189,8 +188,8 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     has_tilt = any(kind == "tilt" for kind, _ in final_labels)
     lam_min = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
     return Consistent(result.p, x[:r], names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
-                      lam, table, rounds, [j + 1 for j in range(dof) if not armature_ok[j]],
-                      pinned(solver.problem, result.p), solver.V, (robot, prior) if has_tilt else None, dropped,
+                      lam, table, [j + 1 for j in range(dof) if not armature_ok[j]],
+                      pinned(solver.problem, result.p), (robot, prior) if has_tilt else None, dropped,
                       lags, groups, notes)
 
 
@@ -220,7 +219,7 @@ def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam,
     return sorted(out), out_cone, decisions
 
 
-def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior, g_vec, notes, dropped):
+def _final(solver, normal, blocks, fit, weights, active, cone, lam, g_vec, notes, dropped):
     """Step 6: the consistent fit; a tilt refitted as a rotation, refused beyond tilt.MAX_TILT_DEG, its
     torques the prior's links' (their first moments across gravity the data cannot give)."""
     labels, r = normal.labels, normal.r
@@ -228,22 +227,22 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, robot, prior
     def fit_with(act):
         keep = np.r_[np.arange(r), r + np.asarray(act, dtype=int)]
         G, g = normal.total(fit, weights, keep)
-        x, _, rounds, result = solver.solve(G, g, [labels[k] for k in act], lam, cone=cone)
-        return x, rounds, result
+        x, _, result = solver.solve(G, g, [labels[k] for k in act], lam, cone=cone)
+        return x, result
 
-    x, rounds, result = fit_with(active)
+    x, result = fit_with(active)
     tilt_at = [i for i, k in enumerate(active) if labels[k][0] == "tilt"]
     if tilt_at:
         a = x[r + np.asarray(tilt_at)]
         # the estimate's columns from here on (the statistics' pass reads them): algebra on the hidden column
         normal = normal.rotated([active[i] for i in tilt_at], a / (2 * float(np.linalg.norm(g_vec))))
         blocks.tilt = tilt_columns(g_vec, a)
-        x, rounds, result = fit_with(active)
+        x, result = fit_with(active)
         a = x[r + np.asarray(tilt_at)]
         if tilt.angle_deg(g_vec, a) > tilt.MAX_TILT_DEG:
             notes.append(f"a base tilt of {tilt.angle_deg(g_vec, a):.1f} deg was refused (above {tilt.MAX_TILT_DEG:g} "
                          "deg it is no mounting error: check the YAML's gravity and the torque signs)")
             dropped += [name_of(("tilt", 0)), name_of(("tilt", 1))]
             active = [k for k in active if labels[k][0] != "tilt"]
-            x, rounds, result = fit_with(active)
-    return result, x, rounds, normal, active
+            x, result = fit_with(active)
+    return result, x, normal, active

@@ -30,10 +30,8 @@ class Consistent:
     lambda_min: np.ndarray  # (N,) consistency margin of each link
     regularisation: float
     selection: list  # (lambda, held-out weighted mean square) tried
-    rounds: int
     dropped_armature: list = field(default_factory=list)  # joints whose rotor inertia the body carries
     at_bounds: list = field(default_factory=list)  # parameter names pinned at a bound
-    velocity_limits: np.ndarray | None = None
     tilt_model: tuple | None = None  # (robot, parameters) the tilt's torques are evaluated with
     dropped_columns: list = field(default_factory=list)  # columns the data cannot separate, or refused
     lags: np.ndarray | None = None  # (N,) lag of the Coulomb term behind the velocity [s]

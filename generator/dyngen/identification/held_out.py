@@ -41,7 +41,7 @@ def scores(solver, normal, folds: Folds, labels_idx, lam: float, free=None, work
     def one(k):
         fit, held = folds.splits[k]
         G, g = normal.total(fit, folds.weights, keep)
-        x, f, _, _ = solver.solve(G, g, labels, lam, restarts=1, free=None if free is None else free[k], cone=cone)
+        x, f, _ = solver.solve(G, g, labels, lam, restarts=1, free=None if free is None else free[k], cone=cone)
         sse = normal.sse(x, held, keep).sum(axis=0)
         n = normal.n[held].sum(axis=0)
         return float(sse @ w2 / max(n.sum(), 1.0)), sse / np.maximum(n, 1), f

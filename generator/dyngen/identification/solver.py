@@ -68,7 +68,7 @@ class Solver:
         self.pi_prior = model("pi_full", prior) if prior is not None else None
 
     def solve(self, gram, rhs, labels, lam: float, restarts=None, free=None, cone=()):
-        """(x = (pi, natural friction values), free set, rounds, extraction result); cone: joints held dissipative."""
+        """(x = (pi, natural friction values), free set, extraction result); cone: joints held dissipative."""
         r = self.r
         M = generators(labels, r, self.V, cone)
         gram, rhs = M.T @ gram @ M, M.T @ rhs
@@ -85,8 +85,8 @@ class Solver:
         # steps (converged to ~1e-5 of the cost), no nearest-to-prior step (it does not change the fit)
         opts = self.extract_options if restarts is None else replace(self.extract_options, restarts=restarts,
                                                                         local_maxeval=150)
-        rounds, y_f = 0, np.zeros(nf)
-        for rounds in range(1, self.options.max_rounds + 1):
+        y_f = np.zeros(nf)
+        for _ in range(self.options.max_rounds):
             fi = r + np.flatnonzero(free)
             Lf = np.linalg.cholesky(G[np.ix_(fi, fi)] + 1e-12 * np.eye(len(fi)))
             X = np.linalg.solve(Lf, G[np.ix_(fi, np.arange(r))])
@@ -113,7 +113,7 @@ class Solver:
                 break
             free |= wants
         natural = M[r:, r:] @ (y_f / scale[r:])
-        return np.concatenate([pi, natural]), free, rounds, result
+        return np.concatenate([pi, natural]), free, result
 
 
 def robot_with_default_bounds(robot):

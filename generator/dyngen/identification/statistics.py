@@ -18,7 +18,7 @@ MIN_BLOCKS = 10
 LAGS = 2048  # autocorrelation lags kept per recording and joint (the correlation time's sum)
 
 
-def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray, dof: int) -> list:
+def residuals(pieces, labels, r: int, x: np.ndarray, keep: np.ndarray) -> list:
     """Per piece (T, N): measured less fitted torque for the values x of the columns keep."""
     full = np.zeros(r + len(labels))
     full[keep] = x
@@ -62,7 +62,7 @@ class _Correlation:
         return truncated(acf / acf[0], min(lags, n // 4))
 
 
-def _score_rows(piece, labels, r, weights, e, dof) -> np.ndarray:
+def _score_rows(piece, labels, r, weights, e) -> np.ndarray:
     """(T, c): per sample, sum over joints of a_t w_j^2 e_t (the fit's scores)."""
     we = weights ** 2 * e
     out = np.empty((e.shape[0], r + len(labels)))
@@ -124,9 +124,9 @@ def estimate(normal, parts, weights, blocks, names, keep, dof: int) -> Estimate:
     def scored(piece):  # the residuals of a block of the fit parts, its score rows written (blocks.each)
         if not np.isin(piece.part, parts).all():
             return None
-        e = residuals([piece], labels, r, x, keep, dof)[0]
+        e = residuals([piece], labels, r, x, keep)[0]
         at = (next(i for i, s in enumerate(blocks.sources) if s is piece.source), piece.start)
-        np.save(os.path.join(folder.name, "%d-%d.npy" % at), _score_rows(piece, labels, r, weights, e, dof)[:, keep])
+        np.save(os.path.join(folder.name, "%d-%d.npy" % at), _score_rows(piece, labels, r, weights, e)[:, keep])
         return at, e
 
     for at, e in filter(None, blocks.each(scored)):
