@@ -168,8 +168,6 @@ def _lowpass(name: str, rate: float, cutoff: float, order: int):
     if not 0 < cutoff < rate / 2:
         raise InputError(name, "cutoff", f"{cutoff:g} Hz must lie between 0 and half the sampling rate "
                          f"({rate / 2:g} Hz)")
-    if not 1 <= order <= 12:
-        raise InputError(name, "order", f"{order} must be between 1 and 12")
     sos = signal.butter(order, cutoff, btype="low", fs=rate, output="sos")
     reach = int(np.ceil(PAD_PERIODS * rate / cutoff))
 

@@ -122,8 +122,7 @@ def check_header(name, header, dof, require_torques=True, required=(), where="co
             continue
         expected = set(range(1, dof + 1))
         if numbers - expected:
-            got = max(numbers)
-            raise InputError(name, where, f"the robot has {dof} joints but the file has {prefix}{got}")
+            raise InputError(name, where, f"the robot has {dof} joints but the file has {prefix}{max(numbers)}")
         if expected - numbers:
             missing = ", ".join(f"{prefix}{j}" for j in sorted(expected - numbers))
             if numbers:

@@ -121,9 +121,9 @@ def choose(sse_per_joint: list[dict], chosen, min_gain: float, consistent_values
         if CONSISTENT in sse and _better(sse[CONSISTENT], consistent_values, sse[best], size[best], min_gain) \
                 and sse[CONSISTENT] < (1 - min_gain) * sse[best]:
             best = CONSISTENT
-        # (a joint no effect acts on keeps the nominal model unless the simple model wins outright)
-        acting = COMPLETED in sse
-        if acting and best in (EFFECTS, COMPLETED) and not sse[best] < (1 - min_gain) * sse[SIMPLE]:
+        # (COMPLETED is there where an effect acts; a joint no effect acts on keeps the nominal model
+        # unless the simple model wins outright)
+        if COMPLETED in sse and best in (EFFECTS, COMPLETED) and not sse[best] < (1 - min_gain) * sse[SIMPLE]:
             best = TIED
         modes.append(best)
     return modes

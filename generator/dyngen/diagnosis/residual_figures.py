@@ -28,16 +28,6 @@ def _shade(ax, t, mask, color):
         ax.axvspan(t[start], t[min(stop, t.size - 1)], color=color, alpha=0.18, lw=0)
 
 
-def _grid(n):
-    cols = 2
-    rows = (n + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(12, 2.2 * rows + 1.0), sharex=True, squeeze=False)
-    axes = axes.ravel()
-    for ax in axes[n:]:
-        ax.set_visible(False)
-    return fig, axes
-
-
 def _save(fig, path, title) -> Path:
     fig.suptitle(title, fontsize=12)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
@@ -82,8 +72,13 @@ def figures(d, out_dir, robot_name: str) -> dict:
 
 
 def _panels(n, t, labels, draw, ylabel):
-    """One panel per joint, reversals and standstill shaded; draw(ax, j) plots joint j and returns its title."""
-    fig, axes = _grid(n)
+    """One panel per joint (two columns), reversals and standstill shaded; draw(ax, j) plots joint j and
+    returns its title."""
+    rows = (n + 1) // 2
+    fig, axes = plt.subplots(rows, 2, figsize=(12, 2.2 * rows + 1.0), sharex=True, squeeze=False)
+    axes = axes.ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
     for j in range(n):
         ax = axes[j]
         for name, color in SHADED.items():

@@ -31,8 +31,7 @@ def kinds_of(names) -> tuple:
 
 
 def group_of(label) -> str | None:
-    kind = label[0]
-    return next((g for g, kinds in GROUPS.items() if kind in kinds), None)
+    return next((g for g, kinds in GROUPS.items() if label[0] in kinds), None)
 
 
 def name_of(label) -> str:

@@ -65,11 +65,6 @@ def _coulomb(blocks, normal, fit, options, dof, ks, swaps=None):
     return smoothing, lags, normal
 
 
-def _labels(kinds, armature_ok, dof, with_tilt: bool) -> list:
-    labels = [(kind, j) for j in range(dof) for kind in kinds if kind != "armature" or armature_ok[j]]
-    return labels + ([("tilt", 0), ("tilt", 1)] if with_tilt else [])
-
-
 def _unexcited(normal, fit, weights, r) -> set:
     """Labels (indices) the weighted fit cannot tell from the rest: while the unit-norm columns have a
     direction weaker than WEAK, the label carrying most of it goes (coefficients the data do not
@@ -119,7 +114,8 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
                          f"record at least {2 * unknowns // dof + 1} samples (many more, on an exciting trajectory, "
                          "for a usable estimate)")
     armature_ok = armature_identifiable(model, dof) if "armature" in kinds else [False] * dof
-    labels = _labels(kinds, armature_ok, dof, with_tilt)
+    labels = [(kind, j) for j in range(dof) for kind in kinds if kind != "armature" or armature_ok[j]] \
+        + ([("tilt", 0), ("tilt", 1)] if with_tilt else [])
 
     # 1. regressor, columns and normal equations per part and joint
     folds = max(2, int(options.folds))

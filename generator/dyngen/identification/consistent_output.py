@@ -80,9 +80,7 @@ def _f(x) -> str:
 
 
 def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
-    n = robot.dof
     ols = c.ols
-    r = len(c.names)
     lines = [
         f"# {robot.name}: physically consistent identification by dyngen from {', '.join(sources)}.",
         f"# Conditioning: {conditioning}. Rows weighted by 1 / sigma_j (per-joint noise below); "
@@ -95,13 +93,12 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
         "the residual's correlation time (holds for correlated residuals).",
         f"robot: {robot.name}",
         "links:",
-    ]
-    lines.append(links_yaml(c.p).rstrip("\n"))
-    lines.append("friction:   # per joint; Coulomb Fc tanh(qd(t - lag) / vs) [Nm, s, rad/s], viscous Fv [Nm s/rad], "
-                 "offset [Nm], rotor inertia Ia [kg m^2] (null: carried by the rigid body), ripple [a, b]: "
-                 "a cos q + b sin q [Nm], sigma: noise [Nm]")
+        links_yaml(c.p).rstrip("\n"),
+        "friction:   # per joint; Coulomb Fc tanh(qd(t - lag) / vs) [Nm, s, rad/s], viscous Fv [Nm s/rad], "
+        "offset [Nm], rotor inertia Ia [kg m^2] (null: carried by the rigid body), ripple [a, b]: "
+        "a cos q + b sin q [Nm], sigma: noise [Nm]"]
     k = {name: i for i, name in enumerate(c.column_names)}
-    for j in range(n):
+    for j in range(robot.dof):
         def std(kind):
             i = k.get(f"{kind} j{j + 1}")
             return _f(ols.std[i]) if i is not None else "null"
@@ -112,25 +109,23 @@ def consistent_yaml(robot, c, sources: list[str], conditioning: str) -> str:
                      f"sigma: {_f(c.sigma[j])}}}   # joint {j + 1}; std Fc {std('coulomb')}, Fv {std('viscous')}, "
                      f"offset {std('offset')}, Ia {std('armature')}")
     if c.simple:
-        lines.append("simple_model:   # joints the simple model predicted the --select recordings better on; there "
-                     "tau_j = Y_j(q, qd, qdd) pi(prior_links) + b + Fc tanh(qd / 0.02) + Fv qd [Nm, Nm, Nm s/rad] "
-                     "(the URDF and MJCF carry the links and friction above)")
-        lines.append("  joints:")
+        lines += ["simple_model:   # joints the simple model predicted the --select recordings better on; there "
+                  "tau_j = Y_j(q, qd, qdd) pi(prior_links) + b + Fc tanh(qd / 0.02) + Fv qd [Nm, Nm, Nm s/rad] "
+                  "(the URDF and MJCF carry the links and friction above)", "  joints:"]
         for j in c.simple["joints"]:
             b, fc, fv = c.simple["values"][j]
             lines.append(f"    - {{joint: {j + 1}, b: {_f(b)}, Fc: {_f(fc)}, Fv: {_f(fv)}}}")
-        lines.append("  prior_links:")
-        lines.append("\n".join("  " + x for x in links_yaml(c.simple["prior"]).rstrip("\n").splitlines()))
+        lines += ["  prior_links:", *("  " + x for x in links_yaml(c.simple["prior"]).rstrip("\n").splitlines())]
     if c.tilt_model is not None:
         dg = tilt_change(c)
         lines.append(f"tilt: {{dg: [{_f(dg[0])}, {_f(dg[1])}, {_f(dg[2])}], angle_deg: {_f(c.tilt_deg())}}}   "
                      "# m/s^2: the change of the gravity vector in the base frame (a rotation: its size is kept)")
     lines.append(f"identified:\n  full:   # base coefficients of the links above; condition number {ols.condition:.3g} "
                  f"(weighted, with the friction columns; columns scaled {ols.scaled_condition:.3g})")
-    for i in range(r):
+    for i, name in enumerate(c.names):
         note = "not excited by the data: set by the prior and consistency" if i in ols.unexcited \
             else f"std {ols.std[i]:.3g}, unconstrained fit {ols.values[i]:.6g}"
-        lines.append(f'    - {{coefficient: "{c.names[i]}", value: {float(c.pi[i])!r}}}   # {note}')
+        lines.append(f'    - {{coefficient: "{name}", value: {float(c.pi[i])!r}}}   # {note}')
     return "\n".join(lines) + "\n"
 
 

@@ -47,9 +47,8 @@ def identify(model, signals: list, kind: str) -> Estimate:
         factors.add(Y, b)
     rows = int(factors.rows.sum())
     if rows <= factors.c:
-        per_sample = factors.dof
         raise InputError(files, "", f"under-determined: {rows} equations for {factors.c} {kind} "
-                         f"coefficients; record at least {factors.c // per_sample + 1} samples (many more, "
+                         f"coefficients; record at least {factors.c // factors.dof + 1} samples (many more, "
                          "on an exciting trajectory, for a usable estimate)")
     try:
         return fit_factor(factors.factor(), rows, names)

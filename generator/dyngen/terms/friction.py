@@ -193,12 +193,9 @@ FRICTION_NAMES = tuple(field.name for field in FRICTION_FIELDS)
 
 def friction_torque(m, qd, f) -> list:
     """Per joint, the emitted routine's friction at velocities qd for the vector f, with math module m."""
-    n = len(FRICTION_FIELDS)
-    out = []
-    for j, v in enumerate(qd):
-        fields = dict(zip(FRICTION_NAMES, f[n * j: n * (j + 1)]))
-        out.append(sum(term.torque(m, v, fields) for term in IN_FRICTION))
-    return out
+    n = len(FRICTION_NAMES)
+    joints = [dict(zip(FRICTION_NAMES, f[n * j: n * (j + 1)])) for j in range(len(qd))]  # each joint's fields
+    return [sum(term.torque(m, v, fields) for term in IN_FRICTION) for v, fields in zip(qd, joints)]
 
 
 def c_terms(names, v: str = "v", vector: str = "fj") -> list[dict]:

@@ -45,8 +45,7 @@ def fit(segments) -> Simple:
             r = seg.residual[seg.fit]
             G += np.einsum("tjk,tjl->jkl", A, A)
             b += np.einsum("tjk,tj->jk", A, r)
-    values = np.array([np.linalg.lstsq(G[j], b[j], rcond=1e-12)[0] for j in range(n)])
-    return Simple(values)
+    return Simple(np.array([np.linalg.lstsq(G[j], b[j], rcond=1e-12)[0] for j in range(n)]))
 
 
 def predict(simple: Simple, seg) -> np.ndarray:

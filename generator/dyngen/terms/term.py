@@ -176,6 +176,4 @@ class Term:
 
 def sign(m, v, scale):
     """sign(v) smoothed as tanh(v / scale); the plain sign when scale <= 0 (the C's sgn)."""
-    if scale > 0:
-        return m.tanh(v / scale)
-    return m.sign(v)
+    return m.tanh(v / scale) if scale > 0 else m.sign(v)

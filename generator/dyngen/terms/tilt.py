@@ -95,12 +95,11 @@ def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
     return G
 
 
-def body_gravity_matrix(robot, q, poses=None) -> np.ndarray:
-    """B (T, N, 3, 4): G(q) of a body on the last link per unit of (m, mx, my, mz): -z x (o_N - o), -z x R_N e_k."""
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    poses = poses or forward_kinematics(robot.joint_models, q)
+def body_gravity_matrix(robot, poses) -> np.ndarray:
+    """B (T, N, 3, 4): G(q) of a body on the last link per unit of (m, mx, my, mz): -z x (o_N - o), -z x R_N e_k
+    (poses: q's kinematics)."""
     last = poses[-1]
-    B = np.zeros((q.shape[0], len(poses), 3, 4))
+    B = np.zeros((last.origin.shape[0], len(poses), 3, 4))
     for i, model in enumerate(robot.joint_models):
         z, o = poses[i].axis, poses[i].point
         if model.revolute:
@@ -208,7 +207,7 @@ def recording_gravity(context, signals) -> np.ndarray:
     G = context.memo(("gravity_matrix", id(signals)), lambda: gravity_matrix(context.robot, context.p, signals.q, poses()))
     if context.load is None:
         return G
-    B = context.memo(("body_gravity", id(signals)), lambda: body_gravity_matrix(context.robot, signals.q, poses()))
+    B = context.memo(("body_gravity", id(signals)), lambda: body_gravity_matrix(context.robot, poses()))
     return G + B @ np.asarray(context.load)
 
 
