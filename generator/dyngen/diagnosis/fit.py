@@ -74,8 +74,7 @@ def reweighted(design, final) -> CandidateMoments:
     the nominal residual holds the very effects sought (a payload's 9 Nm on joint 2 would weigh it
     down as if it were noise)."""
     rms = np.sqrt(design.fit.mse(final.slots, final.x))
-    weights = 1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300))
-    return CandidateMoments(design.candidates, design.fit, design.select, design.test, weights, design.groups)
+    return dataclasses.replace(design, weights=1.0 / np.maximum(rms, 1e-9 * max(rms.max(), 1e-300)))  # H, g anew
 
 
 def correlation_time(segments, weights) -> float:
@@ -85,9 +84,13 @@ def correlation_time(segments, weights) -> float:
     return float(np.median(times))
 
 
-def ranged(context, segments, chosen):
-    """The context with the positions the fit samples cover (Context.q_range) if a chosen effect needs them."""
-    if not any(c.effect.ranged for c in chosen):
-        return context
+def positions(segments) -> tuple:
+    """(low, high) per joint: the positions the fit samples cover (Context.q_range)."""
     q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
-    return dataclasses.replace(context, q_range=(q.min(axis=0), q.max(axis=0)), cache={})
+    return q.min(axis=0), q.max(axis=0)
+
+
+def ranged(context, segments, chosen):
+    """The context with the positions the fit samples cover if a chosen effect needs them."""
+    return dataclasses.replace(context, q_range=positions(segments), cache={}) \
+        if any(c.effect.ranged for c in chosen) else context

@@ -61,25 +61,22 @@ def solve(design, chosen, block: slice | None = None, covariance: bool = True) -
 
 
 def _factored(H: np.ndarray):
-    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal (units differ by orders): H^-1 b = Hs^-1 (b / d) / d."""
+    """(b -> Hs^-1 b, d) for H scaled to a unit diagonal Hs (units differ by orders): H^-1 b = Hs^-1 (b / d) / d;
+    by Cholesky, or a pseudo-inverse when columns are dependent (they then share no value)."""
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    return _solver(H / np.outer(d, d)), d
-
-
-def _solver(Hs: np.ndarray):
-    """b -> Hs^-1 b: Cholesky, or a pseudo-inverse when columns are dependent (they then share no value)."""
+    Hs = H / np.outer(d, d)
     if Hs.size == 0:
-        return lambda b: np.zeros_like(b)
+        return (lambda b: np.zeros_like(b)), d
     try:
         factor = linalg.cho_factor(Hs, check_finite=False)
         if np.min(np.abs(np.diag(factor[0]))) > 1e-5:  # condition below about 1e10
-            return lambda b: linalg.cho_solve(factor, b, check_finite=False)
+            return (lambda b: linalg.cho_solve(factor, b, check_finite=False)), d
     except linalg.LinAlgError:
         pass
     vals, vecs = np.linalg.eigh(Hs)
     keep = vals > 1e-10 * max(vals.max(), 1e-300)
     inverse = (vecs[:, keep] / vals[keep]) @ vecs[:, keep].T
-    return lambda b: inverse @ b
+    return (lambda b: inverse @ b), d
 
 
 def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
@@ -170,10 +167,8 @@ def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps:
 
 def _shown(candidate, before, after, min_gain) -> bool:
     """An arm-wide effect must gain min_gain on two joints (on one, that joint's own effects explain it)."""
-    if candidate.joint is None:
-        relative = relative_change(before, after)
-        return int(np.sum(relative >= min_gain)) >= min(2, len(relative))
-    return True
+    relative = relative_change(before, after)
+    return candidate.joint is not None or int(np.sum(relative >= min_gain)) >= min(2, len(relative))
 
 
 def relative_change(before: np.ndarray, after: np.ndarray) -> np.ndarray:

@@ -33,7 +33,8 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # trust.Unusable is raised (nothing claimed)
     fit_signals, select_signals, test = trust.checked_roles(model, s, fit_signals, select_signals, test)
     segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
-    context = _context(model, robot, p, s, options, segments)
+    # position-dependent laws are known only over the positions the fit data cover
+    context = Context(model, robot, p, s, options.sign_velocity, fit.positions(segments))
     # 1. fit: the moments of every candidate on every role's samples
     design = fit.build(context, library(context, options.effects), segments, robot.dof)
     # 2. select
@@ -55,12 +56,6 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
                      roles_of, options.min_gain, floors)
     return replace(result, warnings=notes(result, model, s, fit_signals, select_signals or [], test or [],
                                           judged.used) + result.warnings)
-
-
-def _context(model, robot, p, s, options, segments) -> Context:
-    """Position-dependent laws are known only over the positions the fit data cover."""
-    fit_q = np.vstack([seg.signals.q[seg.fit] for seg in segments if seg.fit.any()])
-    return Context(model, robot, p, s, options.sign_velocity, (fit_q.min(axis=0), fit_q.max(axis=0)))
 
 
 @dataclass(frozen=True)

@@ -47,13 +47,8 @@ def _plain(x):
 
 
 def _value_text(e) -> str:
-    parts = []
-    for name, value in e.values.items():
-        unit = e.units[name]
-        if value is None:
-            parts.append(f"{name} not identifiable")
-        else:
-            parts.append(f"{name} = {value:.4g} +- {e.std[name]:.2g} {unit}")
+    parts = [f"{name} not identifiable" if value is None else f"{name} = {value:.4g} +- {e.std[name]:.2g} {e.units[name]}"
+             for name, value in e.values.items()]
     text = ", ".join(parts)
     if len(parts) > 4:  # the coefficient errors, the payload, the ripple: the largest ones only
         shown = sorted(((abs(v / e.std[n]) if e.std[n] else 0, n) for n, v in e.values.items()
