@@ -63,9 +63,7 @@ def motion_band(qd: np.ndarray, rate: float) -> float:
     power = (np.abs(np.fft.rfft(x * np.hanning(x.shape[0])[:, None], axis=0)) ** 2).sum(axis=1)
     f = np.fft.rfftfreq(x.shape[0], 1.0 / rate)
     cumulative = np.cumsum(power)
-    if cumulative[-1] <= 0:
-        return 0.0
-    return float(f[min(np.searchsorted(cumulative, 0.99 * cumulative[-1]), f.size - 1)])
+    return 0.0 if cumulative[-1] <= 0 else float(f[min(np.searchsorted(cumulative, 0.99 * cumulative[-1]), f.size - 1)])
 
 
 def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision:

@@ -72,9 +72,7 @@ def as_recording(name, columns, data, dof) -> Recording:
     t = data[:, columns["t"]]
 
     def block(prefix):
-        if f"{prefix}1" not in columns:
-            return None
-        return data[:, [columns[f"{prefix}{j}"] for j in range(1, dof + 1)]]
+        return data[:, [columns[f"{prefix}{j}"] for j in range(1, dof + 1)]] if f"{prefix}1" in columns else None
 
     numbered = {f"{p}{j}" for p in ("q", "qd", "qdd", "tau") for j in range(1, dof + 1)}
     extra = {h: data[:, k] for h, k in columns.items() if h != "t" and h not in numbered}

@@ -47,9 +47,7 @@ def reidentified(robot, model, p, context, segments, chosen, x, simple, modes, m
     new = joints.decide(context, segments, chosen, x, simple, min_gain, consistent, reidentify.JOINT_VALUES)
     # only on joints whose residual the link parameters were shown to explain (the gate)
     new = [m if m != joints.CONSISTENT or j in flagged else old for j, (m, old) in enumerate(zip(new, modes))]
-    if joints.CONSISTENT not in new:
-        return None, None, modes, result
-    return result, consistent, new, result
+    return (result, consistent, new, result) if joints.CONSISTENT in new else (None, None, modes, result)
 
 
 def refit(robot, model, p, segments, reid, consistent):

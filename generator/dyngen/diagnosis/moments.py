@@ -122,9 +122,7 @@ def world(context, chosen) -> dict:
 def as_chosen(context, chosen):
     """The context with the arm and sensor the chosen candidates describe (world)."""
     fields = world(context, chosen)
-    if all(getattr(context, k) == v for k, v in fields.items()):
-        return context
-    return dataclasses.replace(context, **fields)
+    return context if all(getattr(context, k) == v for k, v in fields.items()) else dataclasses.replace(context, **fields)
 
 
 def delayed(x: np.ndarray, t: np.ndarray, delay: float) -> np.ndarray:

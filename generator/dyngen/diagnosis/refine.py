@@ -170,9 +170,7 @@ def _secant(state, index) -> None:
         current = state.chosen[index].effect
         values = state.values(index)
         implied = current.implied_setting(values)
-        if implied is None or not current.plausible(values):
-            return None
-        return float(implied) - setting
+        return None if implied is None or not current.plausible(values) else float(implied) - setting
 
     s0 = float(state.chosen[index].effect.setting)
     f0 = excess(s0)
@@ -207,6 +205,4 @@ def _renumbered(chosen) -> list:
 
 def _groups(seg, design) -> list:
     """The segment's block-group masks where the design keeps group moments."""
-    if not design.groups:
-        return []
-    return seg.groups or [np.zeros(seg.residual.shape[0], dtype=bool)] * len(design.groups)
+    return (seg.groups or [np.zeros(seg.residual.shape[0], dtype=bool)] * len(design.groups)) if design.groups else []

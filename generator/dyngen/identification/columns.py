@@ -88,6 +88,4 @@ class Piece:
 
     def column(self, label, coulomb_full=None, tilt=None) -> np.ndarray:
         kind, j = label
-        if kind == "tilt":
-            return tilt[..., j]
-        return joint_column(self.signals, kind, j, coulomb_full)[self.keep]
+        return tilt[..., j] if kind == "tilt" else joint_column(self.signals, kind, j, coulomb_full)[self.keep]

@@ -48,9 +48,7 @@ class Consistent:
                  "armature": _nz(f["armature"][j])} for j in range(len(self.sigma))]
 
     def tilt_deg(self) -> float:
-        if self.tilt_model is None:
-            return 0.0
-        return tilt.angle_deg(tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
+        return 0.0 if self.tilt_model is None else tilt.angle_deg(tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
 
     def predict(self, model, signals) -> np.ndarray:
         """Torques (T, N) of this model on signals (Coulomb through the recording's filter, as in the fit)."""
@@ -137,11 +135,9 @@ def tilt_change(c) -> np.ndarray:
 
 def consistent_table(c) -> str:
     """Markdown: per base coefficient the consistent value, the unconstrained one and its std."""
-    rows = ["| coefficient | consistent | unconstrained | std | excited |", "|---|---:|---:|---:|---|"]
-    for i, name in enumerate(c.names):
-        rows.append(f"| {name} | {c.pi[i]:.6g} | {c.ols.values[i]:.6g} | {c.ols.std[i]:.3g} | "
-                    f"{'no' if i in c.ols.unexcited else 'yes'} |")
-    return "\n".join(rows)
+    return "\n".join(["| coefficient | consistent | unconstrained | std | excited |", "|---|---:|---:|---:|---|"]
+                     + [f"| {name} | {c.pi[i]:.6g} | {c.ols.values[i]:.6g} | {c.ols.std[i]:.3g} | "
+                        f"{'no' if i in c.ols.unexcited else 'yes'} |" for i, name in enumerate(c.names)])
 
 
 def summary_lines(robot, c) -> list[str]:

@@ -57,9 +57,7 @@ class _Correlation:
         last = np.r_[0.0, np.cumsum(self.tail[::-1])][k]  # sums of the last k and the first k values
         first = np.r_[0.0, np.cumsum(self.head)][k]
         acf = self.products[k] - m * (2 * self.total - last - first) + (n - k) * m * m
-        if not acf[0] > 1e-24 * max(self.products[0], 1e-300):
-            return 1.0
-        return truncated(acf / acf[0], min(lags, n // 4))
+        return truncated(acf / acf[0], min(lags, n // 4)) if acf[0] > 1e-24 * max(self.products[0], 1e-300) else 1.0
 
 
 def _score_rows(piece, labels, r, weights, e) -> np.ndarray:
