@@ -137,8 +137,8 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
         if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
-            what = "position" if differentiate else "velocity"
-            out.warnings.append(f"{r.name}: {what} noise ({_sigma(decision.q_noise)}) allows a cutoff of only "
+            out.warnings.append(f"{r.name}: {'position' if differentiate else 'velocity'} noise "
+                                f"({_sigma(decision.q_noise)}) allows a cutoff of only "
                                 f"{cutoff:.3g} Hz, below twice the motion's band ({decision.band:.3g} Hz): "
                                 "accelerations are smoothed")
     elif differentiate:  # without a filter: the central second difference of white noise
@@ -193,8 +193,6 @@ def _lowpass(name: str, rate: float, cutoff: float, order: int):
 
 def _continued(y: np.ndarray, n: int) -> np.ndarray:
     """n samples after y (time along axis 0), from a quadratic fitted to y."""
-    k = np.arange(y.shape[0], dtype=float)
-    coefficients = np.polyfit(k, y.reshape(y.shape[0], -1), 2)
+    coefficients = np.polyfit(np.arange(y.shape[0], dtype=float), y.reshape(y.shape[0], -1), 2)
     ahead = np.arange(y.shape[0], y.shape[0] + n, dtype=float)
-    out = np.vander(ahead, 3) @ coefficients
-    return out.reshape((n,) + y.shape[1:])
+    return (np.vander(ahead, 3) @ coefficients).reshape((n,) + y.shape[1:])

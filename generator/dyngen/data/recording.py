@@ -51,8 +51,7 @@ def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ())
     header_line, _, body = text.partition("\n")
     header = _header(name, header_line)
     columns = check_header(name, header, dof, require_torques, required, "line 1 (header)")
-    data = _numbers(body, name, header)
-    return from_columns(name, header, columns, data, dof)
+    return from_columns(name, header, columns, _numbers(body, name, header), dof)
 
 
 def csv_line(row: int) -> str:

@@ -54,8 +54,7 @@ def _consistent(diagnosis, robot, folder, sources: dict) -> dict:
     for name, text in (("identified.yaml", yaml), ("identified.md", table)):
         write_file(folder / name, text)
         paths[f"consistent/{name}"] = folder / name
-    exported = write_all(robot, c.p, folder, c.joint_dynamics())
-    paths.update({f"consistent/{path.name}": path for path in exported})
+    paths.update({f"consistent/{path.name}": path for path in write_all(robot, c.p, folder, c.joint_dynamics())})
     return paths
 
 

@@ -58,8 +58,7 @@ def identifiable(design, chosen, most: float = 0.5) -> np.ndarray:
     d = np.sqrt(np.maximum(np.diag(H), 1e-300))
     vals, vecs = np.linalg.eigh(H / np.outer(d, d))
     weak = vals <= 1e-10 * max(vals.max(), 1e-300)
-    loading = (vecs[:, weak] ** 2).sum(axis=1)
-    return loading < most
+    return (vecs[:, weak] ** 2).sum(axis=1) < most
 
 
 def reported(chosen, described, replaced) -> tuple[list[Finding], list[Finding]]:

@@ -88,8 +88,7 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     keep = vals > 1e-12 * max(vals.max(initial=0.0), 1e-300)
     if not keep.any():
         return 1.0
-    z = vecs[:, keep].T @ x
-    chi2 = float(np.sum(z ** 2 / vals[keep]))
+    chi2 = float(np.sum((vecs[:, keep].T @ x) ** 2 / vals[keep]))
     return float(stats.chi2.sf(chi2, int(keep.sum())))
 
 
@@ -125,8 +124,7 @@ def selection_gain(candidate, before: np.ndarray, after: np.ndarray) -> float:
     relative = relative_change(before, after)
     if candidate.joint is None:
         return float(relative.sum())
-    others = np.delete(relative, candidate.joint)
-    return float(relative[candidate.joint] + np.minimum(others, 0.0).sum())
+    return float(relative[candidate.joint] + np.minimum(np.delete(relative, candidate.joint), 0.0).sum())
 
 
 def forward(design, min_gain: float = MIN_GAIN, alpha: float = ALPHA, max_steps: int = 30) -> Selection:

@@ -110,7 +110,6 @@ def simple_mse(segments, simple, role, n) -> np.ndarray:
     for seg in segments:
         m = getattr(seg, role)
         if m.any():
-            r = seg.residual[m] - simple_model.predict(simple, seg)[m]
-            sse += (r ** 2).sum(axis=0)
+            sse += ((seg.residual[m] - simple_model.predict(simple, seg)[m]) ** 2).sum(axis=0)
             count += int(m.sum())
     return sse / max(count, 1)

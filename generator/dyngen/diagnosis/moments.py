@@ -44,8 +44,7 @@ class Moments:
     def mse(self, slots: np.ndarray, x: np.ndarray) -> np.ndarray:
         """Per joint mean squared residual after subtracting the candidates' fit x (at slots)."""
         G = self.G[:, slots][:, :, slots]
-        b = self.b[:, slots]
-        sse = self.c - 2 * b @ x + np.einsum("k,jkl,l->j", x, G, x)
+        sse = self.c - 2 * self.b[:, slots] @ x + np.einsum("k,jkl,l->j", x, G, x)
         return np.maximum(sse, 0.0) / max(self.count, 1)
 
 

@@ -62,8 +62,7 @@ class _State:
             return chosen, columns, self.restricted(chosen, columns), context
         # a per-joint candidate's columns on its own joint only, unless another joint's
         # candidate has the same setting (and key)
-        shared = any(c.effect.key == effect.key and c.joint != old.joint for c in chosen)
-        joint = None if shared else old.joint
+        joint = None if any(c.effect.key == effect.key and c.joint != old.joint for c in chosen) else old.joint
         columns = [{**cols, effect.key: dz.columns_of(effect, self.context, seg, joint)}
                    for cols, seg in zip(self.columns, self.segments)]
         return chosen, columns, self.updated(chosen, columns, index), self.context

@@ -72,8 +72,7 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
         for effect in forms:
             replaced = chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:]
             form_design, form_chosen = restricted(context, segments, design, replaced)
-            score = float(design.weights ** 2 @ selection_mse(form_design, form_chosen))
-            options.append((score, form_design, form_chosen))
+            options.append((float(design.weights ** 2 @ selection_mse(form_design, form_chosen)), form_design, form_chosen))
         _, design, chosen = min(options, key=lambda o: o[0])
         refused.append(Refusal(*refusal))  # what of the term is refused, its values
         return design, chosen, solve(design, chosen)

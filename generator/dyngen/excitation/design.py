@@ -187,8 +187,7 @@ def optimise(robot, model, settings: Settings | None = None) -> Design:
     if settings.criterion not in ("cond", "logdet"):
         raise InputError("--criterion", "", f'expected "cond" or "logdet", got "{settings.criterion}"')
     start = time.perf_counter()
-    limits = limits_of(robot)
-    shape = _Shape(limits, settings, flange_of(robot) if settings.workspace is not None else None)
+    shape = _Shape(limits_of(robot), settings, flange_of(robot) if settings.workspace is not None else None)
     armature = armature_identifiable(model, robot.dof)
     times = np.arange(settings.points) * settings.period / settings.points
     evaluations = 0

@@ -36,8 +36,7 @@ def _coulomb_search(normal, trials, fit, grid, tolerance: float):
     n = normal.n[fit].sum(axis=0)
     best, choice, which = np.full(normal.dof, np.inf), np.full(normal.dof, grid[0], dtype=float), np.zeros(normal.dof, int)
     for i, (value, trial) in enumerate(zip(grid, trials)):
-        x = solve_unconstrained(*trial.total(fit))
-        ms = trial.sse(x, fit).sum(axis=0) / np.maximum(n, 1)
+        ms = trial.sse(solve_unconstrained(*trial.total(fit)), fit).sum(axis=0) / np.maximum(n, 1)
         better = ms < best * (1 - tolerance)
         best[better], choice[better], which[better] = ms[better], value, i
     return choice, Normal.per_joint([trials[i] for i in which])
@@ -221,8 +220,7 @@ def _final(solver, normal, blocks, fit, weights, active, cone, lam, g_vec, notes
     labels, r = normal.labels, normal.r
 
     def fit_with(act):
-        keep = np.r_[np.arange(r), r + np.asarray(act, dtype=int)]
-        G, g = normal.total(fit, weights, keep)
+        G, g = normal.total(fit, weights, np.r_[np.arange(r), r + np.asarray(act, dtype=int)])
         x, _, result = solver.solve(G, g, [labels[k] for k in act], lam, cone=cone)
         return x, result
 

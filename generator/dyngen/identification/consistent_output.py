@@ -64,8 +64,7 @@ class Consistent:
         if self.simple:  # the prior's rigid body + b + Fc tanh(qd / 0.02) + Fv qd there
             j = list(self.simple["joints"])
             rigid = model.batch("rnea", signals.q, signals.qd, signals.qdd, self.simple["standard"])
-            terms = np.einsum("tjk,jk->tj", simple_model.columns(signals), self.simple["values"])
-            out[:, j] = (rigid + terms)[:, j]
+            out[:, j] = (rigid + np.einsum("tjk,jk->tj", simple_model.columns(signals), self.simple["values"]))[:, j]
         return out
 
 

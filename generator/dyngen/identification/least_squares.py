@@ -43,8 +43,7 @@ def fit_factor(R: np.ndarray, rows: int, names: list[str], weak: float = WEAK) -
     sigma2 = sse / max(rows - int(strong.sum()), 1)
     loading = (Vt[~strong] ** 2).sum(axis=0)  # share of each coefficient in the weak directions
     unexcited = [k for k in range(c) if loading[k] > 0.5 or norms[k] == 0]
-    cov_scaled = (Vt[strong].T / sv[strong] ** 2) @ Vt[strong]
-    std = np.sqrt(sigma2 * np.diag(cov_scaled)) / scale
+    std = np.sqrt(sigma2 * np.diag((Vt[strong].T / sv[strong] ** 2) @ Vt[strong])) / scale
     std[unexcited] = np.inf
     raw = np.linalg.svd(A, compute_uv=False)
     condition = float(raw[0] / raw[-1]) if raw[-1] > 0 else float("inf")

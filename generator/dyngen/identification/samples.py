@@ -24,8 +24,7 @@ def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray
     if kind == "gravity":
         return model.batch(REGRESSOR[kind], q), tau
     if kind == "inertia":
-        names = stacked_inertia_columns(model.manifest)
-        return model.batch(REGRESSOR[kind], q), np.column_stack([extra[c] for c in names])
+        return model.batch(REGRESSOR[kind], q), np.column_stack([extra[c] for c in stacked_inertia_columns(model.manifest)])
     return model.batch(REGRESSOR[kind], q, qd, qdd), tau
 
 

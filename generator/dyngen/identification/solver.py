@@ -112,8 +112,7 @@ class Solver:
             if not wants.any():
                 break
             free |= wants
-        natural = M[r:, r:] @ (y_f / scale[r:])
-        return np.concatenate([pi, natural]), free, result
+        return np.concatenate([pi, M[r:, r:] @ (y_f / scale[r:])]), free, result  # friction's natural values
 
 
 def robot_with_default_bounds(robot):

@@ -116,8 +116,7 @@ class Payload(Term):
             return np.array(list(values.values()), dtype=float)
         m = values["m"]
         c = np.array([values[k] for k in ("mx", "my", "mz")]) / m
-        J = inertia_array((variant or {}).get("inertia_per_kg", [0.0] * 6))
-        I = m * (J + _point(c))
+        I = m * (inertia_array((variant or {}).get("inertia_per_kg", [0.0] * 6)) + _point(c))
         return np.array([m, *(m * c), *(I[i, k] for i, k in _UPPER)])
 
 

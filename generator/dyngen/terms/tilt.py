@@ -90,8 +90,7 @@ def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
     for i, model in enumerate(robot.joint_models):
         z, o = poses[i].axis, poses[i].point
         for k in range(i, n):
-            m = links[k, 0]
-            G[:, i, :] -= m * (np.cross(z, centres[k] - o) if model.revolute else z)
+            G[:, i, :] -= links[k, 0] * (np.cross(z, centres[k] - o) if model.revolute else z)
     return G
 
 
