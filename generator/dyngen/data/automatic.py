@@ -79,17 +79,16 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
         band = motion_band(derivatives(q)[0], rate) if q.shape[0] >= 32 else 0.0
         return Decision(None, sigma, np.zeros_like(sigma), band)
     noise = float(np.sqrt(np.mean(sigma ** 2)))
-    top = MAX_FRACTION * rate
     cutoff = rate / 20
     for _ in range(6):  # converges in two or three steps: the RMS changes slowly with the cutoff
-        qd, qdd = derivatives(lowpass_of(cutoff)(q))
+        qdd = derivatives(lowpass_of(cutoff)(q))[1]
         measured = float(np.mean(qdd ** 2))
         signal = np.sqrt(max(measured - float(np.mean(acceleration_noise(sigma, cutoff, rate, order) ** 2)), 0.0))
         # the largest fc with noise(fc) <= NOISE_SHARE * signal
         target = NOISE_SHARE * max(signal, 1e-12)
         k = 2 * order + 1
-        new = (target / (noise * (2 * np.pi) ** order)) ** (2 / k) * (k * rate / 2) ** (1 / k)
-        new = float(np.clip(new, MIN_CUTOFF, top))
+        new = float(np.clip((target / (noise * (2 * np.pi) ** order)) ** (2 / k) * (k * rate / 2) ** (1 / k),
+                            MIN_CUTOFF, MAX_FRACTION * rate))
         if abs(new - cutoff) <= 0.01 * cutoff:
             cutoff = new
             break

@@ -110,13 +110,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
             cutoff = None  # the recording's own velocities: nothing to differentiate, nothing to filter
     lowpass = _lowpass(r.name, rate, cutoff, options.order) if cutoff is not None else None
     same = lowpass or (lambda x: np.array(x, dtype=float))
-    q = same(r.q)
-    if differentiate:
-        qd = np.gradient(q, r.t, axis=0)  # second-order central differences (non-uniform t allowed)
-        qdd = np.gradient(qd, r.t, axis=0)
-    else:
-        qd = same(r.qd)
-        qdd = same(r.qdd) if r.qdd is not None else np.gradient(qd, r.t, axis=0)
+    q = same(r.q)  # qd, qdd where not recorded: second-order central differences (non-uniform t allowed)
+    qd = np.gradient(q, r.t, axis=0) if differentiate else same(r.qd)
+    qdd = np.gradient(qd, r.t, axis=0) if differentiate or r.qdd is None else same(r.qdd)
     tau = same(r.tau) if r.tau is not None else None
     extra = {k: same(v) for k, v in r.extra.items()}
     trim = 0

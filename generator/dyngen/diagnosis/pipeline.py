@@ -230,12 +230,10 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
                      "effects found there may stand for wrong masses or inertias; --reidentify tries consistent link "
                      "parameters as an alternative (or identify them first: dyngen identify)"
                      + _why_not_tried(choice.precision))
-    rms = {key: np.sqrt(x).tolist() for key, x in (("before", judged.before), ("after", judged.after),
-                                                    ("effects", judged.effects), ("simple", judged.simple))}
+    rms = {f"rms_{key}": np.sqrt(getattr(judged, key)).tolist() for key in ("before", "after", "effects", "simple")}
     reid = final.reidentified
     return Diagnosis(
-        robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected,
-        rms_before=rms["before"], rms_after=rms["after"], rms_effects=rms["effects"], rms_simple=rms["simple"],
+        robot=robot.name, joints=n, split=split, judged_on=judged.on, selected=selected, **rms,
         selection_before=selection_rms["before"], selection_after=selection_rms["effects"],
         selection_simple=selection_rms["simple"],
         simple_wins=[j + 1 for j in range(n) if modes[j] == joints.SIMPLE], simple_values=final.simple.values.tolist(),

@@ -56,8 +56,7 @@ def scores(solver, normal, folds: Folds, labels_idx, lam: float, free=None, work
 
 def choose_lambda(solver, normal, folds: Folds, labels_idx, grid, rule: str = "1se", workers: int = 1, cone=()):
     """(lambda, [(lambda, mean weighted score)], {lambda: Scores})."""
-    table, kept = [], {}
-    free = None
+    table, kept, free = [], {}, None
     for lam in sorted(grid):
         s = scores(solver, normal, folds, labels_idx, lam, free, workers, cone)
         free = s.free
