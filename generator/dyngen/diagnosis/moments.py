@@ -111,9 +111,7 @@ def world(context, chosen) -> dict:
     """The Context fields the chosen set: a time shift's delay, 1 + each sensor gain (scale), a payload (load)."""
     delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
-    scale = None
-    if gains:
-        scale = tuple(1.0 + gains.get(j, 0.0) for j in range(len(context.robot.joints)))
+    scale = tuple(1.0 + gains.get(j, 0.0) for j in range(len(context.robot.joints))) if gains else None
     load = next((c.effect.load for c in chosen if c.effect.load is not None), None)
     return {"delay": delay, "scale": scale, "load": load}
 

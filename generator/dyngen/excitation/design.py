@@ -63,9 +63,8 @@ def limits_of(robot) -> JointLimits:
     """The YAML's joint limits; an InputError names the first missing one."""
     values = {k: [] for k in ("lower", "upper", "velocity", "acceleration")}
     for i, joint in enumerate(robot.joints):
-        lim = joint.limits
         for key in values:
-            value = getattr(lim, key, None) if lim is not None else None
+            value = getattr(joint.limits, key, None)  # None without limits
             if value is None:
                 raise InputError(robot.source, f"joints[{i}].limits.{key}",
                                  "missing (dyngen excite needs lower, upper, velocity and acceleration)")
@@ -110,9 +109,7 @@ class _Shape:
                         m * lim.acceleration / np.maximum(np.abs(qdd).max(axis=0), tiny)], axis=0)
         scale = np.where(np.isfinite(scale), scale, 0.0)
         traj = _from(self.base_hz, q0, a * scale[:, None], b * scale[:, None])
-        if self.flange is not None and self.settings.workspace is not None:
-            traj = self._into_box(traj, q0)
-        return traj
+        return self._into_box(traj, q0) if self.flange is not None and self.settings.workspace is not None else traj
 
     def _into_box(self, traj, q0):
         # the flange is checked on every second grid point against the box shrunk by 1 mm (the
@@ -193,8 +190,7 @@ def optimise(robot, model, settings: Settings | None = None) -> Design:
     evaluations = 0
 
     def matrix(x):
-        q, qd, qdd = shape.trajectory(x)(times)
-        return identification_matrix(model, q, qd, qdd, settings.coulomb_velocity, armature)
+        return identification_matrix(model, *shape.trajectory(x)(times), settings.coulomb_velocity, armature)
 
     def criterion(x):
         nonlocal evaluations
@@ -215,10 +211,8 @@ def optimise(robot, model, settings: Settings | None = None) -> Design:
     result = minimize(criterion, best, method="L-BFGS-B", bounds=bounds,
                       options={"maxiter": settings.max_iterations, "eps": 1e-6})
     x = result.x if result.fun <= min(values) else best
-    traj = shape.trajectory(x)
-    cond, scaled = _conditions(matrix(x))
-    rcond, rscaled = _conditions(matrix(starts[random_index]))
-    return Design(traj, cond, scaled, rcond, rscaled, evaluations, time.perf_counter() - start)
+    return Design(shape.trajectory(x), *_conditions(matrix(x)), *_conditions(matrix(starts[random_index])), evaluations,
+                  time.perf_counter() - start)
 
 
 def random_design(robot, settings: Settings, seed: int) -> FourierTrajectory:

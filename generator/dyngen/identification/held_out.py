@@ -67,9 +67,7 @@ def choose_lambda(solver, normal, folds: Folds, labels_idx, grid, rule: str = "1
         limit = means[best] + _se(kept[table[best][0]].weighted)
         if len(table) - 1 > best and means[-1] > limit:
             break
-    chosen = best
-    if rule == "1se" and len(folds.splits) > 1:
-        chosen = max(i for i in range(len(means)) if means[i] <= limit)
+    chosen = max(i for i in range(len(means)) if means[i] <= limit) if rule == "1se" and len(folds.splits) > 1 else best
     return table[chosen][0], table, kept
 
 
