@@ -12,6 +12,7 @@ import numpy as np
 
 from ..catalogue import RNEA
 from ..forked import in_order
+from ..terms.context import Memo
 from . import fit, joints, reidentify, roles
 from . import moments as dz
 from .judge import held_sums, over_every_row
@@ -36,7 +37,7 @@ def every_row(context, chosen, tasks, size: int) -> dz.Moments:
 
     def of_block(block) -> dz.Moments:
         seg = block_segment(context, block, "fit")
-        columns = dz.effect_columns(effects, replace(world, cache={}), seg)  # a memo per block, not kept
+        columns = dz.effect_columns(effects, replace(world, cache=Memo()), seg)  # a memo per block, not kept
         out = dz.empty(n, size)
         for j in range(n):
             acting = [c for c in chosen if c.joint is None or c.joint == j]
@@ -68,7 +69,7 @@ def every_test_row(model, final, modes, completed, judged, segments):
 
     def of_block(block):
         seg = block_segment(final.context, block, "test")
-        context = replace(final.context, cache={})  # a memo per block, not kept
+        context = replace(final.context, cache=Memo())  # a memo per block, not kept
         (effects,) = fit.corrected(context, chosen, x, [seg])
         consistent = None if final.reidentified is None else reidentify.corrections(final.reidentified, model,
                                                                                      [effects])

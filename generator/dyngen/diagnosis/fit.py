@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..data.correlation import integrated_time
+from ..terms.context import Memo
 from . import moments as dz
 from . import roles
 
@@ -92,5 +93,5 @@ def positions(segments) -> tuple:
 
 def ranged(context, segments, chosen):
     """The context with the positions the fit samples cover if a chosen effect needs them."""
-    return dataclasses.replace(context, q_range=positions(segments), cache={}) \
+    return dataclasses.replace(context, q_range=positions(segments), cache=Memo()) \
         if any(c.effect.ranged for c in chosen) else context

@@ -130,9 +130,7 @@ def choose(sse_per_joint: list[dict], chosen, min_gain: float, consistent_values
 
 
 def _better(sse, size, best_sse, best_size, min_gain) -> bool:
-    """Whether a model beats the current best on selection data, the one with more values
-    having to gain `min_gain` of the mean square per extra value (as an effect must to be
-    selected), the one with fewer values winning ties."""
+    """Whether a model beats the current best on selection data by the rule above (fewer values win ties)."""
     if size > best_size:
         return sse < (1 - min_gain) ** (size - best_size) * best_sse
     return sse <= best_sse / (1 - min_gain) ** (best_size - size)

@@ -8,12 +8,8 @@ friction that opposes motion, a tilted base, regularised toward the diagnosed pa
 the alternative, with the three roles of data kept:
 
   excited by default (Options.reidentify None) it runs where the fit samples determine what it
-          would change: the gate's unconstrained fit of the rigid body's base columns to what
-          the effects leave moves some base coefficients (each one whose torque is at least
-          MOVED of the residual's), and every one of them is determined to PRECISION of its
-          value (its standard deviation from the residual the fit leaves, scaled for that
-          residual's correlation in time): two deviations from zero. (Numbers:
-          docs/measured-data.md, "runs by default where the fit data determine".)
+          would change: every base coefficient the gate's fit moves (MOVED) determined to
+          PRECISION (gate; docs/measured-data.md, "runs by default where the fit data determine");
   gate    cheap: the residual the selected effects leave on the fit samples, regressed on the
           rigid body's base columns (unconstrained, at GATE_RATE); the joints where that gains
           `min_gain` of the mean square on the selection samples are those whose residual the

@@ -62,10 +62,6 @@ class Context:
     load: tuple | None = None
     cache: Memo = field(default_factory=Memo)  # columns and shared intermediates, per recording (memo)
 
-    def __post_init__(self):
-        if isinstance(self.cache, dict):  # a fresh memo asked for as `cache={}` (fit.ranged)
-            self.cache = Memo()
-
     def memo(self, key, compute):
         """compute() once per key (one diagnosis's recordings do not change, so a value computed again is the same)."""
         return self.cache.get(key, compute)
