@@ -59,8 +59,7 @@ def pieces(segments, role: str) -> list:
     """Conditioned signals of every contiguous run of `role` samples, decimated to ~RATE Hz."""
     out = []
     for seg in segments:
-        sig, mask = seg.signals, getattr(seg, role)
-        idx = np.flatnonzero(mask)
+        sig, idx = seg.signals, np.flatnonzero(getattr(seg, role))
         if not idx.size:
             continue
         step = max(1, int(round(sig.rate / RATE)))

@@ -89,11 +89,10 @@ class _Shape:
         return np.concatenate([rng.uniform(-0.2, 0.2, self.n), rng.standard_normal(self.size - self.n) * decay])
 
     def coefficients(self, x):
+        """(a, b): the free ones for harmonics 2 .. L, the first's set so that the motion starts at rest."""
         free = x[self.n:].reshape(self.n, 2, self.L - 1)
-        harmonic = np.arange(2, self.L + 1)
-        a = np.column_stack([-free[:, 0].sum(axis=1), free[:, 0]])
-        b = np.column_stack([-(free[:, 1] * harmonic).sum(axis=1), free[:, 1]])
-        return a, b
+        return (np.column_stack([-free[:, 0].sum(axis=1), free[:, 0]]),
+                np.column_stack([-(free[:, 1] * np.arange(2, self.L + 1)).sum(axis=1), free[:, 1]]))
 
     def trajectory(self, x) -> FourierTrajectory:
         lim, m = self.limits, self.settings.margin

@@ -59,8 +59,7 @@ class Consistent:
         out = out + (f["viscous"] * signals.qd + f["offset"] + f["armature"] * signals.qdd
                      + f["ripple_cos"] * np.cos(signals.q) + f["ripple_sin"] * np.sin(signals.q))
         if self.tilt_model is not None:
-            robot, p = self.tilt_model
-            out = out + tilt.torque(robot, p, signals.q, tilt.gravity_of(robot), self.friction["tilt"])
+            out = out + tilt.torque(*self.tilt_model, signals.q, tilt.gravity_of(self.tilt_model[0]), self.friction["tilt"])
         if self.simple:  # the prior's rigid body + b + Fc tanh(qd / 0.02) + Fv qd there
             j = list(self.simple["joints"])
             rigid = model.batch("rnea", signals.q, signals.qd, signals.qdd, self.simple["standard"])
