@@ -184,15 +184,12 @@ def _check_time(name, t, where=csv_line) -> None:
     if t.size < 2:
         raise InputError(name, "column t", f"{t.size} sample(s); at least 2 are needed")
     steps = np.diff(t)
-    bad = np.flatnonzero(steps <= 0)
-    if bad.size:
-        k = bad[0]
-        raise InputError(name, f"{where(k + 1)}, column t", f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})")
-    bad = np.flatnonzero(steps < MIN_STEP)
-    if bad.size:
-        k = bad[0]
-        raise InputError(name, f"{where(k + 1)}, column t", f"a time step of {float(steps[k]):.3g} s (at least "
-                         f"{MIN_STEP:g} s: t is in seconds, and no sensor samples faster than 1 MHz)")
+    for bad, what in ((steps <= 0, lambda k: f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})"),
+                      (steps < MIN_STEP, lambda k: f"a time step of {float(steps[k]):.3g} s (at least {MIN_STEP:g} s: "
+                                                   "t is in seconds, and no sensor samples faster than 1 MHz)")):
+        if bad.any():
+            k = np.flatnonzero(bad)[0]
+            raise InputError(name, f"{where(k + 1)}, column t", what(k))
 
 
 def check_informative(recordings, need_motion: bool = True) -> None:

@@ -176,16 +176,14 @@ def identify_consistent(robot, model, folder, signals_list, options: ConsistentO
     rms = np.sqrt(normal.sse(x, fit, keep).sum(axis=0) / np.maximum(n_fit, 1))
     ols_rms = np.sqrt(normal.sse(ols.values, fit, keep).sum(axis=0) / np.maximum(n_fit, 1))
 
-    friction = {k: np.full(dof, np.nan) for k in PER_JOINT}
-    friction["tilt"] = np.zeros(2)
+    friction = {**{k: np.full(dof, np.nan) for k in PER_JOINT}, "tilt": np.zeros(2)}
     for (kind, j), value in zip(final_labels, x[r:]):
         friction[kind][j] = value  # for the tilt, j is the direction (u1, u2)
-    has_tilt = any(kind == "tilt" for kind, _ in final_labels)
     lam_min = np.array([consistency_margin(row) for row in result.p.reshape(-1, PER_LINK)])
     return Consistent(result.p, x[:r], names, friction, smoothing, sigma, ols, column_names, rms, ols_rms, lam_min,
-                      lam, table, [j + 1 for j in range(dof) if not armature_ok[j]],
-                      pinned(solver.problem, result.p), (robot, prior) if has_tilt else None, dropped,
-                      lags, groups, notes)
+                      lam, table, [j + 1 for j in range(dof) if not armature_ok[j]], pinned(solver.problem, result.p),
+                      (robot, prior) if any(kind == "tilt" for kind, _ in final_labels) else None, dropped, lags,
+                      groups, notes)
 
 
 def _decide(solver, normal, splits, active, cone, undecided, falling, base, lam, workers):
