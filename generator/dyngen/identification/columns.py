@@ -46,12 +46,10 @@ def lagged(t, x, lag: float) -> np.ndarray:
 
 def switching_filter(signals):
     """The recording's low-pass, for columns switching with the velocity's sign (redesigned if decimated)."""
-    lowpass = getattr(signals, "lowpass", None)
-    cutoff = getattr(signals, "cutoff", None)
+    lowpass, cutoff = getattr(signals, "lowpass", None), getattr(signals, "cutoff", None)
     if lowpass is None or cutoff is None or len(signals.t) < 16:
         return lambda x: x
-    rate = signals.rate
-    designed = getattr(lowpass, "rate", None)
+    rate, designed = signals.rate, getattr(lowpass, "rate", None)
     if designed is None or abs(designed - rate) <= 1e-3 * rate:
         return signals.filtered
     if not cutoff < 0.45 * rate:
@@ -70,9 +68,8 @@ def coulomb_matrix(signals, smoothing, lags) -> np.ndarray:
 
 def joint_column(signals, kind: str, j: int, coulomb=None) -> np.ndarray:
     """(T,): the column of (kind, j) in joint j's rows (coulomb from coulomb_matrix)."""
-    if kind == "coulomb":
-        return coulomb[:, j]
-    return joint_columns.column(kind, signals.q[:, j], signals.qd[:, j], signals.qdd[:, j])
+    return coulomb[:, j] if kind == "coulomb" else joint_columns.column(kind, signals.q[:, j], signals.qd[:, j],
+                                                                          signals.qdd[:, j])
 
 
 @dataclass
