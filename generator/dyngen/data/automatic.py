@@ -76,8 +76,7 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
         return qd, np.gradient(qd, t, axis=0)
 
     if q.shape[0] < 32 or float(sigma.max()) <= NO_FILTER_NOISE:
-        band = motion_band(derivatives(q)[0], rate) if q.shape[0] >= 32 else 0.0
-        return Decision(None, sigma, np.zeros_like(sigma), band)
+        return Decision(None, sigma, np.zeros_like(sigma), motion_band(derivatives(q)[0], rate) if q.shape[0] >= 32 else 0.0)
     noise = float(np.sqrt(np.mean(sigma ** 2)))
     cutoff = rate / 20
     for _ in range(6):  # converges in two or three steps: the RMS changes slowly with the cutoff
@@ -89,9 +88,8 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
         k = 2 * order + 1
         new = float(np.clip((target / (noise * (2 * np.pi) ** order)) ** (2 / k) * (k * rate / 2) ** (1 / k),
                             MIN_CUTOFF, MAX_FRACTION * rate))
-        if abs(new - cutoff) <= 0.01 * cutoff:
-            cutoff = new
+        cutoff, before = new, cutoff
+        if abs(new - before) <= 0.01 * before:
             break
-        cutoff = new
     qd = derivatives(lowpass_of(cutoff)(q))[0]
     return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate, order), motion_band(qd, rate))

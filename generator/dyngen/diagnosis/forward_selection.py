@@ -23,12 +23,6 @@ class Fit:
     # the block of `block` (see solve)
     block: slice | None = None
 
-    def covariance_of(self, k: slice) -> np.ndarray:
-        if self.block is None:
-            return self.covariance[k, k]
-        assert k == self.block, "covariance computed for another block"
-        return self.covariance
-
 
 @dataclass
 class Selection:
@@ -83,7 +77,8 @@ def p_value(fit: Fit, candidate, chosen, correlation: float = 1.0) -> float:
     """Chi-square test of the candidate's values against zero, the covariance scaled by the correlation time."""
     offset = sum(c.size for c in chosen[:chosen.index(candidate)])
     k = slice(offset, offset + candidate.size)
-    x, C = fit.x[k], fit.covariance_of(k) * correlation
+    assert fit.block in (None, k), "covariance computed for another block"
+    x, C = fit.x[k], (fit.covariance[k, k] if fit.block is None else fit.covariance) * correlation
     vals, vecs = np.linalg.eigh(C)
     keep = vals > 1e-12 * max(vals.max(initial=0.0), 1e-300)
     if not keep.any():
