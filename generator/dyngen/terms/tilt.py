@@ -42,8 +42,7 @@ def directions(g) -> np.ndarray:
 
 
 def tilt_directions(robot) -> tuple[np.ndarray, np.ndarray]:
-    D = directions([float(x) for x in robot.gravity])
-    return D[0], D[1]
+    return tuple(directions([float(x) for x in robot.gravity])[:2])
 
 
 def tilt_axes(robot) -> tuple[str, str]:
@@ -51,10 +50,8 @@ def tilt_axes(robot) -> tuple[str, str]:
     names = []
     for u in tilt_directions(robot):
         k = int(np.argmax(np.abs(u)))
-        if abs(abs(u[k]) - 1.0) < 1e-9:
-            names.append(f"base {'+' if u[k] > 0 else '-'}{'xyz'[k]}")
-        else:
-            names.append("base (" + ", ".join(f"{x:.3g}" for x in u) + ")")
+        names.append(f"base {'+' if u[k] > 0 else '-'}{'xyz'[k]}" if abs(abs(u[k]) - 1.0) < 1e-9
+                     else "base (" + ", ".join(f"{x:.3g}" for x in u) + ")")
     return names[0], names[1]
 
 
