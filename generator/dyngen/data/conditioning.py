@@ -95,10 +95,8 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     filtering = options.cutoff is not None and (options.cutoff != AUTO or differentiate or recording.qdd is None)
     # repeats, held columns, jittered stamps; uneven ones made a regular grid where a filter follows
     r, log = log_quality.regular_samples(recording, regrid=filtering)
-    timing = log.clock
     rate = 1.0 / float(np.median(np.diff(r.t)))
-    decision = None
-    cutoff = options.cutoff
+    decision, cutoff = None, options.cutoff
     if isinstance(cutoff, str):
         if cutoff != AUTO:
             raise InputError(r.name, "cutoff", f"{cutoff!r}: expected a frequency in Hz or {AUTO!r}")
@@ -123,9 +121,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     trim = min(trim, max((r.t.size - 4) // 4, 0))
     out = Signals(r.name, r.t, q, qd, qdd, tau, extra, lowpass, trim, cutoff, _note(differentiate, cutoff, options,
                                                                                       decision, r.qdd is None))
-    if timing:
-        out.note = f"{timing}; {out.note}"
-        out.warnings.append(f"{r.name}: {timing}")
+    if log.clock:
+        out.note = f"{log.clock}; {out.note}"
+        out.warnings.append(f"{r.name}: {log.clock}")
     if log.notes:
         out.note = "; ".join(log.notes) + f"; {out.note}"
         out.warnings.extend(log.warnings)
@@ -133,10 +131,9 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
         if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
-            out.warnings.append(f"{r.name}: {'position' if differentiate else 'velocity'} noise "
-                                f"({_sigma(decision.q_noise)}) allows a cutoff of only "
-                                f"{cutoff:.3g} Hz, below twice the motion's band ({decision.band:.3g} Hz): "
-                                "accelerations are smoothed")
+            out.warnings.append(f"{r.name}: {'position' if differentiate else 'velocity'} noise ({_sigma(decision.q_noise)})"
+                                f" allows a cutoff of only {cutoff:.3g} Hz, below twice the motion's band "
+                                f"({decision.band:.3g} Hz): accelerations are smoothed")
     elif differentiate:  # without a filter: the central second difference of white noise
         out.q_noise = sigma = automatic.position_noise(r.q)
         out.qdd_noise = automatic.acceleration_noise(sigma, cutoff, rate) if cutoff else sigma * np.sqrt(6.0) * rate ** 2
