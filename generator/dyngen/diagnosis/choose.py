@@ -24,10 +24,7 @@ def on_folds(context, segments, design, chosen, options) -> list[str]:
         # Position laws are known only over the positions this cut's fit blocks cover, as the
         # final model's are over all the fit data (else a ripple would be judged on guesses).
         fold = ranged(context, cut, chosen)
-        x = np.zeros(0)
-        if chosen:
-            fold_design, fold_chosen = restricted(fold, cut, design, chosen)
-            x = solve(fold_design, fold_chosen, covariance=False).x
+        x = solve(*restricted(fold, cut, design, chosen), covariance=False).x if chosen else np.zeros(0)
         cut = corrected(fold, chosen, x, cut)
         sse = joints.errors(fold, cut, chosen, x, simple_model.fit(cut))
         totals = sse if totals is None else [{k: a[k] + b[k] for k in a} for a, b in zip(totals, sse)]

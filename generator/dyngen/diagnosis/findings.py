@@ -21,9 +21,8 @@ def describe(design, chosen, cand, min_gain) -> Finding:
     gain = selection_gain(cand, mse_without, mse_with)
     joints = [cand.joint + 1] if cand.joint is not None else \
         [j + 1 for j in range(len(gain_per_joint)) if gain_per_joint[j] >= min_gain]
-    names = list(cand.effect.parameters)
     return Finding(effect=cand.effect.name, joints=tuple(joints), variant=cand.effect.fixed(), values={}, std={},
-                   units=dict(zip(names, cand.effect.units)), derived={}, selection_gain=gain,
+                   units=dict(zip(cand.effect.parameters, cand.effect.units)), derived={}, selection_gain=gain,
                    rms_before=np.sqrt(mse_without).tolist(), rms_after=np.sqrt(mse_with).tolist(),
                    suspect=cand.effect.suspect)
 
@@ -36,7 +35,7 @@ def with_values(described, design, chosen, final, tau_corr, robot) -> list[Findi
         offset += cand.size
         std = np.sqrt(np.maximum(np.diag(final.covariance)[k], 0.0) * tau_corr)
         determined = identifiable(design, chosen)[k]
-        names = list(cand.effect.parameters)
+        names = cand.effect.parameters
         values = {nm: (float(v) if ok else None) for nm, v, ok in zip(names, final.x[k], determined)}
         std = {nm: (float(d) if ok else None) for nm, d, ok in zip(names, std, determined)}
         derived = cand.effect.derived(robot, values, std, partial(_torque_rms, design, cand, final.x[k]))

@@ -44,9 +44,8 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
         out += [segment(sig, none(sig), sig.inner(), none(sig)) for sig in select_signals]
         split = "selection on separate recordings"
     else:
-        for sig in fit_signals:
-            fit, select = blocks(sig, block_seconds)
-            out.append(segment(sig, fit, select, none(sig), [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]))
+        out += [segment(sig, *blocks(sig, block_seconds), none(sig),
+                        [blocks(sig, block_seconds, phase)[1] for phase in range(FOLDS)]) for sig in fit_signals]
         split = f"selection on blocks of {block_seconds:g} s of the fit data (each third of them in turn)"
     out += [segment(sig, none(sig), none(sig), sig.inner()) for sig in test_signals or []]
     return out, split
