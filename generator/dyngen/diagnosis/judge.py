@@ -45,8 +45,7 @@ def judge(design, segments, chosen, final, simple) -> Judged:
     held_before = np.vstack([seg.residual[mask(seg)] for seg in used])
     held_after = np.vstack([(seg.residual - seg.correction)[mask(seg)] for seg in used])
     after = np.mean(held_after ** 2, axis=0)
-    masks = [phases.labels(seg.signals.t[mask(seg)], seg.signals.q[mask(seg)], seg.signals.qd[mask(seg)],
-                           seg.signals.qdd[mask(seg)]) for seg in used]
+    masks = [phases.labels(*(getattr(seg.signals, k)[mask(seg)] for k in ("t", "q", "qd", "qdd"))) for seg in used]
     masks = {name: np.vstack([m[name] for m in masks]) for name in phases.PHASES}
     where = phases.by_phase(held_before, masks)
     for w, a in zip(where, phases.by_phase(held_after, masks)):

@@ -89,9 +89,8 @@ def _row(label, values) -> str:
 
 
 def markdown(d, sources: dict) -> str:
-    n = d.joints
-    head = " | ".join(f"J{j + 1}" for j in range(n))
-    rule = "|---|" + "---:|" * n
+    head = " | ".join(f"J{j + 1}" for j in range(d.joints))
+    rule = "|---|" + "---:|" * d.joints
     test = d.judged_on == "test"
     lines = [f"# Diagnosis of {d.robot}", "",
              f"Model parameters: {sources.get('params')}. Fit on: {', '.join(sources.get('fit', []))}. "
@@ -103,7 +102,6 @@ def markdown(d, sources: dict) -> str:
         lines += [f"Control run: {d.control}.", ""]
     if d.warnings:
         lines += ["## Warnings", ""] + [f"- {w}" for w in d.warnings] + [""]
-    simple = "simple model b + Fc tanh(qd/0.02) + Fv qd (fit data)"
     lines += [f"## {'Test' if test else 'Selection'} residual (measured - model) per joint [Nm or N]", "",
               ("On the test recordings, which played no part in fitting or choosing the effects." if test else
                "**No test data**: these are the selection data, which chose the effects. Not a held-out figure."),
@@ -111,7 +109,7 @@ def markdown(d, sources: dict) -> str:
               _row("RMS, nominal model", d.rms_before),
               _row("RMS, final model (effects; simple model where it won or tied)", d.rms_after),
               _row("RMS, selected effects alone", d.rms_effects),
-              _row(f"RMS, {simple}", d.rms_simple),
+              _row("RMS, simple model b + Fc tanh(qd/0.02) + Fv qd (fit data)", d.rms_simple),
               _row("peak, nominal model", d.peak_before),
               _row("white-noise estimate", d.noise_rms), ""]
     worse = worse_than_simple(d)
