@@ -18,8 +18,8 @@ def notes(d, model, s, fit_signals, select_signals, test_signals, used) -> list[
                    "the effects; it is not a held-out figure")
     # Laws fitted on one range of motion and judged beyond it (friction at higher speeds).
     if test_signals:
-        fast_fit = np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in fit_signals]), axis=0)
-        fast_test = np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in test_signals]), axis=0)
+        fast_fit, fast_test = (np.max(np.vstack([np.abs(sig.qd[sig.inner()]) for sig in group]), axis=0)
+                               for group in (fit_signals, test_signals))
         beyond = [j for j in range(d.joints) if fast_test[j] > EXTRAPOLATION * fast_fit[j]]
         if beyond:
             out.append("the test data move joint(s) " + ", ".join(

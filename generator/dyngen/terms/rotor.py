@@ -23,8 +23,7 @@ class Ripple(Term):
 
     @staticmethod
     def harmonic(q, k: int, kind: str):
-        x = q if k == 1 else k * q
-        return np.cos(x) if kind == "cos" else np.sin(x)
+        return (np.cos if kind == "cos" else np.sin)(k * q)  # 1 * q is q, bit for bit
 
     @classmethod
     def regressor(cls, q, revolute, q_range=None, harmonics=HARMONICS):
