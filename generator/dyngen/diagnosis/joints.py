@@ -66,8 +66,7 @@ def _completed_fit(context, chosen, x, segments, j):
         effects = np.column_stack(columns) @ own if columns else 0.0
         rows.append(baseline.columns(seg.signals)[seg.fit, j, :])
         targets.append((seg.residual[:, j] - arm - effects)[seg.fit])
-    simple = np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]
-    return np.concatenate([own, simple])
+    return np.concatenate([own, np.linalg.lstsq(np.vstack(rows), np.concatenate(targets), rcond=1e-10)[0]])
 
 
 def _completed_predict(context, chosen, x, values, seg, j):

@@ -42,9 +42,8 @@ def fit(segments) -> Simple:
     for seg in segments:
         if seg.fit.any():
             A = columns(seg.signals)[seg.fit]
-            r = seg.residual[seg.fit]
             G += np.einsum("tjk,tjl->jkl", A, A)
-            b += np.einsum("tjk,tj->jk", A, r)
+            b += np.einsum("tjk,tj->jk", A, seg.residual[seg.fit])
     return Simple(np.array([np.linalg.lstsq(G[j], b[j], rcond=1e-12)[0] for j in range(n)]))
 
 
