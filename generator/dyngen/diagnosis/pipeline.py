@@ -211,15 +211,14 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     selection_rms = {key: np.sqrt(x).tolist() for key, x in choice.selection_mse.items()}
     selected, apart = findings_check.check(selected, selection_rms["before"], model, s, roles_of[0][1])
     for which, so in ((explained, "so not claimed"), (marked, "flagged (those links won no joint)")):
-        if which:
+        told = [final.chosen[i] for i in which]
+        if told:
             apart.append("not told apart from the link parameters being off (the re-identified links' rigid body "
                          f"explains them: beside it each gains less than {min_gain:g} of the selection data's mean "
                          f"square), {so}: "
-                         + "; ".join(final.chosen[i].effect.name + ("" if final.chosen[i].joint is None else
-                                     f" on joint {final.chosen[i].joint + 1}") for i in which)
+                         + "; ".join(c.effect.name + ("" if c.joint is None else f" on joint {c.joint + 1}") for c in told)
                          + ("; a payload is a change of the last link's parameters: a control run without it "
-                            "(--control) tells them apart" if any(final.chosen[i].effect.name == "payload"
-                                                                  for i in which) else ""))
+                            "(--control) tells them apart" if any(c.effect.name == "payload" for c in told) else ""))
     if faint:
         apart.append(f"below the significance floor, not findings (kept in the model): {'; '.join(faint)}; the floor is "
                      f"{findings_check.FLOOR:g} of the torque sensor's noise sigma per joint, from the raw torques: "

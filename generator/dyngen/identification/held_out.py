@@ -77,10 +77,8 @@ def _se(x: np.ndarray) -> float:
 
 def gains(with_group: Scores, without: Scores, joint: int | None = None) -> tuple[float, float, float]:
     """(mean gain, its standard error, the mean score without the group) over the folds (joint's score)."""
-    if joint is None:
-        a, b = without.weighted, with_group.weighted
-    else:
-        a, b = without.joints[:, joint], with_group.joints[:, joint]
+    a, b = (without.weighted, with_group.weighted) if joint is None else (without.joints[:, joint],
+                                                                          with_group.joints[:, joint])
     d = a - b
     return float(d.mean()), _se(d), float(a.mean())
 

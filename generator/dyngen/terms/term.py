@@ -76,8 +76,7 @@ class Term:
     @classmethod
     def inside(cls, values, scales: dict | None = None) -> bool:
         """Whether fitted values are physical: each inside its range."""
-        values = np.atleast_1d(values)
-        return all(v.inside(x, scales) for v, x in zip(cls.values, values))
+        return all(v.inside(x, scales) for v, x in zip(cls.values, np.atleast_1d(values)))
 
     @classmethod
     def c(cls, v: str, f, c) -> str:

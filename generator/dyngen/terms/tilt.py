@@ -163,10 +163,9 @@ class Tilt(_Gravity):
         if None in values.values():
             return {}
         a = [values["dg1"], values["dg2"]]
-        a1, a2 = angles_deg(self.g, a)
         # a std's angle: that of a tilt of one std along each direction alone
         s1, s2 = angle_deg(self.g, [std["dg1"], 0.0]), angle_deg(self.g, [0.0, std["dg2"]])
-        return {"tilt_deg": [a1, a2], "tilt_std_deg": [s1, s2], "tilt_towards": list(tilt_axes(robot)),
+        return {"tilt_deg": list(angles_deg(self.g, a)), "tilt_std_deg": [s1, s2], "tilt_towards": list(tilt_axes(robot)),
                 "tilt_total_deg": angle_deg(self.g, a)}
 
 
