@@ -109,11 +109,10 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
 
 def world(context, chosen) -> dict:
     """The Context fields the chosen set: a time shift's delay, 1 + each sensor gain (scale), a payload (load)."""
-    delay = next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0)
     gains = {c.joint: float(c.effect.setting) for c in chosen if c.effect.scales and c.effect.setting}
     scale = tuple(1.0 + gains.get(j, 0.0) for j in range(len(context.robot.joints))) if gains else None
-    load = next((c.effect.load for c in chosen if c.effect.load is not None), None)
-    return {"delay": delay, "scale": scale, "load": load}
+    return {"delay": next((float(c.effect.setting) for c in chosen if c.effect.delays), 0.0), "scale": scale,
+            "load": next((c.effect.load for c in chosen if c.effect.load is not None), None)}
 
 
 def as_chosen(context, chosen):

@@ -39,8 +39,7 @@ class _State:
 
     def __init__(self, context, segments, design, chosen):
         self.context, self.segments, self.weights = dz.as_chosen(context, chosen), segments, design.weights
-        self.template = design
-        self.chosen = chosen
+        self.template, self.chosen = design, chosen
         self.columns = self.all_columns(chosen, self.context)
         self.design = self.restricted(chosen, self.columns)
 
