@@ -36,11 +36,8 @@ def by_phase(residual: np.ndarray, masks: dict) -> list[dict]:
     out = []
     for j in range(residual.shape[1]):
         total = float(np.sqrt(np.mean(residual[:, j] ** 2)))
-        phases = {}
-        for name, mask in masks.items():
-            m = mask[:, j]
-            if m.any():
-                phases[name] = {"rms": float(np.sqrt(np.mean(residual[m, j] ** 2))), "share": float(m.mean())}
+        phases = {name: {"rms": float(np.sqrt(np.mean(residual[mask[:, j], j] ** 2))), "share": float(mask[:, j].mean())}
+                  for name, mask in masks.items() if mask[:, j].any()}
         # The phase with the largest RMS among those with a fair share of samples (>= 5 %).
         fair = {k: v for k, v in phases.items() if v["share"] >= 0.05}
         worst = max(fair, key=lambda k: fair[k]["rms"]) if fair else None

@@ -45,8 +45,7 @@ def figures(d, out_dir, robot_name: str) -> dict:
     m = m[::max(1, m.size // MAX_POINTS)]
     t = seg.signals.t[m]
     measured, model = seg.signals.tau[m], seg.tau_model[m]
-    before = seg.residual[m]
-    after = before - seg.correction[m]
+    before, after = seg.residual[m], seg.residual[m] - seg.correction[m]
     labels = phases.labels(t, seg.signals.q[m], seg.signals.qd[m], seg.signals.qdd[m])
     n = measured.shape[1]
     out = Path(out_dir)
