@@ -51,10 +51,9 @@ def _plausible(design, chosen):
                 why = c.effect.refusal_beside(values[id(c)], values[id(base)])
                 if why:
                     reasons[id(c)] = f"beside {base.key} at {', '.join(f'{v:.3g}' for v in values[id(base)])}: {why}"
-        bad = [c for c in chosen if id(c) in reasons]
-        if not bad:
+        worst = next((c for c in chosen if id(c) in reasons), None)
+        if worst is None:
             return chosen, final, refused
-        worst = bad[0]
         refused.append(Refusal(worst.key, values[id(worst)].tolist(), reasons[id(worst)]))
         chosen, gone = without(chosen, worst)  # a Stribeck term whose Coulomb was refused goes with it
         refused += [Refusal(c.key, [], f"{worst.key} refused") for c in gone[1:]]
@@ -68,12 +67,11 @@ def _consistent_payload(context, segments, design, chosen, final, refused):
         if simpler is None:
             continue
         refusal, forms = simpler
-        options = []
-        for effect in forms:
-            replaced = chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:]
-            form_design, form_chosen = restricted(context, segments, design, replaced)
-            options.append((float(design.weights ** 2 @ selection_mse(form_design, form_chosen)), form_design, form_chosen))
-        _, design, chosen = min(options, key=lambda o: o[0])
+        tried = [restricted(context, segments, design,
+                            chosen[:i] + [dz.Candidate(effect, c.joint, 0, len(effect.parameters))] + chosen[i + 1:])
+                 for effect in forms]  # (design, chosen) per simpler form
+        w2 = design.weights ** 2
+        design, chosen = min(tried, key=lambda form: float(w2 @ selection_mse(*form)))
         refused.append(Refusal(*refusal))  # what of the term is refused, its values
         return design, chosen, solve(design, chosen)
     return design, chosen, final
