@@ -24,9 +24,7 @@ BOUNDED = tuple(k for k in PER_JOINT if TERM_OF[k].values[0].low == 0.0)
 def kinds_of(names) -> tuple:
     """Column kinds of user names: "ripple" stands for cos q_j and sin q_j."""
     wanted = set(names)
-    for group, kinds in GROUPS.items():
-        if group in wanted:
-            wanted |= set(kinds)
+    wanted |= {k for group, kinds in GROUPS.items() if group in wanted for k in kinds}
     return tuple(k for k in PER_JOINT if k in wanted)
 
 
