@@ -122,10 +122,7 @@ class _Shape:
         lo, hi = 0.0, 1.0
         for _ in range(12):  # bisection on a common shrink factor of the motion about q0
             mid = 0.5 * (lo + hi)
-            if _inside(self.flange(_shrunk(traj, q0, mid)(grid)[0]), box).all():
-                lo = mid
-            else:
-                hi = mid
+            lo, hi = (mid, hi) if _inside(self.flange(_shrunk(traj, q0, mid)(grid)[0]), box).all() else (lo, mid)
         return _shrunk(traj, q0, lo)
 
 
