@@ -167,7 +167,7 @@ class Source:
             if key not in self._coulomb:
                 self._coulomb[key] = coulomb_matrix(self.signals, smoothing, lags)[_kept(self.signals)]
             return self._coulomb[key][start:start + block.t.size]
-        if before is None:
+        if before is None or not np.any(lags):  # no lag: the block's own rows (tanh row by row: the same numbers)
             return coulomb_matrix(block, smoothing, lags)
         joined = SimpleNamespace(t=np.r_[before.t, block.t], qd=np.vstack([before.qd, block.qd]))
         return coulomb_matrix(joined, smoothing, lags)[before.t.size:]
