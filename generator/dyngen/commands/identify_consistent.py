@@ -75,6 +75,7 @@ def _sampled(sources, robot, args):
         if s.signals is not None:
             out.append(s.signals)
             continue
-        out += [condition(w, conditioning_of(args)) 
-                for w in long_enough(windows(s.path, robot.dof, s.effort_topic))]
+        # the windows kept from the parse (recordings.read_sources), else read again
+        got = s.sample.windows() if s.sample is not None else windows(s.path, robot.dof, s.effort_topic)
+        out += [condition(w, conditioning_of(args)) for w in long_enough(got)]
     return out

@@ -61,6 +61,23 @@ def check_enough(recordings) -> None:
                              "(seconds of motion at the recording's rate)")
 
 
+class _Sample:
+    """streaming.sample.windows(path) of a recording (its defaults: 8192-row blocks, no conditioning),
+    made from the blocks of its parse (blocks.Source.of_file, the same blocks): the same windows."""
+
+    def __init__(self):
+        from ..streaming.sample import Spread
+
+        self.spread, self.name = Spread(), None
+
+    def add(self, block) -> None:
+        self.spread.add(block)
+        self.name = block.name
+
+    def windows(self) -> list:
+        return self.spread.windows(self.name)
+
+
 def long_enough(windows) -> list:
     """The windows of a recording read in blocks that can be diagnosed (a last short one is left out)."""
     return [w for w in windows if w.t.size >= MIN_DIAGNOSIS_SAMPLES]
@@ -140,9 +157,12 @@ def read_sources(paths, robot, args) -> list:
     read = []  # a Source read in blocks, or the Recording read whole
     for path in paths:
         first = next(chunks(path, robot.dof, True, (), 64, topic))
-        source = Source.of_file(path, robot.dof, topic) if _local(first, conditioning) and \
+        sample = _Sample()  # the sanity check's windows, from the parse's blocks (no second read)
+        source = Source.of_file(path, robot.dof, topic, tap=sample.add) if _local(first, conditioning) and \
             columnar.format_of(path) != "rosbag" else None
         streamed = source is not None and source.rows > getattr(args, "max_rows", HELD_ROWS)
+        if streamed:
+            source.sample = sample
         read.append(source if streamed else read_recording(path, robot.dof, True, (), topic))
     # what check_informative reads of a Source: a two-sample stand-in that moves and has torques as the file does
     check_informative([r if isinstance(r, Recording) else Recording(

@@ -52,6 +52,7 @@ class Source:
     dof: int = 0
     effort_topic: str | None = None
     block_rows: int = ROWS
+    sample: object = None  # the sanity check's windows, made from the parse's blocks (commands/recordings.py)
     _coulomb: dict = field(default_factory=dict)  # (smoothing, lags) -> whole column, this pass (held)
     _gravity: dict = field(default_factory=dict)  # the tilt's G(q) per block (held)
     _parsed: bool = False  # the file's blocks are in the temporary folder
@@ -69,16 +70,17 @@ class Source:
                    block_rows=block_rows)
 
     @classmethod
-    def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS) -> "Source":
+    def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS, tap=None) -> "Source":
         """The file parsed once, its blocks kept for every pass: its length, time span and
-        velocities, and whether it moves and has torques (data.recording.check_informative)."""
+        velocities, and whether it moves and has torques (data.recording.check_informative).
+        tap(block): each block as read, before the repeated rows are left out (the sanity check's sample)."""
         from ..forked import roomy_heap
 
         roomy_heap()  # the passes' block-sized arrays reused, not mapped afresh
         source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
                      dof=dof, effort_topic=effort_topic, block_rows=block_rows)
         first, source.moved, source.torque = None, False, False
-        for block in source._file_blocks():
+        for block in source._file_blocks(tap):
             first = first or block
             source.rows += block.t.size
             source.qd_max = np.maximum(source.qd_max, np.abs(block.qd).max(axis=0))
@@ -106,7 +108,7 @@ class Source:
             yield block, before, number, start
             before, start = block, start + block.t.size
 
-    def _file_blocks(self):
+    def _file_blocks(self, tap=None):
         from ..data.chunks import chunks
         from ..data.log_quality import Streamed
 
@@ -119,8 +121,8 @@ class Source:
         # kernel, without the GIL: the parse is one process, the other core free); one write at a time
         with ThreadPoolExecutor(1) as writer:
             written = None
-            for number, block in enumerate(self._log.blocks(chunks(self.path, self.dof, True, (), self.block_rows,
-                                                                   self.effort_topic))):
+            read = chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic)
+            for number, block in enumerate(self._log.blocks(read if tap is None else _tapped(read, tap))):
                 data = np.column_stack([block.t, block.q, block.qd, block.qdd, block.tau])
                 if written is not None:
                     written.result()
@@ -165,10 +167,16 @@ class Source:
             if key not in self._coulomb:
                 self._coulomb[key] = coulomb_matrix(self.signals, smoothing, lags)[_kept(self.signals)]
             return self._coulomb[key][start:start + block.t.size]
-        if before is None:
+        if before is None or not np.any(lags):  # no lag: the block's own rows (tanh row by row: the same numbers)
             return coulomb_matrix(block, smoothing, lags)
         joined = SimpleNamespace(t=np.r_[before.t, block.t], qd=np.vstack([before.qd, block.qd]))
         return coulomb_matrix(joined, smoothing, lags)[before.t.size:]
+
+
+def _tapped(blocks, tap):
+    for block in blocks:
+        tap(block)
+        yield block
 
 
 def _kept(signals) -> slice:
@@ -187,6 +195,7 @@ class Blocks:
         self.smoothing, self.lags, self.gravity, self.tilt = smoothing, lags, gravity, tilt_columns(g_vec)
         self.along = None if g_vec is None else tilt_along(g_vec)
         self.token = next(_IDENTIFICATIONS)  # the sources' kept G(q) are this identification's (its prior's)
+        self.rigid = None  # base coefficients: the pieces carry Y rigid (statistics.estimate), not Y
 
     def __iter__(self):
         for source, part in zip(self.sources, self.parts):
@@ -208,15 +217,19 @@ class Blocks:
         yield from in_order(lambda task: work(_piece_of(self, task)), tasks, workers)
 
     def piece(self, source, part, block, before, number, start) -> Piece:
-        Y = self.model.batch("regressor", block.q, block.qd, block.qdd)
+        if self.rigid is not None:  # a pass that needs Y rigid only: the inverse dynamics, no regressor
+            Y, rigid = None, self.model.batch("inverse_dynamics", block.q, block.qd, block.qdd, self.rigid)
+        else:
+            Y, rigid = self.model.batch("regressor", block.q, block.qd, block.qdd), None
         if isinstance(part, int):
             at = np.full(block.t.size, part, dtype=int)
         else:  # contiguous stretches of equal duration: parts[0] of them
             u = (block.t - source.t0) / max(source.t1 - source.t0, 1e-300)
             at = np.minimum((u * part[0]).astype(int), part[0] - 1)
         # Yj joint by joint as a view, not a copy: BLAS takes the rows of one joint at their stride
-        p = Piece(block, slice(None), Y.transpose(1, 0, 2), np.asarray(block.tau, dtype=float), at, {})
-        p.source, p.start = source, start
+        p = Piece(block, slice(None), None if Y is None else Y.transpose(1, 0, 2), np.asarray(block.tau, dtype=float),
+                  at, {})
+        p.source, p.start, p.rigid = source, start, rigid
         p.coulomb = lambda smoothing, lags: source.coulomb(block, before, start, smoothing, lags)
         coulomb = p.coulomb(self.smoothing, self.lags) if any(k == "coulomb" for k, _ in self.labels) else None
         tilted = None

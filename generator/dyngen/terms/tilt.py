@@ -82,13 +82,23 @@ def gravity_matrix(robot, p, q, poses=None) -> np.ndarray:
     links = np.asarray(p, dtype=float).reshape(-1, 10)
     poses = poses or forward_kinematics(robot.joint_models, q)
     n = len(poses)
-    G = np.zeros((q.shape[0], n, 3))
-    centres = [pose.origin + np.einsum("tij,j->ti", pose.R, links[k, 1:4]) for k, pose in enumerate(poses)]
+    # component-major (3, N, T), each component a contiguous row: the cross products written out as
+    # np.cross computes them (a1 b2 - a2 b1, ...), the same operations in the same order, so G is
+    # bitwise the same, in 2/5 of the time (np.cross on (T, 3) arrays: strided and a dozen calls)
+    G = np.zeros((3, n, q.shape[0]))
+    centres = [(pose.origin + np.einsum("tij,j->ti", pose.R, links[k, 1:4])).T.copy() for k, pose in enumerate(poses)]
     for i, model in enumerate(robot.joint_models):
-        z, o = poses[i].axis, poses[i].point
+        z, o = poses[i].axis.T.copy(), poses[i].point.T.copy()
         for k in range(i, n):
-            G[:, i, :] -= links[k, 0] * (np.cross(z, centres[k] - o) if model.revolute else z)
-    return G
+            m = links[k, 0]
+            if not model.revolute:
+                G[:, i] -= m * z
+                continue
+            d = centres[k] - o
+            G[0, i] -= m * (z[1] * d[2] - z[2] * d[1])
+            G[1, i] -= m * (z[2] * d[0] - z[0] * d[2])
+            G[2, i] -= m * (z[0] * d[1] - z[1] * d[0])
+    return np.ascontiguousarray(G.transpose(2, 1, 0))
 
 
 def body_gravity_matrix(robot, poses) -> np.ndarray:
