@@ -28,7 +28,7 @@ from simulation.withheld_cases import CASES, nominal_model, write_cases
 from simulation.withheld_run import run
 
 from dyngen.catalogue import RNEA, STANDARD_FROM_DYNAMIC
-from dyngen.data import condition, read_recording
+from dyngen.data import condition, log_quality, read_recording
 from dyngen.data.log_quality import regular_samples
 from dyngen.description import load_robot
 from dyngen.diagnosis import diagnose
@@ -219,18 +219,23 @@ def _fine_positions_and_torque_noise(path, bits=24):
     return logger.unparse(",".join(names[k] for k in keep), out[:, keep]), data[:, 0], data[:, qdd]
 
 
-def test_stamps_whose_error_wanders_smoothly_lower_the_cutoff(arm, exact, tmp_path):
+@pytest.mark.parametrize("way", ["clock", "lowered"])
+def test_stamps_whose_error_wanders_smoothly(arm, exact, tmp_path, monkeypatch, way):
     """Fine positions (24-bit encoder) stamped when they arrive, the latency wandering smoothly
     (0.5 ms RMS at 20 Hz; 5.5 % of the samples written twice): the position noise, measured over
     the upper band, sees almost nothing and allowed 37 Hz, through which the accelerations were
     3-6 rad/s^2 off (the true ones 0.7-1.6 RMS) and joint 1's nominal residual 10.7 Nm against
-    2.7 Nm of torque (main 88a9636). Judged against the simulator's own accelerations through
-    the same filter, and the torques."""
+    2.7 Nm of torque (main 88a9636). Now the rows are put on the clock that has one sample per row
+    (no sample is dropped); where that clock is not found ("lowered": it is switched off here) the
+    cutoff is lowered while its last octave adds acceleration power the motion does not have.
+    Judged against the simulator's own accelerations through the same filter, and the torques."""
     folder, doc = exact
     robot, model = arm
     text, t_true, qdd_true = _fine_positions_and_torque_noise(folder / doc["cases"][0]["fit"])
     path = tmp_path / "wandering.csv"
     path.write_text(logger.wandering(text, seed=1))
+    if way == "lowered":
+        monkeypatch.setattr(log_quality, "_counted", lambda t, q: (t, None), raising=False)
     sig = condition(read_recording(path, robot.dof))
     keep = sig.inner()
     truth = sig.filtered(np.column_stack([np.interp(sig.t, t_true, x) for x in qdd_true.T]))[keep]
@@ -240,7 +245,10 @@ def test_stamps_whose_error_wanders_smoothly_lower_the_cutoff(arm, exact, tmp_pa
     before = np.sqrt(np.mean((sig.tau[keep] - model.batch(RNEA.name, sig.q[keep], sig.qd[keep], sig.qdd[keep], s)) ** 2,
                              axis=0))
     assert log_variants.below_the_torques(before, sig), (before, np.sqrt(np.mean(sig.tau[keep] ** 2, axis=0)))
-    assert sig.cutoff < 15 and any("cutoff lowered" in w for w in sig.warnings), (sig.cutoff, sig.warnings)
+    if way == "clock":
+        assert "one sample per row" in (sig.log.clock or ""), sig.note
+    else:
+        assert sig.cutoff < 15 and any("cutoff lowered" in w for w in sig.warnings), (sig.cutoff, sig.warnings)
 
 
 @pytest.fixture(scope="module")
