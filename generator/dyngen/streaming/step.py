@@ -18,8 +18,6 @@ import functools
 import itertools
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ..identification.samples import regressor_rows
 from ..identification.triangular import Triangular
 
