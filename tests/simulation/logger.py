@@ -13,6 +13,9 @@ as tests/simulation/mujoco_measurements.csv_text writes it):
              and late stamps at once: the franka_ros logs of Gaz et al. 2019 have 5.5 % repeated
              rows and steps of 0.7-8.8 ms at a nominal 1 kHz)
   held       some columns (e.g. the torques) updated only every `every`-th sample (mixed rates)
+  wandering  every sample written once (5.5 % twice), stamped when it arrives: its latency wanders
+             smoothly (a queue filling and draining, a driver's receive-time clock), so the stamps'
+             error lives at tens of Hz and the positions over the row index stay smooth
 
 The sample values are never altered, only repeated, left out or stamped elsewhere: what a
 diagnosis can do with such a log is what it could do with the clean one, or it must say why not.
@@ -99,3 +102,29 @@ def held(text: str, prefix: str, every: int) -> str:
     source = (np.arange(data.shape[0]) // every) * every
     data[:, columns] = data[source][:, columns]
     return unparse(header, data)
+
+
+def wandering(text: str, seed: int, rms: float = 0.5e-3, hz: float = 20.0, base: float = 0.5e-3,
+              share: float = 0.055) -> str:
+    """Each sample stamped at its time + a latency of `base` plus a smooth random wander (white noise
+    through a 2nd-order low-pass at `hz`, scaled to `rms` s, the latency kept above 0.05 ms); with
+    probability `share` a sample is written again, stamped between it and the next."""
+    from scipy import signal
+
+    header, data = parse(text)
+    t = data[:, 0]
+    rng = np.random.default_rng(seed)
+    lead = 2000
+    wander = signal.sosfilt(signal.butter(2, hz, fs=1.0 / float(np.median(np.diff(t))), output="sos"),
+                            rng.standard_normal(t.size + lead))[lead:]
+    stamp = t + np.maximum(base + rms * wander / wander.std(), 0.05e-3)
+    twice = rng.random(t.size) < share
+    twice[-1] = False
+    source = np.repeat(np.arange(t.size), 1 + twice)
+    again = np.r_[False, source[1:] == source[:-1]]
+    rows = data[source].copy()
+    rows[:, 0] = stamp[source]
+    k = source[again]
+    rows[again, 0] = stamp[k] + rng.uniform(0.2, 0.8, k.size) * (stamp[k + 1] - stamp[k])
+    rows[:, 0] = np.maximum.accumulate(rows[:, 0] + 1e-9 * np.arange(rows.shape[0]))
+    return unparse(header, rows)

@@ -209,12 +209,27 @@ def regular_clock(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]
     period = float(np.median((t[half:2 * half] - t[:half]) / (k[half:2 * half] - k[:half])))
     clock = float(np.median(t - k * period)) + k * period
     off = np.abs(t - clock)
-    if off.max() > JITTER_SHARE * period or off.max() <= 1e-6 * period:
+    if off.max() > JITTER_SHARE * period:
+        return _counted(t, q)
+    if off.max() <= 1e-6 * period:
         return t, None
     if _roughness(clock, q) >= ROUGHER * _roughness(t, q):
         return t, None
     return clock, (f"time stamps jitter by up to {1e3 * off.max():.2g} ms around a regular {1e3 * period:.4g} ms "
                    "clock; the positions are smooth over the clock, not over the stamps: the clock is used")
+
+
+def _counted(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """Every row one tick of a regular clock, as a logger that drops no sample but stamps each on
+    arrival writes them (its latency wandering by more than JITTER_SHARE of a step): used when the
+    positions' jerk over it carries less than ROUGHER of its energy over the stamps (a dropped
+    sample, a gap or a stall makes it rough)."""
+    count = t[0] + (t[-1] - t[0]) * np.arange(t.size) / (t.size - 1)
+    if _roughness(count, q) >= ROUGHER * _roughness(t, q):
+        return t, None
+    return count, (f"time stamps wander by up to {1e3 * float(np.max(np.abs(t - count))):.2g} ms off a regular "
+                   f"{1e3 * float(count[1] - count[0]):.4g} ms clock that has one sample per row; the positions are "
+                   "smooth over that clock, not over the stamps: the clock is used")
 
 
 def _roughness(t: np.ndarray, q: np.ndarray) -> float:
