@@ -15,7 +15,6 @@ HEAVY_TAILS = 1.5  # the spectrum's noise is used when it exceeds the robust est
 NO_FILTER_NOISE = 1e-12  # rad: positions this clean are differentiated without a filter
 BAND_FROM = 0.25  # of the sampling rate: the band whose median power is the spectral noise floor (up to 0.5)
 MEDIAN_OF_CHI2_2 = np.log(2.0)  # median / mean of a periodogram bin (chi-square, 2 degrees of freedom)
-OCTAVE_SHARE = 0.05  # of the acceleration power: more from the octave below the cutoff is no motion's (lowered)
 
 
 @dataclass(frozen=True)
@@ -24,7 +23,6 @@ class Decision:
     q_noise: np.ndarray  # per joint position noise sigma [rad]
     qdd_noise: np.ndarray  # per joint predicted acceleration noise after the filter [rad/s^2]
     band: float  # Hz: 99 % of the motion's velocity power lies below
-    lowered: tuple | None = None  # (the cutoff the noise allowed, its octave's share of the acceleration power)
 
 
 def position_noise(q: np.ndarray) -> np.ndarray:
@@ -94,22 +92,4 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
         if abs(new - before) <= 0.01 * before:
             break
     qd = derivatives(lowpass_of(cutoff)(q))[0]
-    band = motion_band(qd, rate)
-    lowered, share = None, octave_share(derivatives, lowpass_of, q, cutoff, rate)
-    while share > OCTAVE_SHARE and cutoff / 2 >= max(MIN_CUTOFF, 2 * band):
-        lowered = lowered or (cutoff, share)
-        cutoff /= 2
-        share = octave_share(derivatives, lowpass_of, q, cutoff, rate)
-    return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate, order), band, lowered)
-
-
-def octave_share(derivatives, lowpass_of, q: np.ndarray, cutoff: float, rate: float) -> float:
-    """Share of the acceleration power (all joints, the filters' start-up left out) that the octave below
-    the cutoff adds: noise the position noise foretells is a small part of it, the motion (a band well
-    below) hardly any; stamps off the samples' own times by a smooth error (a logger's wandering
-    latency) add power there that the upper band, where the position noise is measured, does not show."""
-    edge = int(np.ceil(2 * rate / cutoff))
-    if q.shape[0] <= 4 * edge:
-        return 0.0
-    full, half = (derivatives(lowpass_of(fc)(q))[1][edge:-edge] for fc in (cutoff, cutoff / 2))
-    return float(np.sum((full - half) ** 2) / max(float(np.sum(full ** 2)), 1e-300))
+    return Decision(cutoff, sigma, acceleration_noise(sigma, cutoff, rate, order), motion_band(qd, rate))

@@ -130,8 +130,6 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     out.log, out.source, out.options = log, recording, options
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
-        if decision.lowered:
-            out.warnings.append(f"{r.name}: {_lowered(decision, cutoff)}")
         if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
             out.warnings.append(f"{r.name}: {'position' if differentiate else 'velocity'} noise ({_sigma(decision.q_noise)})"
                                 f" allows a cutoff of only {cutoff:.3g} Hz, below twice the motion's band "
@@ -140,13 +138,6 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
         out.q_noise = sigma = automatic.position_noise(r.q)
         out.qdd_noise = automatic.acceleration_noise(sigma, cutoff, rate) if cutoff else sigma * np.sqrt(6.0) * rate ** 2
     return out
-
-
-def _lowered(decision, cutoff) -> str:
-    allowed, share = decision.lowered
-    return (f"the accelerations through the {allowed:.3g} Hz cutoff the position noise allows take {100 * share:.2g} % "
-            f"of their power from its last octave, far above the motion's band ({decision.band:.3g} Hz): errors the "
-            f"position noise does not show (stamps off the samples' own times); cutoff lowered to {cutoff:.3g} Hz")
 
 
 def _sigma(x) -> str:
@@ -163,8 +154,6 @@ def _note(differentiate, cutoff, options, decision, no_qdd) -> str:
         noise = f"position noise {_sigma(decision.q_noise)}" if differentiate else \
             f"velocity noise {_sigma(decision.q_noise)}/s"
         text += f" (chosen from the data: {noise}, motion band {decision.band:.3g} Hz)"
-        if decision.lowered:
-            text += f"; {_lowered(decision, cutoff)}"
     return text
 
 
