@@ -29,6 +29,7 @@ from simulation.withheld_run import run
 
 from dyngen.catalogue import RNEA, STANDARD_FROM_DYNAMIC
 from dyngen.data import condition, log_quality, read_recording
+from dyngen.data.chunks import chunks
 from dyngen.data.log_quality import regular_samples
 from dyngen.description import load_robot
 from dyngen.diagnosis import diagnose, trust
@@ -95,6 +96,28 @@ def test_repeats_and_held_columns_are_found_exactly(khz, tmp_path):
     # (both keep the 0.05 Nm noise of the samples they leave out: 0.067 against 0.100 Nm)
     steps = read_recording(path, 7).tau
     assert np.sqrt(np.mean((held.tau - clean.tau) ** 2)) < 0.8 * np.sqrt(np.mean((steps - clean.tau) ** 2))
+
+
+def test_rows_copied_with_their_stamp_are_left_out(khz, tmp_path):
+    """A logger or an export that writes a message twice, stamp included: the rows were refused
+    ("time does not increase", c684f9a); now they are left out at reading, whole or in blocks (a
+    copy at a block's edge too), and counted with the repeated rows."""
+    folder, _ = khz
+    clean = read_recording(folder / "coulomb.fit.csv", 7)
+    header, data = logger.parse((folder / "coulomb.fit.csv").read_text())
+    twice = np.random.default_rng(5).random(data.shape[0]) < 0.05
+    twice[[0, 99, 100]] = True  # the first row; a copy crossing the blocks of 100 rows read below
+    path = tmp_path / "copied.csv"
+    path.write_text(logger.unparse(header, data[np.repeat(np.arange(data.shape[0]), 1 + twice)]))
+    whole = read_recording(path, 7)
+    assert whole.copies == twice.sum() and np.array_equal(whole.t, clean.t) and np.array_equal(whole.tau, clean.tau)
+    fixed, report = regular_samples(whole)
+    assert report.repeated == twice.sum() and any("repeated rows" in n for n in report.notes)
+    streamed = log_quality.Streamed()
+    blocks = list(streamed.blocks(chunks(path, 7, rows=100)))
+    assert np.array_equal(np.concatenate([b.t for b in blocks]), clean.t)
+    assert np.array_equal(np.concatenate([b.q for b in blocks]), clean.q)
+    assert streamed.report.repeated == twice.sum()
 
 
 def test_rest_in_a_noise_free_log_is_not_a_repeat(tmp_path):

@@ -12,6 +12,7 @@ files. CSV (plain or .gz) and Parquet are read in blocks; a ROS 2 bag is read wh
 
 from __future__ import annotations
 
+import dataclasses
 import gzip
 import io
 import warnings
@@ -25,7 +26,8 @@ from ..errors import InputError
 from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
-from .recording import _check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line
+from .recording import (_check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line,
+                        without_copies)
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -45,13 +47,16 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
     last, total = None, 0
     for start, data, where in blocks:
         _check_values(name, header, data, lambda row: where(start + row))
+        data, copies, kept = without_copies(data, last)
+        if not data.shape[0]:
+            continue
         t = data[:, columns["t"]]
-        joined = t if last is None else np.r_[last, t]
+        joined = t if last is None else np.r_[last[columns["t"]], t]
         if joined.size >= 2:
-            _check_time(name, joined, lambda row: where(start + row - (last is not None)))
-        last = t[-1]
+            _check_time(name, joined, lambda row: where(start + int(kept[row - (last is not None)])))
+        last = data[-1]
         total += t.size
-        yield as_recording(name, columns, data, dof)
+        yield dataclasses.replace(as_recording(name, columns, data, dof), copies=copies)
     if total < 2:
         _check_time(name, np.zeros(total), csv_line)  # the whole-file reader's message
 

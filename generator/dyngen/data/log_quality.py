@@ -24,7 +24,7 @@ ROUGHER = 0.5  # the clock is used when the positions' jerk energy over it is be
 
 @dataclass
 class LogReport:
-    repeated: int = 0  # rows left out as repeats of the row before
+    repeated: int = 0  # rows left out as repeats of the row before (with their stamp or another)
     held: dict = field(default_factory=dict)  # block -> median rows between its updates
     filled: int = 0  # samples interpolated onto the grid where the log had none
     longest_gap: float = 0.0  # s
@@ -87,6 +87,7 @@ class Streamed:
     def blocks(self, blocks):
         before, pending, name = None, None, ""
         for block in blocks:
+            self.report.repeated += block.copies  # left out at reading (data/recording.without_copies)
             name, r = block.name, (block if pending is None else _joined(pending, block))
             data = _all_columns(r)
             repeats, end = _repeats(data, r.q, before)
@@ -150,14 +151,14 @@ def _unheld(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogReport]:
     """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are exact)."""
-    report = LogReport()
+    report = LogReport(repeated=r.copies)  # rows that copied the row before, stamp included, left out at reading
     if r.t.size < 16:
         return r, report
     repeats = repeated_rows(r)
     if repeats.any():
-        report.repeated = int(repeats.sum())
+        report.repeated += int(repeats.sum())
         r = _mapped(r, r.t[~repeats], lambda x: x[~repeats])
-        _say_repeats(report, r.name, r.t.size)
+    _say_repeats(report, r.name, r.t.size)
     held = held_blocks(r)
     for name, every in held.items():
         setattr(r, name, _unheld(r.t, getattr(r, name)))

@@ -4,6 +4,7 @@ other columns (e.g. `M11, M12, ...`); every problem is an InputError naming file
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import re
 import warnings
@@ -39,6 +40,7 @@ class Recording:
     qd: np.ndarray | None = None
     qdd: np.ndarray | None = None
     extra: dict = field(default_factory=dict)  # other columns by name, (T,)
+    copies: int = 0  # rows left out at reading: exact copies of the row before, stamp included
 
 
 def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
@@ -62,8 +64,21 @@ def csv_line(row: int) -> str:
 def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
     """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a row."""
     _check_values(name, header, data, where)
-    _check_time(name, data[:, columns["t"]], where)
-    return as_recording(name, columns, data, dof)
+    data, copies, kept = without_copies(data)
+    _check_time(name, data[:, columns["t"]], lambda row: where(int(kept[row])))
+    return dataclasses.replace(as_recording(name, columns, data, dof), copies=copies)
+
+
+def without_copies(data: np.ndarray, before=None) -> tuple[np.ndarray, int, np.ndarray]:
+    """(data without the rows that copy the row before in every column, stamp included (a logger or an
+    export writing one message twice: they carry nothing), how many, the kept rows' indices in data).
+    `before`: the row before data's first (reading in blocks)."""
+    same = np.zeros(data.shape[0], dtype=bool)
+    same[1:] = np.all(data[1:] == data[:-1], axis=1)
+    if before is not None and data.shape[0]:
+        same[0] = bool(np.all(data[0] == before))
+    kept = np.flatnonzero(~same)
+    return data[kept], int(same.sum()), kept
 
 
 def as_recording(name, columns, data, dof) -> Recording:
