@@ -171,3 +171,32 @@ def test_exact_or_truly_irregular_stamps_are_kept(tmp_path):
         s = condition(read_recording(path, N), Conditioning(cutoff=None, differentiate=True))
         assert np.array_equal(s.t, read_recording(path, N).t), name
         assert not any("jitter" in x for x in s.warnings), name
+
+
+@pytest.mark.parametrize("unit, scale, origin", [("ms", 1e3, 0.0), ("us", 1e6, 0.0), ("ns", 1e9, 0.0),
+                                                 ("s", 1.0, 1.765e9), ("ns", 1e9, 1.765e18)])
+def test_stamps_in_other_units_or_from_an_absolute_clock(tmp_path, unit, scale, origin):
+    """A 1 kHz log stamped in ms, us or ns, or by Unix time (seconds, or nanoseconds as ROS writes
+    them): read as seconds from the first row, whole and in blocks, and said. A log in ms was read
+    as a 1 Hz log and diagnosed without a word; Unix time was refused ("value out of range")."""
+    from dyngen.data.chunks import chunks
+
+    t = 0.001 * np.arange(300) + 0.0001 * np.sin(np.arange(300))  # jittered, as a logger's clock
+    rows = [[float(origin + scale * tk), float(np.sin(tk)), float(np.cos(tk)), 1.0, 2.0] for tk in t]
+    path = tmp_path / "run.csv"
+    path.write_text(",".join(HEADER) + "\n" + "\n".join(",".join(repr(v) for v in row) for row in rows) + "\n")
+    whole = read_recording(path, N)
+    blocks = list(chunks(path, N, rows=64))
+    precision = 3e-7 if origin else 1e-9  # float64 spacing of Unix time: 238 ns in s, 256 ns in ns
+    for got in (whole.t, np.concatenate([b.t for b in blocks])):
+        assert np.max(np.abs(got - (t - t[0] * (origin > 0)))) < precision
+    said = whole.time_note or ""
+    assert (f"t read in {unit}" in said) == (unit != "s") and ("absolute clock" in said) == (origin > 0)
+    assert said.split(": its")[0] == (blocks[0].time_note or "").split(": its")[0]  # the median of one block or all
+    assert "t read in" in (condition(whole).note if unit != "s" else "t read in")
+
+
+def test_a_time_column_beyond_any_clock_is_refused(tmp_path):
+    rows = good_rows()
+    rows[2][0] = 2e19
+    assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 4, column t: 2e+19: value out of range (|x| at most 1e+19)"

@@ -27,7 +27,7 @@ from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
 from .recording import (_check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line,
-                        without_copies)
+                        time_base, without_copies)
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -44,19 +44,25 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
     where_header = "columns" if kind == "parquet" else "line 1 (header)"
     header = next(blocks)
     columns = check_header(name, header, dof, require_torques, required, where_header)
-    last, total = None, 0
+    last, total, base, at_t = None, 0, None, columns["t"]
     for start, data, where in blocks:
-        _check_values(name, header, data, lambda row: where(start + row))
+        _check_values(name, header, data, lambda row: where(start + row), at_t)
         data, copies, kept = without_copies(data, last)
         if not data.shape[0]:
             continue
-        t = data[:, columns["t"]]
-        joined = t if last is None else np.r_[last[columns["t"]], t]
+        raw = data[:, at_t]
+        joined = raw if last is None else np.r_[last[at_t], raw]
+        at = (lambda row: where(start + int(kept[row - (last is not None)])))
         if joined.size >= 2:
-            _check_time(name, joined, lambda row: where(start + int(kept[row - (last is not None)])))
-        last = data[-1]
-        total += t.size
-        yield dataclasses.replace(as_recording(name, columns, data, dof), copies=copies)
+            _check_time(name, joined, at, increase_only=True)
+        base = base or time_base(raw)  # the first block's: one origin and unit for the file
+        origin, scale, note = base
+        if joined.size >= 2:
+            _check_time(name, (joined - origin) * scale, at)
+        last = data[-1].copy()
+        data[:, at_t] = (raw - origin) * scale
+        total += raw.size
+        yield dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, time_note=note)
     if total < 2:
         _check_time(name, np.zeros(total), csv_line)  # the whole-file reader's message
 

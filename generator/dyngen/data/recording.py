@@ -22,6 +22,12 @@ MAX_VALUE = 1e9
 # No joint sensor samples faster than 1 MHz; a step of 1e-12 s (or 1e-300) is a unit error, and
 # velocities from it would overflow. A column name is a short label; a row a few kB.
 MIN_STEP = 1e-6
+MAX_TIME = 1e19  # the time column may be a clock's absolute reading: nanoseconds since 1970 until 2286
+ABSOLUTE = 1e6  # a first stamp beyond this (11 days in seconds) is an absolute clock: t counted from it
+# A joint-torque log is written at 20 Hz to 20 kHz: a median step of 0.05 ms to 50 ms in seconds. Stamps in
+# ms, us or ns are found by the step that lands there; each range below leaves a gap to the one before
+# (a step of 0.05-0.2 "s" or 50-200 "ms" is read as it stands, not guessed).
+UNITS = (("s", 1.0, 5e-5, 0.05), ("ms", 1e-3, 0.2, 50.0), ("us", 1e-6, 200.0, 5e4), ("ns", 1e-9, 2e5, 5e7))
 MAX_NAME = 64
 MAX_COLUMNS = 4000  # the stacked inertia matrix of 40 joints has 820
 MAX_CELL = 64  # characters of one number
@@ -41,6 +47,7 @@ class Recording:
     qdd: np.ndarray | None = None
     extra: dict = field(default_factory=dict)  # other columns by name, (T,)
     copies: int = 0  # rows left out at reading: exact copies of the row before, stamp included
+    time_note: str | None = None  # how the time column was read when it was not seconds from a small start
 
 
 def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
@@ -63,10 +70,30 @@ def csv_line(row: int) -> str:
 
 def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
     """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a row."""
-    _check_values(name, header, data, where)
+    _check_values(name, header, data, where, columns["t"])
     data, copies, kept = without_copies(data)
+    raw = data[:, columns["t"]]
+    _check_time(name, raw, lambda row: where(int(kept[row])), increase_only=True)
+    origin, scale, note = time_base(raw)
+    data[:, columns["t"]] = (raw - origin) * scale
     _check_time(name, data[:, columns["t"]], lambda row: where(int(kept[row])))
-    return dataclasses.replace(as_recording(name, columns, data, dof), copies=copies)
+    return dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, time_note=note)
+
+
+def time_base(t: np.ndarray) -> tuple[float, float, str | None]:
+    """(origin, scale, note): seconds from the start are (t - origin) * scale. An absolute clock's
+    stamps (Unix time) are counted from the first; stamps in ms, us or ns are found by their median
+    step (UNITS), and said in the note."""
+    origin = float(t[0]) if t.size and abs(float(t[0])) > ABSOLUTE else 0.0
+    step = float(np.median(np.diff(t))) if t.size >= 2 else 0.0
+    unit, scale = next(((u, k) for u, k, low, high in UNITS if low <= step <= high), ("s", 1.0))
+    said = []
+    if origin:
+        said.append(f"t starts at {origin:.6g} {unit} (an absolute clock): counted from the first row")
+    if unit != "s":
+        said.append(f"t read in {unit}: its median step {step:.3g} would be a {1 / step:.3g} Hz log in seconds, "
+                    f"{1 / (step * scale):.4g} Hz in {unit}")
+    return origin, scale, "; ".join(said) or None
 
 
 def without_copies(data: np.ndarray, before=None) -> tuple[np.ndarray, int, np.ndarray]:
@@ -185,23 +212,30 @@ def _cell(cell: str, name, line, column) -> float:
         raise InputError(name, where, f'not a number ("{shorten(cell.strip())}")') from None
 
 
-def _check_values(name, header, data, where=csv_line) -> None:
-    if (np.abs(data) <= MAX_VALUE).all():  # NaN fails the comparison, so this passes only good data;
+def _check_values(name, header, data, where=csv_line, time=None) -> None:
+    """Every value finite and at most MAX_VALUE in size; the column `time` (its index) at most MAX_TIME."""
+    bound = np.full(data.shape[1], MAX_VALUE)
+    if time is not None:
+        bound[time] = MAX_TIME
+    if (np.abs(data) <= bound).all():  # NaN fails the comparison, so this passes only good data;
         return  # the searches for the first bad cell (two argwhere, 1.4 s a 1 kHz hour) only when one is there
     for bad, what in ((~np.isfinite(data), "{} (NaN or infinite value)"),
-                      (np.abs(data) > MAX_VALUE, f"{{:g}}: value out of range (|x| at most {MAX_VALUE:g})")):
+                      (np.abs(data) > bound, "{:g}: value out of range (|x| at most {:g})")):
         if bad.any():
             row, col = np.argwhere(bad)[0]
-            raise InputError(name, f"{where(row)}, column {shorten(header[col])}", what.format(float(data[row, col])))
+            raise InputError(name, f"{where(row)}, column {shorten(header[col])}",
+                             what.format(float(data[row, col]), bound[col]))
 
 
-def _check_time(name, t, where=csv_line) -> None:
+def _check_time(name, t, where=csv_line, increase_only: bool = False) -> None:
+    """t increases (as in the file), and once in seconds (increase_only False), by at least MIN_STEP."""
     if t.size < 2:
         raise InputError(name, "column t", f"{t.size} sample(s); at least 2 are needed")
     steps = np.diff(t)
-    for bad, what in ((steps <= 0, lambda k: f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})"),
-                      (steps < MIN_STEP, lambda k: f"a time step of {float(steps[k]):.3g} s (at least {MIN_STEP:g} s: "
-                                                   "t is in seconds, and no sensor samples faster than 1 MHz)")):
+    checks = ((steps <= 0, lambda k: f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})"),
+              (steps < MIN_STEP, lambda k: f"a time step of {float(steps[k]):.3g} s (at least {MIN_STEP:g} s: "
+                                           "no sensor samples faster than 1 MHz)"))
+    for bad, what in checks[:1] if increase_only else checks:
         if bad.any():
             k = np.flatnonzero(bad)[0]
             raise InputError(name, f"{where(k + 1)}, column t", what(k))
