@@ -43,7 +43,7 @@ from simulation.withheld_run import DIRECTIONS, run  # noqa: E402
 from dyngen.atomic import write_file  # noqa: E402
 from dyngen.data import condition, read_recording  # noqa: E402
 from dyngen.description import load_robot  # noqa: E402
-from dyngen.diagnosis.trust import Unusable  # noqa: E402
+from dyngen.data.trust import Unusable  # noqa: E402
 from dyngen.runtime import load  # noqa: E402
 
 OUT_OF_SCOPE = {"coefficients"}  # not in the default library (bench_withheld.py)

@@ -35,7 +35,7 @@ COMMANDS = ("diagnose", "excite", "identify", "identify_consistent", "identify_l
 ADDED = (
     (25, "logs as loggers write them", "data/log_quality.py"),
     (25, "noise from the spectrum (log quality)", "data/automatic.py:spectral_noise"),
-    (25, "whether a log can be trusted (exit 3)", "diagnosis/trust.py"),
+    (25, "whether a log can be trusted (exit 3)", "data/trust.py"),
     (25, "what an unusable log writes", "diagnosis/diagnosis_files.py:write_unusable"),
     (25, "its figure", "diagnosis/diagnosis_files.py:_figure"),
     (25, "findings outside their physical range", "diagnosis/findings_check.py"),

@@ -33,7 +33,7 @@ STAGES = (
 RANK = {name: k for k, names in enumerate(STAGES) for name in names}
 # The diagnosis's stages (diagnosis/__init__.py), its result's types and shared tools first.
 DIAGNOSIS_STAGES = (
-    {"record", "phases", "moments", "trust", "roles"},  # the result's types; 0. roles
+    {"record", "phases", "moments", "roles"},  # the result's types; 0. roles
     {"fit"},  # 1. fit (its candidates: dyngen.terms.library)
     {"forward_selection"},  # 2. select
     {"refine", "settle"},  # 3. settle

@@ -1,4 +1,4 @@
-"""Logs as loggers write them (data/log_quality.py, data/automatic.py, diagnosis/trust.py).
+"""Logs as loggers write them (data/log_quality.py, data/automatic.py, data/trust.py).
 
 A withheld-effect case (tests/simulation/withheld_cases.py: the LWR in MuJoCo, sharp Coulomb
 friction on joints 1 and 6, 0.05 Nm torque noise, positions from an encoder, no qd or qdd

@@ -131,7 +131,7 @@ def main(argv, prog="dyngen diagnose") -> int:
                "test": [s.name for s in test], "conditioning": conditioning_text(fit + select + test)}
     if sampled:
         sources["sampled"] = sampled
-    from ..diagnosis.trust import EXIT_UNUSABLE, Unusable  # the diagnosis loads only once it runs
+    from ..data.trust import EXIT_UNUSABLE, Unusable  # the diagnosis loads only once it runs
     from ..diagnosis.diagnosis_files import write_unusable
 
     try:

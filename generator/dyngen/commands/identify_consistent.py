@@ -26,19 +26,32 @@ def run_consistent(args, robot, model, signals, progress, out: Path) -> int:
     if args.prior:
         options = replace(options, prior=read_link_parameters(args.prior, robot.dof))
     select = read_sources(args.select, robot, args) if args.select else None
+    import numpy as np
+
+    prior = options.prior if options.prior is not None else (
+        np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
+    # --- hook (data/trust.py): a recording whose nominal residual exceeds its torque is conditioned again, or
+    # nothing is fitted nor written (exit 3)
+    from ..data.trust import EXIT_UNUSABLE, Unusable
+
+    windows = {}  # conditioned windows of the recordings read in blocks: the trust and sanity checks' sample
+    try:
+        signals, select, again = trusted(model, prior, signals, select, lambda x: _sampled(x, robot, args, windows))
+    except Unusable as err:
+        import sys
+
+        print(f"dyngen identify: {err.line}", file=sys.stderr)
+        return EXIT_UNUSABLE
+    # ---
     start = time.perf_counter()
     with progress.step("consistent identification (weighted least squares, barrier solver)"):
         result = identify_consistent(robot, model, model.folder, signals, options, select=select)
     seconds = time.perf_counter() - start
     # --- hook (sanity.py): values in their physical ranges, grid edges, the simple model on --select
-    import numpy as np
-
     from ..identification.sanity import check, table_lines
 
-    prior = options.prior if options.prior is not None else (
-        np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
-    sanity, sanity_table, result = check(robot, model, result, _sampled(signals, robot, args),
-                                        _sampled(select, robot, args), prior)
+    sanity, sanity_table, result = check(robot, model, result, _sampled(signals, robot, args, windows),
+                                        _sampled(select, robot, args, windows), prior)
     # ---
     sources = [s.name for s in signals]  # printable: data/recording.py
     write_file(out, consistent_yaml(robot, result, sources, conditioning_text(signals)))
@@ -50,20 +63,52 @@ def run_consistent(args, robot, model, signals, progress, out: Path) -> int:
     exported = write_all(robot, result.p, out.parent, result.joint_dynamics())
     if not args.quiet:
         print("\n".join(summary_lines(robot, result)))
-        for w in [*(w for s in signals for w in getattr(s, "warnings", [])), *sanity]:
+        fitted = [w for s in signals for w in getattr(s, "warnings", [])]  # with those of data/trust.py
+        for w in [*fitted, *(w for w in again if w not in fitted), *sanity]:
             print(f"  warning: {w}")
         print(f"  {seconds:.1f} s; written: {out}, {table}, " + ", ".join(str(p) for p in exported))
-    elif sanity:
+    elif sanity or again:
         import sys
 
-        print("\n".join(f"warning: {w}" for w in sanity), file=sys.stderr)
+        print("\n".join(f"warning: {w}" for w in [*again, *sanity]), file=sys.stderr)
     return 0
 
 
-def _sampled(sources, robot, args):
+def trusted(model, p, signals, select, sampled):
+    """(signals, select, warnings): the fit and --select sources with any recording held whole whose nominal
+    residual (link parameters p) exceeds its torque conditioned again (data/trust.py: its warnings); one read
+    in blocks, which keeps its columns as recorded, is judged on sampled([source]) (its windows). Raises
+    trust.Unusable; without p (no prior, no parameters.nominal) nothing is judged."""
+    if p is None:
+        return signals, select, []
+    import numpy as np
+
+    from ..catalogue import STANDARD_FROM_DYNAMIC
+    from ..data.trust import checked
+    from ..identification.blocks import Source
+
+    groups = [list(signals), list(select or [])]
+    held = [x.signals for g in groups for x in g if x.signals is not None]
+    streamed = [(x.name, sampled([x])) for g in groups for x in g if x.signals is None]
+    done = iter(checked(model, model(STANDARD_FROM_DYNAMIC.name, np.asarray(p, dtype=float)), held, "identification",
+                        streamed))
+    out, again = [], []
+    for g in groups:
+        out.append([])
+        for x in g:
+            y = next(done) if x.signals is not None else x.signals
+            if y is not x.signals:  # conditioned again: its warning is the last
+                x = Source.held(y, x.block_rows)
+                again.append(y.warnings[-1])
+            out[-1].append(x)
+    return out[0], out[1] if select is not None else None, again
+
+
+def _sampled(sources, robot, args, kept=None):
     """Conditioned signals of the sources for the sanity check: a recording held whole as it is,
     one read in blocks whole within streaming.sample.MAX_ROWS samples, else evenly spread
-    windows of it (the ranges and the simple model's comparison on a sample, not every row)."""
+    windows of it (the ranges and the simple model's comparison on a sample, not every row).
+    kept: a dict keeping the windows of a recording read in blocks (id of its Source) for the next call."""
     from ..data import condition
     from ..streaming.sample import windows
     from .recordings import conditioning_of, long_enough
@@ -75,7 +120,13 @@ def _sampled(sources, robot, args):
         if s.signals is not None:
             out.append(s.signals)
             continue
+        if kept is not None and id(s) in kept:
+            out += kept[id(s)]
+            continue
         # the windows kept from the parse (recordings.read_sources), else read again
         got = s.sample.windows() if s.sample is not None else windows(s.path, robot.dof, s.effort_topic)
-        out += [condition(w, conditioning_of(args)) for w in long_enough(got)]
+        got = [condition(w, conditioning_of(args)) for w in long_enough(got)]
+        out += got
+        if kept is not None:
+            kept[id(s)] = got
     return out

@@ -85,7 +85,7 @@ def _figure(record, path: Path) -> Path:
 
 
 def write_unusable(err, out_dir, sources: dict) -> dict:
-    """When the data cannot support a diagnosis (trust.Unusable): report.md, diagnosis.json and the figure."""
+    """When the data cannot support a diagnosis (data/trust.Unusable): report.md, diagnosis.json and the figure."""
     out = Path(out_dir)
     lines = ["# Diagnosis not possible: the conditioning cannot be trusted", "", f"**{err.line}**", "",
              f"![the nominal residual against the torque]({FIGURE})", ""]

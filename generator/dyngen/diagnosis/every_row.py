@@ -20,7 +20,7 @@ from .judge import held_sums, over_every_row
 
 def streams_of(segments) -> list:
     """The long recordings (streaming.gap.GapTask) whose windows (streaming/sample.py) the segments
-    are, where the windows kept their columns as recorded (trust.py may have filtered them since)."""
+    are, where the windows kept their columns as recorded (data/trust.py may have filtered them since)."""
     tasks = [getattr(getattr(seg.signals, "source", None), "stream", None) if seg.signals.lowpass is None else None
              for seg in segments]
     return [task for k, task in enumerate(tasks) if task is not None and task not in tasks[:k]]

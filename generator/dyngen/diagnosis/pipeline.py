@@ -14,7 +14,8 @@ import numpy as np
 
 from ..catalogue import STANDARD_FROM_DYNAMIC
 from ..terms import Context, library, simple_model
-from . import across, choose, every_row, findings_check, fit, joints, reidentify, roles, stable, trust
+from ..data import trust
+from . import across, choose, every_row, findings_check, fit, joints, reidentify, roles, stable
 from .diagnose_options import Options
 from .findings import describe, reported, with_values
 from .forward_selection import forward, selection_mse, solve

@@ -1,8 +1,10 @@
-"""Whether a recording's conditioning can be trusted before anything is claimed: where the nominal
-residual exceeds ABOVE times the torque, the recording is conditioned again (automatic cutoff only);
-when nothing helps, Unusable (docs/measured-data.md, "When conditioning cannot be trusted").
+"""Whether a recording's conditioning can be trusted before anything is claimed from it (`dyngen
+diagnose`, `dyngen identify`): where the nominal residual exceeds ABOVE times the torque, the
+recording is conditioned again (automatic cutoff only); when nothing helps, Unusable
+(docs/measured-data.md, "When conditioning cannot be trusted").
 
-    signals = checked(model, s, signals)"""
+    signals = checked(model, s, signals, "diagnosis")        # or "identification"
+    signals = checked(model, s, signals, "identification", as_recorded=[(name, windows)])"""
 
 from __future__ import annotations
 
@@ -12,13 +14,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..catalogue import RNEA
+from .conditioning import AUTO, condition
 
 TORQUE_FLOOR = 0.05  # joints carrying less torque RMS than this share of the largest are not judged
 ABOVE = 1.5  # a residual this many times the torque's RMS is not the model's error (a joint whose torque is
 # all friction, which the nominal model lacks, has a residual as large as its torque)
 KEEP = 1.1  # the highest cutoff whose mean squared residual share is within this factor of the best
 MIN_CUTOFF = 0.5  # Hz
-EXIT_UNUSABLE = 3  # `dyngen diagnose` exit status when a recording's conditioning cannot be trusted
+EXIT_UNUSABLE = 3  # `dyngen diagnose` and `identify` exit status when a recording's conditioning cannot be trusted
+# what cannot be done, and what is therefore not claimed, in Unusable's line
+PURPOSES = {"diagnosis": ("a diagnosis", "no effect is claimed"),
+            "identification": ("an identification", "nothing is identified")}
 
 
 @dataclass
@@ -48,6 +54,7 @@ class Trial:
 class Untrusted:
     recording: str
     trials: list = field(default_factory=list)  # the first is the automatic conditioning
+    as_recorded: bool = False  # read in blocks: its columns as recorded, not conditioned again
 
 
 class Unusable(Exception):
@@ -59,22 +66,24 @@ class Unusable(Exception):
 
 
 def trial(model, s, sig, how: str) -> Trial:
-    keep = sig.inner()
-    tau = sig.tau[keep]
-    residual = tau - model.batch(RNEA.name, sig.q[keep], sig.qd[keep], sig.qdd[keep], s)
-    return Trial(how, sig.cutoff, np.sqrt(np.mean(tau ** 2, axis=0)), np.sqrt(np.mean(residual ** 2, axis=0)))
+    return pooled(model, s, [sig], how)
+
+
+def pooled(model, s, pieces, how: str) -> Trial:
+    """The Trial over the inner samples of every piece at once (the windows of one recording)."""
+    tau = np.concatenate([sig.tau[sig.inner()] for sig in pieces])
+    model_tau = np.concatenate([model.batch(RNEA.name, sig.q[keep], sig.qd[keep], sig.qdd[keep], s)
+                                for sig in pieces for keep in [sig.inner()]])
+    return Trial(how, pieces[0].cutoff, np.sqrt(np.mean(tau ** 2, axis=0)),
+                 np.sqrt(np.mean((tau - model_tau) ** 2, axis=0)))
 
 
 def _again(sig, **changes):
-    from ..data.conditioning import condition
-
     return condition(sig.source, dataclasses.replace(sig.options, **changes))
 
 
 def _alternatives(sig):
     """(how, signals) conditioned otherwise, highest cutoff first."""
-    from ..data.conditioning import AUTO
-
     first = sig
     if sig.cutoff is None or not sig.note.startswith("qd, qdd differentiated"):
         try:
@@ -96,10 +105,11 @@ def _joints(js) -> str:
     return ", ".join(str(j + 1) for j in js)
 
 
-def checked(model, s, signals: list) -> list:
-    """signals with any untrustworthy recording conditioned again; raises Unusable."""
-    from ..data.conditioning import AUTO
-
+def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=()) -> list:
+    """signals with any untrustworthy recording conditioned again; raises Unusable (its line says
+    that the data cannot support the `purpose`, a key of PURPOSES). as_recorded: (name, pieces)
+    of recordings that cannot be conditioned again (read in blocks, their columns as recorded),
+    each judged over its conditioned pieces pooled."""
     out, failed = [], []
     for sig in signals:
         if sig.tau is None or sig.t.size < 16:
@@ -128,20 +138,28 @@ def checked(model, s, signals: list) -> list:
             f"{_joints(first.above)} ({_rms_pair(first)}); conditioned again: {t.how} (residual {_rms_pair(t)})")
         other.note = f"conditioned again after the automatic choice failed: {other.note}"
         out.append(other)
+    for name, pieces in as_recorded:
+        pieces = [sig for sig in pieces if sig.tau is not None and sig.t.size >= 16]
+        first = pooled(model, s, pieces, f"as recorded, read in blocks ({pieces[0].note})") if pieces else None
+        if first is not None and first.above:
+            failed.append(Untrusted(name, [first], as_recorded=True))
     if failed:
         worst = failed[0].trials[0]
-        line = (f"the data cannot support a diagnosis: on {', '.join(r.recording for r in failed)} the nominal "
+        what, claim = PURPOSES[purpose]
+        line = (f"the data cannot support {what}: on {', '.join(r.recording for r in failed)} the nominal "
                 f"model's residual exceeds the measured torque on joint(s) {_joints(worst.above)} ({_rms_pair(worst)}) "
-                "with every conditioning tried (a log whose rows or stamps cannot be repaired, torques that do not "
-                "belong to the positions, or parameters far off); no effect is claimed")
+                + ("with its columns as recorded, read in blocks and not conditioned again"
+                   if all(r.as_recorded for r in failed) else "with every conditioning tried")
+                + " (a log whose rows or stamps cannot be repaired, torques that do not "
+                f"belong to the positions, or parameters far off); {claim}")
         raise Unusable(line, failed)
     return out
 
 
 def checked_roles(model, s, fit, select, test):
-    """checked() over the fit, select and test recordings at once (None stays None)."""
+    """checked() over the fit, select and test recordings of a diagnosis at once (None stays None)."""
     groups = [list(g) if g else [] for g in (fit, select, test)]
-    done = checked(model, s, [x for g in groups for x in g])
+    done = checked(model, s, [x for g in groups for x in g], "diagnosis")
     out, k = [], 0
     for original, g in zip((fit, select, test), groups):
         out.append(done[k:k + len(g)] if original is not None else None)

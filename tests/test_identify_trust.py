@@ -1,0 +1,85 @@
+"""`dyngen identify` refuses recordings whose conditioning cannot be trusted (data/trust.py, the
+check `dyngen diagnose` makes; docs/measured-data.md, "When conditioning cannot be trusted").
+
+The log: the LWR in MuJoCo with Coulomb friction, 1 kHz, encoder positions (no qd, qdd), as
+tests/test_log_quality.py builds it, fitted against examples/lwr.yaml's nominal links.
+  - its torques reversed in time (they do not belong to the positions): exit 3, one line naming
+    the file, nothing written; so as --select recording, and when read in blocks (--max-rows);
+  - as simulated: exit 0, no warning;
+  - qd, qdd recorded as raw differences of the encoder positions (recorded accelerations that are
+    noise, 11 Nm of nominal residual on joint 1 against 2.7 Nm of torque): conditioned again from
+    the positions, with diagnose's warning, exit 0.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import ROOT
+from simulation import logger
+from simulation.mujoco_measurements import Encoder
+from simulation.withheld_cases import CASES, write_cases
+
+LWR = ROOT / "examples" / "lwr.yaml"
+CASE = next(c for c in CASES if c.name == "coulomb")
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("trust")
+    write_cases(folder / "clean", rate_hz=1000.0, cases=[CASE], encoder=Encoder())
+    good = folder / "clean" / "coulomb.fit.csv"
+    header, data = logger.parse(good.read_text())
+    swapped = data.copy()
+    swapped[:, 8:15] = data[::-1, 8:15]
+    (folder / "swapped.csv").write_text(logger.unparse(header, swapped))
+    t, q, tau = data[:, 0], data[:, 1:8], data[:, 8:15]
+    qd = np.gradient(q, t, axis=0)
+    names = ",".join(["t"] + [f"{k}{i}" for k in ("q", "qd", "qdd", "tau") for i in range(1, 8)])
+    (folder / "raw.csv").write_text(logger.unparse(names, np.column_stack([t, q, qd, np.gradient(qd, t, axis=0), tau])))
+    (folder / "raw_swapped.csv").write_text(logger.unparse(names, np.column_stack(
+        [t, q, qd, np.gradient(qd, t, axis=0), tau[::-1]])))
+    return {"good": good, **{k: folder / f"{k}.csv" for k in ("swapped", "raw", "raw_swapped")}}
+
+
+def identify(out, *args):
+    return subprocess.run([sys.executable, "-m", "dyngen", "identify", str(LWR), "--model", str(ROOT / "generated" / "lwr"),
+                           "-q", "-o", str(out / "identified.yaml"), *map(str, args)], capture_output=True, text=True)
+
+
+@pytest.mark.parametrize("how", ["fit", "select", "in blocks"])
+def test_torques_that_do_not_belong_to_the_positions_stop_the_identification(logs, tmp_path, how):
+    out = tmp_path / "out"
+    bad = logs["raw_swapped" if how == "in blocks" else "swapped"]
+    args = {"fit": ["--data", bad], "select": ["--data", logs["good"], "--select", bad],
+            "in blocks": ["--data", bad, "--max-rows", 1000]}[how]
+    done = identify(out, *args)
+    assert done.returncode == 3, done.stderr
+    lines = [x for x in done.stderr.splitlines() if x.strip()]
+    assert len(lines) == 1 and lines[0].startswith("dyngen identify: the data cannot support an identification: "
+                                                   f"on {bad.name} "), lines
+    assert "joint(s) " in lines[0] and " vs " in lines[0] and "diagnosis" not in lines[0]
+    assert ("read in blocks" in lines[0]) == (how == "in blocks")
+    assert not out.exists()  # nothing written, not even the folder
+    assert done.stdout == ""
+
+
+def test_a_good_log_is_identified_without_a_word(logs, tmp_path):
+    done = identify(tmp_path, "--data", logs["good"])
+    assert done.returncode == 0, done.stderr
+    assert "conditioned again" not in done.stderr and "cannot support" not in done.stderr
+    assert "conditioned again" not in (tmp_path / "identified.yaml").read_text()
+    assert (tmp_path / "lwr.urdf").is_file() and (tmp_path / "lwr.xml").is_file()
+
+
+def test_recorded_accelerations_that_are_noise_are_conditioned_again(logs, tmp_path):
+    done = identify(tmp_path, "--data", logs["raw"])
+    assert done.returncode == 0, done.stderr
+    warning = [x for x in done.stderr.splitlines() if "conditioned again" in x]
+    assert len(warning) == 1 and warning[0].startswith("warning: raw.csv: the automatic conditioning left a nominal "
+                                                       "residual above the measured torque on joint(s) 1"), warning
+    assert "positions differentiated" in warning[0]
+    assert "conditioned again after the automatic choice failed" in (tmp_path / "identified.yaml").read_text()
