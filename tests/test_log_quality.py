@@ -32,7 +32,8 @@ from dyngen.data import condition, log_quality, read_recording
 from dyngen.data.chunks import chunks
 from dyngen.data.log_quality import regular_samples
 from dyngen.description import load_robot
-from dyngen.diagnosis import diagnose, trust
+from dyngen.data import trust
+from dyngen.diagnosis import diagnose
 from dyngen.runtime import load
 
 LWR = ROOT / "examples" / "lwr.yaml"
