@@ -83,3 +83,26 @@ def test_recorded_accelerations_that_are_noise_are_conditioned_again(logs, tmp_p
                                                        "residual above the measured torque on joint(s) 1"), warning
     assert "positions differentiated" in warning[0]
     assert "conditioned again after the automatic choice failed" in (tmp_path / "identified.yaml").read_text()
+
+
+@pytest.mark.parametrize("command", ["identify", "diagnose"])
+@pytest.mark.parametrize("joint, factor, says", [(3, -1.0, "its sign differs"), (2, 1000.0, "a unit or a gear"),
+                                                 (4, 0.01, "a unit or a gear")])
+def test_a_torque_of_the_other_sign_or_in_other_units_is_named(logs, tmp_path, command, joint, factor, says):
+    """One joint's torque logged with the other sign, in mNm, or as 1/100 of it (a motor-side torque):
+    no conditioning repairs it and no effect is a finding, so both commands stop with exit 3 and a line
+    that names the joint and the factor. Before, the sign flip got the generic line and the units
+    none at all: the diagnosis ran and claimed effects (a 1e3-Nm ripple on the mNm joint)."""
+    header, data = logger.parse(logs["good"].read_text())
+    data[:, 7 + joint] *= factor
+    bad = tmp_path / "convention.csv"
+    bad.write_text(logger.unparse(header, data))
+    out = tmp_path / "out"
+    if command == "identify":
+        done = identify(out, "--data", bad)
+    else:
+        done = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--model", str(ROOT / "generated" / "lwr"),
+                               "--params", str(LWR), "-q", "--out", str(out), "--data", str(bad)], capture_output=True, text=True)
+    assert done.returncode == 3, done.stderr
+    lines = [x for x in done.stderr.splitlines() if x.strip()]
+    assert len(lines) == 1 and f"joint {joint}'s measured torque is {factor:.3g} x the nominal model's ({says}" in lines[0], lines

@@ -19,6 +19,10 @@ from .conditioning import AUTO, condition
 TORQUE_FLOOR = 0.05  # joints carrying less torque RMS than this share of the largest are not judged
 ABOVE = 1.5  # a residual this many times the torque's RMS is not the model's error (a joint whose torque is
 # all friction, which the nominal model lacks, has a residual as large as its torque)
+SCALE_RANGE = (1 / 3, 3.0)  # measured / model torque: beyond it no sensor gain but a convention (sign, unit, gear)
+SCALE_EXPLAINS = 0.3  # ... when the model scaled by it leaves at most this share of the measured torque's RMS
+# (91 % of its power explained: torques reversed in time gave -0.61 on the LWR's joint 4, leaving 0.79)
+MODEL_FLOOR = 1e-3  # joints whose model torque is below this share of the largest are not judged for a convention
 KEEP = 1.1  # the highest cutoff whose mean squared residual share is within this factor of the best
 MIN_CUTOFF = 0.5  # Hz
 EXIT_UNUSABLE = 3  # `dyngen diagnose` and `identify` exit status when a recording's conditioning cannot be trusted
@@ -33,6 +37,9 @@ class Trial:
     cutoff: float | None
     torque: np.ndarray  # per joint RMS of the measured torque (inner samples)
     residual: np.ndarray  # per joint RMS of the nominal residual
+    model: np.ndarray | None = None  # per joint RMS of the nominal model's torque
+    scale: np.ndarray | None = None  # per joint least-squares factor of the model's torque in the measured one
+    scaled: np.ndarray | None = None  # per joint RMS of measured - scale x model
 
     @property
     def judged(self) -> np.ndarray:
@@ -42,6 +49,19 @@ class Trial:
     def above(self) -> list[int]:
         """0-based joints whose nominal residual exceeds their torque."""
         return [int(j) for j in np.flatnonzero(self.judged & (self.residual > ABOVE * self.torque))]
+
+    @property
+    def conventions(self) -> list[tuple[int, float]]:
+        """(0-based joint, factor) where the measured torque is the model's times a factor no sensor gain
+        has (a sign, a unit, a gear ratio), that factor explaining most of the measured torque; judged on joints
+        whose model torque is above MODEL_FLOOR of the largest (a wrist's torque is a few per cent of the
+        shoulder's, and the measured one may be in other units)."""
+        if self.scale is None or not self.model.max() > 0:
+            return []
+        lo, hi = SCALE_RANGE
+        judged = self.model > MODEL_FLOOR * float(self.model.max())
+        return [(int(j), float(self.scale[j])) for j in np.flatnonzero(judged)
+                if not lo <= self.scale[j] <= hi and self.scaled[j] <= SCALE_EXPLAINS * self.torque[j]]
 
     @property
     def share(self) -> float:
@@ -74,8 +94,10 @@ def pooled(model, s, pieces, how: str) -> Trial:
     tau = np.concatenate([sig.tau[sig.inner()] for sig in pieces])
     model_tau = np.concatenate([model.batch(RNEA.name, sig.q[keep], sig.qd[keep], sig.qdd[keep], s)
                                 for sig in pieces for keep in [sig.inner()]])
+    scale = np.sum(tau * model_tau, axis=0) / np.maximum(np.sum(model_tau ** 2, axis=0), 1e-300)
     return Trial(how, pieces[0].cutoff, np.sqrt(np.mean(tau ** 2, axis=0)),
-                 np.sqrt(np.mean((tau - model_tau) ** 2, axis=0)))
+                 np.sqrt(np.mean((tau - model_tau) ** 2, axis=0)), np.sqrt(np.mean(model_tau ** 2, axis=0)),
+                 scale, np.sqrt(np.mean((tau - scale * model_tau) ** 2, axis=0)))
 
 
 def _again(sig, **changes):
@@ -116,6 +138,10 @@ def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=())
             out.append(sig)
             continue
         first = trial(model, s, sig, f"as conditioned ({sig.note})")
+        if first.conventions:  # no conditioning changes a sign or a unit
+            failed.append(Untrusted(sig.name, [first]))
+            out.append(sig)
+            continue
         if not first.above:
             out.append(sig)
             continue
@@ -141,11 +167,15 @@ def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=())
     for name, pieces in as_recorded:
         pieces = [sig for sig in pieces if sig.tau is not None and sig.t.size >= 16]
         first = pooled(model, s, pieces, f"as recorded, read in blocks ({pieces[0].note})") if pieces else None
-        if first is not None and first.above:
+        if first is not None and (first.above or first.conventions):
             failed.append(Untrusted(name, [first], as_recorded=True))
     if failed:
         worst = failed[0].trials[0]
         what, claim = PURPOSES[purpose]
+        convention = next((r for r in failed if r.trials[0].conventions), None)
+        if convention is not None:
+            raise Unusable(f"the data cannot support {what}: on {convention.recording} "
+                           f"{_conventions(convention.trials[0].conventions)}; {claim}", failed)
         line = (f"the data cannot support {what}: on {', '.join(r.recording for r in failed)} the nominal "
                 f"model's residual exceeds the measured torque on joint(s) {_joints(worst.above)} ({_rms_pair(worst)}) "
                 + ("with its columns as recorded, read in blocks and not conditioned again"
@@ -165,6 +195,17 @@ def checked_roles(model, s, fit, select, test):
         out.append(done[k:k + len(g)] if original is not None else None)
         k += len(g)
     return tuple(out)
+
+
+def _conventions(found) -> str:
+    """In words: joints whose measured torque is the model's times a factor no sensor gain has."""
+    parts = []
+    for j, k in found:
+        why = ("its sign differs from the model's: the joint's positive direction or the torque's sign" if k < 0 else
+               "a unit or a gear, not a sensor gain: Nm logged as mNm gives 1000, a motor-side torque the gear "
+               "ratio's inverse, a current the torque constant's inverse")
+        parts.append(f"joint {j + 1}'s measured torque is {k:.3g} x the nominal model's ({why})")
+    return "; ".join(parts)
 
 
 def _rms_pair(t: Trial) -> str:

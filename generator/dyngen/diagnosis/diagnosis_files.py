@@ -76,7 +76,7 @@ def _figure(record, path: Path) -> Path:
     ax.set_yscale("log")
     ax.set_xticks(x + 0.4 - width / 2, [f"J{j + 1}" for j in range(n)])
     ax.set_ylabel("RMS [Nm]")
-    ax.set_title(f"{record.recording}: the nominal residual exceeds the torque (conditioning cannot be trusted)")
+    ax.set_title(f"{record.recording}: the nominal residual against the measured torque")
     ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     out = write_figure(path, fig, 110)
@@ -87,7 +87,7 @@ def _figure(record, path: Path) -> Path:
 def write_unusable(err, out_dir, sources: dict) -> dict:
     """When the data cannot support a diagnosis (data/trust.Unusable): report.md, diagnosis.json and the figure."""
     out = Path(out_dir)
-    lines = ["# Diagnosis not possible: the conditioning cannot be trusted", "", f"**{err.line}**", "",
+    lines = ["# Diagnosis not possible: the data do not support one", "", f"**{err.line}**", "",
              f"![the nominal residual against the torque]({FIGURE})", ""]
     doc = {"schema": report_text.SCHEMA_VERSION, "usable": False, "reason": err.line, **sources, "recordings": []}
     for r in err.recordings:
@@ -95,6 +95,9 @@ def write_unusable(err, out_dir, sources: dict) -> dict:
             f"J{j + 1}" for j in range(r.trials[0].torque.size)) + " |",
                   "|---|---:|" + "---:|" * r.trials[0].torque.size,
                   "| measured torque RMS | | " + " | ".join(f"{v:.3g}" for v in r.trials[0].torque) + " |"]
+        if r.trials[0].scale is not None:
+            lines.append("| measured / nominal torque (least squares) | | "
+                         + " | ".join(f"{v:.3g}" for v in r.trials[0].scale) + " |")
         for t in r.trials:
             cut = "none" if t.cutoff is None else f"{t.cutoff:.3g}"
             lines.append(f"| {t.how} | {cut} | " + " | ".join(f"{v:.3g}" for v in t.residual) + " |")
@@ -104,7 +107,8 @@ def write_unusable(err, out_dir, sources: dict) -> dict:
                                              for t in r.trials]})
     lines += ["Nothing is claimed from these data. The nominal model's residual is larger than the torque it should "
               "explain: differentiation noise (a logger's repeated or late rows, recorded accelerations that are "
-              "noise) or torques that do not belong to the positions. See docs/measured-data.md (logs as loggers "
+              "noise), torques that do not belong to the positions, or a torque in other units or of the other sign "
+              "(the ratio row). See docs/measured-data.md (logs as loggers "
               "write them).", ""]
     write_file(out / "report.md", "\n".join(lines))
     write_file(out / "diagnosis.json", json.dumps(doc, indent=1) + "\n")
