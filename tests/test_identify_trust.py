@@ -106,3 +106,30 @@ def test_a_torque_of_the_other_sign_or_in_other_units_is_named(logs, tmp_path, c
     assert done.returncode == 3, done.stderr
     lines = [x for x in done.stderr.splitlines() if x.strip()]
     assert len(lines) == 1 and f"joint {joint}'s measured torque is {factor:.3g} x the nominal model's ({says}" in lines[0], lines
+
+
+@pytest.mark.parametrize("reading", ["degrees", "no gravity"])
+def test_positions_in_degrees_or_torques_without_gravity_are_named(logs, tmp_path, reading):
+    """Positions logged in degrees, or torques with gravity taken out (a gravity-compensated command):
+    the nominal residual is far above the torque, and the line says which reading explains it (it was
+    the generic "torques that do not belong to the positions")."""
+    from dyngen.catalogue import RNEA, STANDARD_FROM_DYNAMIC
+    from dyngen.description import load_robot
+    from dyngen.runtime import load
+    from simulation.withheld_cases import nominal_model
+
+    header, data = logger.parse(logs["good"].read_text())
+    if reading == "degrees":
+        data[:, 1:8] = np.degrees(data[:, 1:8])
+    else:  # the nominal links' gravity: what a controller compensating it with the YAML's model would take out
+        model = load(ROOT / "generated" / "lwr")
+        s = model(STANDARD_FROM_DYNAMIC.name, nominal_model(load_robot(LWR)))
+        zero = np.zeros_like(data[:, 1:8])
+        data[:, 8:15] -= model.batch(RNEA.name, data[:, 1:8], zero, zero, s)
+    bad = tmp_path / "reading.csv"
+    bad.write_text(logger.unparse(header, data))
+    done = identify(tmp_path / "out", "--data", bad)
+    assert done.returncode == 3, done.stderr
+    lines = [x for x in done.stderr.splitlines() if x.strip()]
+    says = "its positions are in degrees" if reading == "degrees" else "its torques leave gravity out"
+    assert len(lines) == 1 and f"on {bad.name} {says}" in lines[0], lines

@@ -22,7 +22,9 @@ ABOVE = 1.5  # a residual this many times the torque's RMS is not the model's er
 SCALE_RANGE = (1 / 3, 3.0)  # measured / model torque: beyond it no sensor gain but a convention (sign, unit, gear)
 SCALE_EXPLAINS = 0.3  # ... when the model scaled by it leaves at most this share of the measured torque's RMS
 # (91 % of its power explained: torques reversed in time gave -0.61 on the LWR's joint 4, leaving 0.79)
+READING_CUTS, READING_SHARE = 0.1, 0.5  # a reading of the log in other conventions must cut the residual share so
 MODEL_FLOOR = 1e-3  # joints whose model torque is below this share of the largest are not judged for a convention
+UNIT_ABOVE = 3.0  # a joint's measured torque this many times the arm's largest model torque is in other units
 KEEP = 1.1  # the highest cutoff whose mean squared residual share is within this factor of the best
 MIN_CUTOFF = 0.5  # Hz
 EXIT_UNUSABLE = 3  # `dyngen diagnose` and `identify` exit status when a recording's conditioning cannot be trusted
@@ -53,15 +55,22 @@ class Trial:
     @property
     def conventions(self) -> list[tuple[int, float]]:
         """(0-based joint, factor) where the measured torque is the model's times a factor no sensor gain
-        has (a sign, a unit, a gear ratio), that factor explaining most of the measured torque; judged on joints
-        whose model torque is above MODEL_FLOOR of the largest (a wrist's torque is a few per cent of the
-        shoulder's, and the measured one may be in other units)."""
+        has (a sign, a unit, a gear ratio), that factor explaining most of the measured torque. Judged
+        on joints whose model torque is above TORQUE_FLOOR of the largest: where it is smaller, a payload
+        alone can multiply it (a wrist's torque by 18, the `payload_tilt` case); there only a torque
+        beyond UNIT_ABOVE times the arm's largest model torque is a unit."""
         if self.scale is None or not self.model.max() > 0:
             return []
         lo, hi = SCALE_RANGE
-        judged = self.model > MODEL_FLOOR * float(self.model.max())
-        return [(int(j), float(self.scale[j])) for j in np.flatnonzero(judged)
-                if not lo <= self.scale[j] <= hi and self.scaled[j] <= SCALE_EXPLAINS * self.torque[j]]
+        largest = float(self.model.max())
+        found = []
+        for j in range(self.scale.size):
+            k, explained = float(self.scale[j]), self.scaled[j] <= SCALE_EXPLAINS * self.torque[j]
+            if not explained or lo <= k <= hi or self.model[j] <= MODEL_FLOOR * largest:
+                continue
+            if self.model[j] > TORQUE_FLOOR * largest or self.torque[j] > UNIT_ABOVE * largest:
+                found.append((j, k))
+        return found
 
     @property
     def share(self) -> float:
@@ -74,6 +83,7 @@ class Trial:
 class Untrusted:
     recording: str
     trials: list = field(default_factory=list)  # the first is the automatic conditioning
+    named: str | None = None  # the convention found to differ from the model's (a sign, a unit), in words
     as_recorded: bool = False  # read in blocks: its columns as recorded, not conditioned again
 
 
@@ -138,8 +148,11 @@ def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=())
             out.append(sig)
             continue
         first = trial(model, s, sig, f"as conditioned ({sig.note})")
-        if first.conventions:  # no conditioning changes a sign or a unit
-            failed.append(Untrusted(sig.name, [first]))
+        named = _other_convention(model, s, sig, first) if first.above else None  # degrees, no gravity
+        if named is None and first.conventions:
+            named = _conventions(first.conventions)  # a sign, a unit, a gear
+        if named is not None:  # no conditioning changes a sign or a unit
+            failed.append(Untrusted(sig.name, [first], named=named))
             out.append(sig)
             continue
         if not first.above:
@@ -168,14 +181,15 @@ def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=())
         pieces = [sig for sig in pieces if sig.tau is not None and sig.t.size >= 16]
         first = pooled(model, s, pieces, f"as recorded, read in blocks ({pieces[0].note})") if pieces else None
         if first is not None and (first.above or first.conventions):
-            failed.append(Untrusted(name, [first], as_recorded=True))
+            failed.append(Untrusted(name, [first], as_recorded=True,
+                                    named=_conventions(first.conventions) if first.conventions else None))
     if failed:
         worst = failed[0].trials[0]
         what, claim = PURPOSES[purpose]
-        convention = next((r for r in failed if r.trials[0].conventions), None)
+        convention = next((r for r in failed if r.named), None)
         if convention is not None:
-            raise Unusable(f"the data cannot support {what}: on {convention.recording} "
-                           f"{_conventions(convention.trials[0].conventions)}; {claim}", failed)
+            raise Unusable(f"the data cannot support {what}: on {convention.recording} {convention.named}; {claim}",
+                           failed)
         line = (f"the data cannot support {what}: on {', '.join(r.recording for r in failed)} the nominal "
                 f"model's residual exceeds the measured torque on joint(s) {_joints(worst.above)} ({_rms_pair(worst)}) "
                 + ("with its columns as recorded, read in blocks and not conditioned again"
@@ -195,6 +209,29 @@ def checked_roles(model, s, fit, select, test):
         out.append(done[k:k + len(g)] if original is not None else None)
         k += len(g)
     return tuple(out)
+
+
+def _other_convention(model, s, sig, first: Trial) -> str | None:
+    """Where the nominal residual is above the torque: positions in degrees, or torques without gravity
+    (a gravity-compensated command, an external-torque estimate), when that reading leaves no judged
+    joint above its torque and cuts the mean squared residual share to READING_CUTS of what it was
+    and below READING_SHARE (torques reversed in time, read without gravity, keep a share near 1)."""
+    keep = sig.inner()
+    q, qd, qdd, tau = sig.q[keep], sig.qd[keep], sig.qdd[keep], sig.tau[keep]
+    rad = np.pi / 180
+    zero = np.zeros_like(q)
+    readings = (
+        ("its positions are in degrees: read in radians, the nominal model leaves {}; convert them to radians",
+         lambda: model.batch(RNEA.name, q * rad, qd * rad, qdd * rad, s)),
+        ("its torques leave gravity out (a gravity-compensated command or an external-torque estimate): the "
+         "nominal model without gravity leaves {}; log the measured joint torques",
+         lambda: model.batch(RNEA.name, q, qd, qdd, s) - model.batch(RNEA.name, q, zero, zero, s)))
+    for words, predicted in readings:
+        read = Trial(words, first.cutoff, first.torque, np.sqrt(np.mean((tau - predicted()) ** 2, axis=0)))
+        if not read.above and read.share <= min(READING_CUTS * first.share, READING_SHARE):
+            pairs = ", ".join(f"J{j + 1} {read.residual[j]:.3g} vs {first.torque[j]:.3g} Nm" for j in first.above[:4])
+            return words.format(f"{pairs} (as logged: {_rms_pair(first)})")
+    return None
 
 
 def _conventions(found) -> str:
