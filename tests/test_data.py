@@ -200,3 +200,10 @@ def test_a_time_column_beyond_any_clock_is_refused(tmp_path):
     rows = good_rows()
     rows[2][0] = 2e19
     assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 4, column t: 2e+19: value out of range (|x| at most 1e+19)"
+
+
+@pytest.mark.parametrize("sep", [";", "\t", " "])
+def test_a_file_separated_otherwise_is_named(tmp_path, sep):
+    path = tmp_path / "run.csv"
+    path.write_text(sep.join(HEADER) + "\n" + "\n".join(sep.join(str(v) for v in row) for row in good_rows()) + "\n")
+    assert f"the values are separated by {sep!r}, not commas" in error_of(path)

@@ -148,6 +148,10 @@ def check_header(name, header, dof, require_torques=True, required=(), where="co
             raise InputError(name, where, f"column {shorten(h)} appears twice")
         columns[h] = k
     if "t" not in columns:
+        sep = next((d for d in (";", "\t", " ", "|") if len(header) == 1 and d in header[0].strip()), None)
+        if sep is not None:
+            raise InputError(name, where, f"one column named {shorten(header[0])!r}: the values are separated by "
+                             f"{sep!r}, not commas (CSV here is comma-separated: t,q1,...,tau1,...)")
         raise InputError(name, where, "no time column t")
     found = {}
     for h in columns:
