@@ -207,3 +207,25 @@ def test_a_file_separated_otherwise_is_named(tmp_path, sep):
     path = tmp_path / "run.csv"
     path.write_text(sep.join(HEADER) + "\n" + "\n".join(sep.join(str(v) for v in row) for row in good_rows()) + "\n")
     assert f"the values are separated by {sep!r}, not commas" in error_of(path)
+
+
+@pytest.mark.parametrize("joint, factor", [(2, 180 / np.pi), (5, -1.0), (6, 100.0)])
+def test_recorded_velocities_in_another_unit_are_set_aside(tmp_path, joint, factor):
+    """The real LWR4+ log (examples/lwr4-real, qd and qdd recorded by the controller) with one joint's
+    qd, qdd in deg/s, of the other sign, or motor-side (x 100): the positions are differentiated
+    instead, and said; as logged, the recorded columns are used (they agree with the positions)."""
+    from conftest import ROOT
+
+    source = ROOT / "examples" / "lwr4-real" / "measurement_1.csv"
+    header, *lines = source.read_text().splitlines()
+    names = header.split(",")
+    data = np.array([[float(x) for x in line.split(",")] for line in lines])
+    assert condition(read_recording(source, 7)).note.endswith("qd, qdd as recorded, no filter")
+    data[:, [names.index(f"qd{joint}"), names.index(f"qdd{joint}")]] *= factor
+    path = tmp_path / "other_unit.csv"
+    path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in data) + "\n")
+    sig = condition(read_recording(path, 7))
+    again = condition(read_recording(path, 7), Conditioning(differentiate=True))
+    assert f"x the positions' derivative on joint {joint} " in sig.warnings[0], sig.warnings
+    said = float(sig.warnings[0].split("recorded qd is ")[1].split(" x")[0])
+    assert abs(said / factor - 1) < 0.01 and np.array_equal(sig.qdd, again.qdd)

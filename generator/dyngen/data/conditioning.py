@@ -21,6 +21,8 @@ from .recording import Recording
 AUTO = "auto"
 EDGE_PERIODS = 1.0  # trimmed at each end: this many periods of the cutoff (the filter's start-up)
 PAD_PERIODS = 2.0  # the recording is continued this many periods of the cutoff before filtering
+VELOCITY_AGREES = (0.8, 1.25)  # recorded qd / the positions' derivative; beyond: another unit, sign or gear side
+VELOCITY_EXPLAINED = 0.3  # ... when that factor leaves at most this share of the recorded qd's RMS
 
 
 def cutoff_of(text: str):
@@ -96,6 +98,12 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     # repeats, held columns, jittered stamps; uneven ones made a regular grid where a filter follows
     r, log = log_quality.regular_samples(recording, regrid=filtering)
     rate = 1.0 / float(np.median(np.diff(r.t)))
+    disagrees = None if differentiate else _velocity_disagrees(r, rate)
+    if disagrees:  # recorded qd in another unit or sign than q: the positions are differentiated instead
+        out = condition(recording, dataclasses.replace(options, differentiate=True))
+        out.warnings.insert(0, f"{r.name}: {disagrees}: qd, qdd differentiated from q instead")
+        out.note = f"recorded qd set aside ({disagrees}); {out.note}"
+        return out
     decision, cutoff = None, options.cutoff
     if isinstance(cutoff, str):
         if cutoff != AUTO:
@@ -155,6 +163,29 @@ def _note(differentiate, cutoff, options, decision, no_qdd) -> str:
             f"velocity noise {_sigma(decision.q_noise)}/s"
         text += f" (chosen from the data: {noise}, motion band {decision.band:.3g} Hz)"
     return text
+
+
+def _velocity_disagrees(r: Recording, rate: float) -> str | None:
+    """In words, the joints whose recorded qd is their positions' derivative times a factor outside
+    VELOCITY_AGREES (deg/s beside rad gives 57.3, a motor-side velocity the gear ratio, -1 a sign),
+    compared through one low-pass well above the motion and below the noise (a tenth of Nyquist,
+    at most 10 Hz), on joints that move (over 1 % of the fastest); None where they agree."""
+    if r.qd is None or r.t.size < 64:
+        return None
+    smooth = _lowpass(r.name, rate, min(0.05 * rate, 10.0), 2)
+    edge = min(int(np.ceil(rate / 5.0)), r.t.size // 4)  # the filter's start-up at each end
+    recorded = smooth(r.qd)[edge:-edge]
+    derived = np.gradient(smooth(r.q), r.t, axis=0)[edge:-edge]
+    size = np.sqrt(np.mean(derived ** 2, axis=0))
+    factor = np.sum(recorded * derived, axis=0) / np.maximum(np.sum(derived ** 2, axis=0), 1e-300)
+    left = np.sqrt(np.mean((recorded - factor * derived) ** 2, axis=0))
+    lo, hi = VELOCITY_AGREES
+    bad = [j for j in range(factor.size) if size[j] > 0.01 * size.max() and not lo <= factor[j] <= hi
+           and left[j] <= VELOCITY_EXPLAINED * np.sqrt(np.mean(recorded[:, j] ** 2))]
+    if not bad:
+        return None
+    return "recorded qd is " + ", ".join(f"{factor[j]:.3g} x the positions' derivative on joint {j + 1}"
+                                         for j in bad) + " (deg/s gives 57.3, a motor-side velocity the gear ratio)"
 
 
 def _lowpass(name: str, rate: float, cutoff: float, order: int):
