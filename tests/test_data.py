@@ -60,7 +60,7 @@ def test_non_monotonic_time(tmp_path):
 def test_nan_and_text(tmp_path):
     rows = good_rows()
     rows[1][3] = "nan"
-    assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 3, column tau1: nan (NaN or infinite value)"
+    assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 3, column tau1: nan (NaN or infinite value; missing values are left out only at the file's start and end)"
     rows[1][3] = "abc"
     assert error_of(write(tmp_path, HEADER, rows)) == 'run.csv: line 3, column tau1: not a number ("abc")'
 
@@ -190,9 +190,9 @@ def test_stamps_in_other_units_or_from_an_absolute_clock(tmp_path, unit, scale, 
     precision = 3e-7 if origin else 1e-9  # float64 spacing of Unix time: 238 ns in s, 256 ns in ns
     for got in (whole.t, np.concatenate([b.t for b in blocks])):
         assert np.max(np.abs(got - (t - t[0] * (origin > 0)))) < precision
-    said = whole.time_note or ""
+    said = whole.read_note or ""
     assert (f"t read in {unit}" in said) == (unit != "s") and ("absolute clock" in said) == (origin > 0)
-    assert said.split(": its")[0] == (blocks[0].time_note or "").split(": its")[0]  # the median of one block or all
+    assert said.split(": its")[0] == (blocks[0].read_note or "").split(": its")[0]  # the median of one block or all
     assert "t read in" in (condition(whole).note if unit != "s" else "t read in")
 
 
@@ -229,3 +229,30 @@ def test_recorded_velocities_in_another_unit_are_set_aside(tmp_path, joint, fact
     assert f"x the positions' derivative on joint {joint} " in sig.warnings[0], sig.warnings
     said = float(sig.warnings[0].split("recorded qd is ")[1].split(" x")[0])
     assert abs(said / factor - 1) < 0.01 and np.array_equal(sig.qdd, again.qdd)
+
+
+def test_rows_missing_values_at_the_ends_are_left_out(tmp_path):
+    """A logger that merges topics writes rows before every column has a value, and after one stops:
+    empty cells or NaN at the file's start and end are left out and said (they were refused); between
+    complete rows a missing value is still named with its line. In blocks, only the start's."""
+    from dyngen.data.chunks import chunks
+
+    rows = [[f"{0.001 * k:.3f}", str(np.sin(0.001 * k)), "0.5", "1.0", "2.0"] for k in range(40)]
+    for k in (0, 1, 2):
+        rows[k][3] = ""  # tau1 not yet published
+    rows[-1][1] = "nan"
+    text = ",".join(HEADER) + "\n" + "\n".join(",".join(r) for r in rows) + "\n"
+    path = tmp_path / "run.csv"
+    path.write_text(text)
+    r = read_recording(path, N)
+    assert r.t.size == 36 and r.t[0] == 0.003 and np.all(np.isfinite(r.tau))
+    assert r.read_note.startswith("3 row(s) at the start and 1 at the end miss a value")
+    assert "3 row(s) at the start" in condition(r).note
+    path.write_text(text.replace("\n0.039,", "\n0.039,1,", 1).replace("0.039,1,nan", "0.039,nan"))
+    with pytest.raises(InputError, match="line 41, column q1"):
+        list(chunks(path, N, rows=16))
+    first = next(chunks(path, N, rows=16))
+    assert first.t[0] == 0.003 and first.read_note.startswith("3 row(s) at the start and 0 at the end")
+    rows[20][2] = ""
+    path.write_text(",".join(HEADER) + "\n" + "\n".join(",".join(r) for r in rows) + "\n")
+    assert error_of(path).startswith("run.csv: line 22, column q2: nan (NaN or infinite value; missing values")

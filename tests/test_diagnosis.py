@@ -294,7 +294,7 @@ def test_diagnose_cli_writes_report_json_figures_and_model(lwr, tmp_path):
     bad.write_text("\n".join(lines) + "\n")
     r = subprocess.run(cmd[:8] + [bad] + cmd[9:-1] + [tmp_path / "none"], capture_output=True, text=True)
     assert r.returncode != 0 and r.stderr.strip().count("\n") == 0, r.stderr
-    assert "bad.csv: line 10, column q4: nan (NaN or infinite value)" in r.stderr
+    assert "bad.csv: line 10, column q4: nan (NaN or infinite value;" in r.stderr
     assert not (tmp_path / "none").exists()
 
 

@@ -97,7 +97,8 @@ def test_a_bad_row_deep_in_a_long_recording_is_one_line_and_nothing_written(tmp_
                          capture_output=True, text=True, timeout=300,
                          env={**os.environ, "PYTHONPATH": str(ROOT / "generator")})
     assert out.returncode != 0
-    assert out.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 5002, column q3: nan (NaN or infinite value)"]
+    assert out.stderr.strip().splitlines() == ["dyngen: error: long.csv: line 5002, column q3: nan (NaN or infinite value; missing values are left out only "
+                                                 "at the file's start and end)"]
     assert not (tmp_path / "d").exists()
 
 

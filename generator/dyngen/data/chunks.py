@@ -27,7 +27,7 @@ from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
 from .recording import (_check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line,
-                        time_base, without_copies)
+                        ragged_note, time_base, without_copies)
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -45,7 +45,12 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
     header = next(blocks)
     columns = check_header(name, header, dof, require_torques, required, where_header)
     last, total, base, at_t = None, 0, None, columns["t"]
+    head = None
     for start, data, where in blocks:
+        if head is None:  # rows missing a value at the file's start are left out (at its end they are refused:
+            complete = ~np.isnan(data).any(axis=1)  # a block cannot know that no complete row follows)
+            head = int(np.argmax(complete)) if complete.any() else 0
+            data, start = data[head:], start + head
         _check_values(name, header, data, lambda row: where(start + row), at_t)
         data, copies, kept = without_copies(data, last)
         if not data.shape[0]:
@@ -62,7 +67,8 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
         last = data[-1].copy()
         data[:, at_t] = (raw - origin) * scale
         total += raw.size
-        yield dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, time_note=note)
+        said = "; ".join(x for x in (ragged_note(head, 0), note) if x) or None
+        yield dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, read_note=said)
     if total < 2:
         _check_time(name, np.zeros(total), csv_line)  # the whole-file reader's message
 

@@ -88,9 +88,9 @@ class Streamed:
         before, pending, name = None, None, ""
         for block in blocks:
             self.report.repeated += block.copies  # left out at reading (data/recording.without_copies)
-            if block.time_note and not self.report.notes:
-                self.report.notes.append(block.time_note)
-                self.report.warnings.append(f"{block.name}: {block.time_note}")
+            if block.read_note and not self.report.notes:
+                self.report.notes.append(block.read_note)
+                self.report.warnings.append(f"{block.name}: {block.read_note}")
             name, r = block.name, (block if pending is None else _joined(pending, block))
             data = _all_columns(r)
             repeats, end = _repeats(data, r.q, before)
@@ -155,9 +155,9 @@ def _unheld(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogReport]:
     """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are exact)."""
     report = LogReport(repeated=r.copies)  # rows that copied the row before, stamp included, left out at reading
-    if r.time_note:  # stamps read in ms, us or ns, or counted from an absolute clock's first (data/recording.py)
-        report.notes.append(r.time_note)
-        report.warnings.append(f"{r.name}: {r.time_note}")
+    if r.read_note:  # rows missing values at the ends, stamps in ms, us, ns or Unix time (data/recording.py)
+        report.notes.append(r.read_note)
+        report.warnings.append(f"{r.name}: {r.read_note}")
     if r.t.size < 16:
         return r, report
     repeats = repeated_rows(r)

@@ -47,7 +47,7 @@ class Recording:
     qdd: np.ndarray | None = None
     extra: dict = field(default_factory=dict)  # other columns by name, (T,)
     copies: int = 0  # rows left out at reading: exact copies of the row before, stamp included
-    time_note: str | None = None  # how the time column was read when it was not seconds from a small start
+    read_note: str | None = None  # what reading did beyond parsing: rows missing values at the ends, the time's unit
 
 
 def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ()) -> Recording:
@@ -70,14 +70,34 @@ def csv_line(row: int) -> str:
 
 def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
     """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a row."""
-    _check_values(name, header, data, where, columns["t"])
+    data, head, tail = without_ragged_ends(data)
+    _check_values(name, header, data, lambda row: where(head + row), columns["t"])
     data, copies, kept = without_copies(data)
     raw = data[:, columns["t"]]
-    _check_time(name, raw, lambda row: where(int(kept[row])), increase_only=True)
+    _check_time(name, raw, lambda row: where(head + int(kept[row])), increase_only=True)
     origin, scale, note = time_base(raw)
     data[:, columns["t"]] = (raw - origin) * scale
-    _check_time(name, data[:, columns["t"]], lambda row: where(int(kept[row])))
-    return dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, time_note=note)
+    _check_time(name, data[:, columns["t"]], lambda row: where(head + int(kept[row])))
+    said = "; ".join(x for x in (ragged_note(head, tail), note) if x) or None
+    return dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, read_note=said)
+
+
+def without_ragged_ends(data: np.ndarray) -> tuple[np.ndarray, int, int]:
+    """(data without the rows at its start and end that miss a value (NaN or an empty cell: a logger
+    writing before every column has one, or after one stopped), how many at the start, at the end).
+    A missing value between complete rows is left for the checks to name."""
+    complete = ~np.isnan(data).any(axis=1)
+    if not complete.any():
+        return data, 0, 0
+    first, last = int(np.argmax(complete)), data.shape[0] - int(np.argmax(complete[::-1]))
+    return data[first:last], first, data.shape[0] - last
+
+
+def ragged_note(head: int, tail: int) -> str | None:
+    if not head and not tail:
+        return None
+    return (f"{head} row(s) at the start and {tail} at the end miss a value (a logger writing before every column "
+            "had one, or after one stopped): left out")
 
 
 def time_base(t: np.ndarray) -> tuple[float, float, str | None]:
@@ -210,6 +230,8 @@ def _cell(cell: str, name, line, column) -> float:
     where = f"line {line}, column {shorten(column)}"
     if len(cell) > MAX_CELL:
         raise InputError(name, where, f"not a number ({len(cell)} characters)")
+    if not cell.strip():
+        return float("nan")  # a missing value: left out at the file's ends, named between complete rows
     try:
         return float(cell)
     except ValueError:
@@ -223,7 +245,8 @@ def _check_values(name, header, data, where=csv_line, time=None) -> None:
         bound[time] = MAX_TIME
     if (np.abs(data) <= bound).all():  # NaN fails the comparison, so this passes only good data;
         return  # the searches for the first bad cell (two argwhere, 1.4 s a 1 kHz hour) only when one is there
-    for bad, what in ((~np.isfinite(data), "{} (NaN or infinite value)"),
+    for bad, what in ((~np.isfinite(data), "{} (NaN or infinite value; missing values are left out only at the file's "
+                                           "start and end)"),
                       (np.abs(data) > bound, "{:g}: value out of range (|x| at most {:g})")):
         if bad.any():
             row, col = np.argwhere(bad)[0]
