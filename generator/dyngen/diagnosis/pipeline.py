@@ -186,9 +186,9 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     (notes.py's are added by diagnose)."""
     n, modes = robot.dof, choice.modes
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
-    flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
-                              final.correlation_samples)
     low = findings_check.below_floor(final.context, final.segments, final.chosen, final.fit.x, floors)
+    flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
+                              final.correlation_samples, faint=list(low))
     claimed = [i for i, c in enumerate(final.chosen) if (i not in flagged or c.joint in replaced) and i not in low]
     explained = [] if choice.tried is None else across.explained_by_links(
         final.context, choice.segments, reidentify.link_corrections(choice.tried, model, choice.segments),
