@@ -203,3 +203,56 @@ def test_one_stretch_of_nine_outside_the_physical_range_does_not_veto_a_finding(
     assert not [u for u in d.unstable if u.finding.effect == "armature"], [u.reason for u in d.unstable]
     (ia,) = [e for e in d.selected if e.effect == "armature" and e.joints == (4,)]
     assert abs(ia.values["Ia"] - IA) < 0.25 * IA
+
+
+def test_an_effect_below_the_floor_is_left_out_of_the_stretches_fits(tmp_path, monkeypatch):
+    """A ripple below the significance floor (R sin(3 q6), 0.01 Nm RMS beside 0.05 Nm noise) beside a
+    rotor inertia and viscous friction on joint 6 (MuJoCo, 200 Hz, 20-bit encoder, 12 s): the ripple is
+    no finding, and the stretches' fits that judge the findings leave it out (stable.unstable's
+    `faint`): kept in, its six values took the rotor inertia's share on a 4-s stretch of the Panda
+    trial's joint 5 (true 0.05, -0.23 there) and voted the true rotor inertia and viscous friction
+    "unstable, not claimed" (bench/trial_other_arm.py --arm panda; not reproduced on this small case,
+    where the check is that the faint effect is left out). Both findings stay claimed."""
+    import dataclasses
+
+    from simulation.mujoco_measurements import Effects, Trajectory, csv_text, encoded, measure
+    from simulation.withheld_cases import grid
+
+    from dyngen.diagnosis import stable
+
+    robot, model = load_robot(ROOT / "examples" / "lwr.yaml"), load(ROOT / "generated" / "lwr")
+    p = nominal_model(robot)
+    motions = [[(0.4, 0.13)], [(0.3, 0.07)], [(0.3, 0.17)], [(0.3, 0.11)], [(0.4, 0.19)],
+               [(0.8, 0.1), (0.3, 0.2), (0.1, 0.5)], [(0.5, 0.29)]]
+
+    def at_of(seed):
+        def at(t):
+            t = np.atleast_1d(np.asarray(t, float))
+            q, qd, qdd = (np.zeros((t.size, 7)) for _ in range(3))
+            for j, parts in enumerate(motions):
+                for a, f in parts:
+                    w = 2 * np.pi * f * (1 + 0.05 * seed)
+                    q[:, j] += a * np.sin(w * t)
+                    qd[:, j] += a * w * np.cos(w * t)
+                    qdd[:, j] -= a * w * w * np.sin(w * t)
+            return q, qd, qdd
+        return at
+
+    for k, name in enumerate(("fit", "test")):
+        m = measure(robot, p, Trajectory(grid(12.0, 200.0), at_of(k)), Effects(armature={6: 0.05}, viscous={6: 0.2}),
+                    0.05, seed=[k])
+        m = dataclasses.replace(m, tau=m.tau + np.outer(0.012 * np.sin(3 * m.q[:, 5]), np.eye(7)[5]))
+        (tmp_path / f"{name}.csv").write_text(csv_text(encoded(m, Encoder(), seed=[k, 1]), velocities=False))
+    fit, test = (condition(read_recording(tmp_path / f"{n}.csv", 7)) for n in ("fit", "test"))
+    calls, unstable = [], stable.unstable
+
+    def spy(context, segments, design, chosen, x, tau_corr, faint=()):
+        calls.append(sorted(chosen[i].key for i in faint))
+        return unstable(context, segments, design, chosen, x, tau_corr, faint)
+
+    monkeypatch.setattr(stable, "unstable", spy)
+    d = diagnose(robot, model, p, [fit], None, test=[test])
+    assert any(x.startswith("ripple on joint 6 (a torque of") for x in d.dropped)
+    assert calls[0] == ["ripple on joint 6"]  # (the call without it follows)
+    found = {e.effect: e.values for e in d.selected if e.joints == (6,)}
+    assert abs(found["armature"]["Ia"] - 0.05) < 0.01 and abs(found["viscous"]["Fv"] - 0.2) < 0.04

@@ -187,9 +187,9 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
     (notes.py's are added by diagnose)."""
     n, modes = robot.dof, choice.modes
     replaced = [j for j in range(n) if modes[j] in (joints.SIMPLE, joints.CONSISTENT)]
-    flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
-                              final.correlation_samples)
     low = findings_check.below_floor(final.context, final.segments, final.chosen, final.fit.x, floors)
+    flagged = stable.unstable(final.context, final.segments, final.design, final.chosen, final.fit.x,
+                              final.correlation_samples, faint=list(low))
     claimed = [i for i, c in enumerate(final.chosen) if (i not in flagged or c.joint in replaced) and i not in low]
     explained = [] if choice.tried is None else across.explained_by_links(
         final.context, choice.segments, reidentify.link_corrections(choice.tried, model, choice.segments),
@@ -202,7 +202,10 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         marked = sorted(set(marked) | {i for i in across.made_by_base_columns(
             model, final.context, choice.segments, settled.chosen, settled.fit.x, min_gain)
             if i not in explained and final.chosen[i].joint not in replaced})
-    findings = [replace(f, suspect=across.LINKS) if i in marked else f for i, f in enumerate(final.findings)]
+    sticking = findings_check.static_not_shown(final.context, final.segments, final.chosen, final.fit.x,
+                                               final.correlation_samples)
+    findings = [replace(f, suspect=across.LINKS) if i in marked else replace(f, suspect=sticking[i]) if i in sticking
+                else f for i, f in enumerate(final.findings)]
     selected, superseded = reported([final.chosen[i] for i in claimed if i not in explained],
                                     [findings[i] for i in claimed if i not in explained], replaced)
     unstable = [Unstable(final.findings[i], *flagged[i]) for i in sorted(set(flagged) - set(claimed) - set(low))]
