@@ -133,3 +133,42 @@ def test_positions_in_degrees_or_torques_without_gravity_are_named(logs, tmp_pat
     lines = [x for x in done.stderr.splitlines() if x.strip()]
     says = "its positions are in degrees" if reading == "degrees" else "its torques leave gravity out"
     assert len(lines) == 1 and f"on {bad.name} {says}" in lines[0], lines
+
+
+@pytest.mark.parametrize("command", ["identify", "diagnose"])
+def test_link_parameters_far_off_are_told_from_a_broken_log(logs, tmp_path, command):
+    """The good log against links three times too heavy (every mass and inertia): the nominal residual is
+    above the torque, and the model's torque three times the measured one, as a unit error would give;
+    but a rigid-body fit of the data explains them. Identify, whose purpose it is, goes on with a
+    warning; diagnose stops, saying to identify first. Before, identify refused the log as untrustworthy."""
+    from dyngen.data.parameters_file import read_link_parameters
+
+    p = read_link_parameters(LWR, 7).reshape(7, 10)
+    heavy = tmp_path / "heavy.yaml"
+    heavy.write_text("links:\n" + "".join(f"  - {{m: {3 * float(r[0])!r}, c: [{', '.join(repr(float(x)) for x in r[1:4])}], "
+                                          f"I: [{', '.join(repr(3 * float(x)) for x in r[4:])}]}}\n" for r in p))
+    out = tmp_path / "out"
+    if command == "identify":
+        done = identify(out, "--data", logs["good"], "--prior", heavy)
+        assert done.returncode == 0, done.stderr
+        assert "a rigid-body fit of the data explains it: the conditioning is sound, the link parameters are off" \
+            in done.stderr
+    else:
+        done = subprocess.run([sys.executable, "-m", "dyngen", "diagnose", str(LWR), "--model", str(ROOT / "generated" / "lwr"),
+                               "--params", str(heavy), "-q", "--out", str(out), "--data", str(logs["good"])],
+                              capture_output=True, text=True)
+        assert done.returncode == 3, done.stderr
+        assert "the nominal link parameters are far off" in done.stderr and "identify the link parameters first" \
+            in done.stderr
+
+
+def test_every_torque_in_mnm_is_named(logs, tmp_path):
+    """Every joint's torque logged in mNm: no joint stands apart from the others, but the arm's common
+    factor (1000) is beyond any nominal model's error (0.1..10)."""
+    header, data = logger.parse(logs["good"].read_text())
+    data[:, 8:15] *= 1000.0
+    bad = tmp_path / "mnm.csv"
+    bad.write_text(logger.unparse(header, data))
+    done = identify(tmp_path / "out", "--data", bad)
+    assert done.returncode == 3, done.stderr
+    assert "joint 2's measured torque is 1e+03 x the nominal model's (a unit or a gear" in done.stderr

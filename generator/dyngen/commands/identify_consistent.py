@@ -89,6 +89,7 @@ def trusted(model, p, signals, select, sampled):
 
     groups = [list(signals), list(select or [])]
     held = [x.signals for g in groups for x in g if x.signals is not None]
+    said = {id(sig): len(sig.warnings) for sig in held}  # a recording kept as it is may be given a warning
     streamed = [(x.name, sampled([x])) for g in groups for x in g if x.signals is None]
     done = iter(checked(model, model(STANDARD_FROM_DYNAMIC.name, np.asarray(p, dtype=float)), held, "identification",
                         streamed))
@@ -100,6 +101,8 @@ def trusted(model, p, signals, select, sampled):
             if y is not x.signals:  # conditioned again: its warning is the last
                 x = Source.held(y, x.block_rows)
                 again.append(y.warnings[-1])
+            elif y is not None and len(y.warnings) > said[id(y)]:  # kept: the link parameters are off
+                again += y.warnings[said[id(y)]:]
             out[-1].append(x)
     return out[0], out[1] if select is not None else None, again
 

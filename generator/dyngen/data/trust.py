@@ -23,8 +23,11 @@ SCALE_RANGE = (1 / 3, 3.0)  # measured / model torque: beyond it no sensor gain 
 SCALE_EXPLAINS = 0.3  # ... when the model scaled by it leaves at most this share of the measured torque's RMS
 # (91 % of its power explained: torques reversed in time gave -0.61 on the LWR's joint 4, leaving 0.79)
 READING_CUTS, READING_SHARE = 0.1, 0.5  # a reading of the log in other conventions must cut the residual share so
+FIT_EXPLAINS = 0.25  # a rigid-body fit leaving at most this share of a joint's torque RMS explains it (94 % of its
+# power; torques reversed in time left 0.49 on the LWR's joint 4: 64 coefficients fit part of anything)
 MODEL_FLOOR = 1e-3  # joints whose model torque is below this share of the largest are not judged for a convention
 UNIT_ABOVE = 3.0  # a joint's measured torque this many times the arm's largest model torque is in other units
+ARM_UNIT = (0.1, 10.0)  # the whole arm's measured / model torque: beyond, a unit (no nominal model is this far off)
 KEEP = 1.1  # the highest cutoff whose mean squared residual share is within this factor of the best
 MIN_CUTOFF = 0.5  # Hz
 EXIT_UNUSABLE = 3  # `dyngen diagnose` and `identify` exit status when a recording's conditioning cannot be trusted
@@ -54,23 +57,24 @@ class Trial:
 
     @property
     def conventions(self) -> list[tuple[int, float]]:
-        """(0-based joint, factor) where the measured torque is the model's times a factor no sensor gain
-        has (a sign, a unit, a gear ratio), that factor explaining most of the measured torque. Judged
-        on joints whose model torque is above TORQUE_FLOOR of the largest: where it is smaller, a payload
-        alone can multiply it (a wrist's torque by 18, the `payload_tilt` case); there only a torque
-        beyond UNIT_ABOVE times the arm's largest model torque is a unit."""
+        """(0-based joint, factor) where the measured torque is the model's times a factor that sets the joint
+        apart from the rest of the arm by more than SCALE_RANGE (a sign, a unit, a gear ratio: link
+        parameters off by a common factor are not a convention), that factor explaining most of the
+        measured torque; or every such joint, where the arm's common factor is beyond ARM_UNIT (torques
+        logged in mNm). Judged on joints whose model torque is above TORQUE_FLOOR of the largest: where
+        it is smaller, a payload alone can multiply it (a wrist's by 18, the `payload_tilt` case); there
+        only a torque beyond UNIT_ABOVE times the arm's largest model torque is a unit."""
         if self.scale is None or not self.model.max() > 0:
             return []
-        lo, hi = SCALE_RANGE
         largest = float(self.model.max())
-        found = []
-        for j in range(self.scale.size):
-            k, explained = float(self.scale[j]), self.scaled[j] <= SCALE_EXPLAINS * self.torque[j]
-            if not explained or lo <= k <= hi or self.model[j] <= MODEL_FLOOR * largest:
-                continue
-            if self.model[j] > TORQUE_FLOOR * largest or self.torque[j] > UNIT_ABOVE * largest:
-                found.append((j, k))
-        return found
+        explained = self.scaled <= SCALE_EXPLAINS * self.torque
+        loaded = explained & (self.model > TORQUE_FLOOR * largest)
+        judged = explained & (self.model > MODEL_FLOOR * largest) & (loaded | (self.torque > UNIT_ABOVE * largest))
+        common = float(np.median(self.scale[loaded])) if loaded.any() else 1.0
+        lo, hi = SCALE_RANGE
+        if not ARM_UNIT[0] <= common <= ARM_UNIT[1]:
+            return [(int(j), float(self.scale[j])) for j in np.flatnonzero(judged)]
+        return [(int(j), float(self.scale[j])) for j in np.flatnonzero(judged) if not lo <= self.scale[j] / common <= hi]
 
     @property
     def share(self) -> float:
@@ -138,6 +142,40 @@ def _joints(js) -> str:
 
 
 def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=()) -> list:
+    """signals with any untrustworthy recording conditioned again; raises Unusable (see _checked).
+    Where the nominal residual is above the torque but a rigid-body fit of the data explains every such
+    joint (data/rigid_fit.py), the conditioning is sound and the link parameters are off: an
+    identification goes on with a warning (fixing them is its purpose), a diagnosis stops, its line
+    saying so."""
+    out, off = [], []
+    for sig in signals:
+        first = trial(model, s, sig, "as conditioned") if sig.tau is not None and sig.t.size >= 16 else None
+        if first is not None and first.above and not first.conventions and _explained(model, sig, first):
+            off.append((sig, first))
+            continue
+        out.append(sig)
+    if off and purpose != "identification":
+        sig, first = off[0]
+        raise Unusable(f"the data cannot support {PURPOSES[purpose][0]}: on {sig.name} the nominal link parameters are "
+                       f"far off ({_rms_pair(first)}), while a rigid-body fit of the data explains them: identify the "
+                       f"link parameters first (dyngen identify); {PURPOSES[purpose][1]}", [Untrusted(sig.name, [first])])
+    done = iter(_checked(model, s, out, purpose, as_recorded))
+    for sig, first in off:
+        sig.warnings.append(f"{sig.name}: the nominal link parameters leave a residual above the measured torque "
+                            f"({_rms_pair(first)}), while a rigid-body fit of the data explains it: the conditioning "
+                            "is sound, the link parameters are off")
+    offs = {id(sig) for sig, _ in off}
+    return [sig if id(sig) in offs else next(done) for sig in signals]
+
+
+def _explained(model, sig, first: Trial) -> bool:
+    from .rigid_fit import rigid_fit_residual
+
+    left = rigid_fit_residual(model, sig)
+    return all(left[j] <= FIT_EXPLAINS * first.torque[j] for j in first.above)
+
+
+def _checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=()) -> list:
     """signals with any untrustworthy recording conditioned again; raises Unusable (its line says
     that the data cannot support the `purpose`, a key of PURPOSES). as_recorded: (name, pieces)
     of recordings that cannot be conditioned again (read in blocks, their columns as recorded),
