@@ -26,8 +26,10 @@ def parser(prog="dyngen identify") -> argparse.ArgumentParser:
         "(eq. 10). Reports the regressor's condition number, every coefficient's standard deviation and "
         "the coefficients the data do not excite. Exit status 3, with nothing written: with --kind full (not --ols), "
         "a --data or --select recording on which the nominal model (--prior, else parameters.nominal) leaves a "
-        "residual over 1.5 times the measured torque on a joint under every conditioning tried, e.g. torques that "
-        "do not belong to the positions (docs/measured-data.md); errors in the input exit with 2."))
+        "residual over 1.5 times the measured torque on a joint under every conditioning tried (unless a rigid-body "
+        "fit of the data explains it: then the links are what is off, and identification goes on), e.g. torques that "
+        "do not belong to the positions, a joint's torque of the other sign or in other units, positions in "
+        "degrees (docs/measured-data.md); errors in the input exit with 2."))
     add_data_options(parser)
     add_arguments(parser.add_argument_group("identification"), Options)
     parser.add_argument("-o", "--output", metavar="FILE",
