@@ -26,8 +26,8 @@ from ..errors import InputError
 from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
-from .recording import (_check_time, _check_values, _header, _numbers, as_recording, check_header, csv_line,
-                        ragged_note, time_base, without_copies)
+from .as_written import ragged_note, without_ragged_ends
+from .recording import _check_time, _header, _numbers, as_recording, check_header, checked_rows, csv_line
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -44,30 +44,17 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
     where_header = "columns" if kind == "parquet" else "line 1 (header)"
     header = next(blocks)
     columns = check_header(name, header, dof, require_torques, required, where_header)
-    last, total, base, at_t = None, 0, None, columns["t"]
-    head = None
+    last, total, base, head = None, 0, None, None
     for start, data, where in blocks:
         if head is None:  # rows missing a value at the file's start are left out (at its end they are refused:
-            complete = ~np.isnan(data).any(axis=1)  # a block cannot know that no complete row follows)
-            head = int(np.argmax(complete)) if complete.any() else 0
-            data, start = data[head:], start + head
-        _check_values(name, header, data, lambda row: where(start + row), at_t)
-        data, copies, kept = without_copies(data, last)
+            data, head, _ = without_ragged_ends(data, end=False)  # a block cannot know that no complete row follows)
+            start += head
+        data, copies, base, last = checked_rows(name, header, columns["t"], data, lambda row: where(start + row),
+                                                last, base)  # base: the first block's origin and unit, for the file
         if not data.shape[0]:
             continue
-        raw = data[:, at_t]
-        joined = raw if last is None else np.r_[last[at_t], raw]
-        at = (lambda row: where(start + int(kept[row - (last is not None)])))
-        if joined.size >= 2:
-            _check_time(name, joined, at, increase_only=True)
-        base = base or time_base(raw)  # the first block's: one origin and unit for the file
-        origin, scale, note = base
-        if joined.size >= 2:
-            _check_time(name, (joined - origin) * scale, at)
-        last = data[-1].copy()
-        data[:, at_t] = (raw - origin) * scale
-        total += raw.size
-        said = "; ".join(x for x in (ragged_note(head, 0), note) if x) or None
+        total += data.shape[0]
+        said = "; ".join(x for x in (ragged_note(head, 0), base[2]) if x) or None
         yield dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, read_note=said)
     if total < 2:
         _check_time(name, np.zeros(total), csv_line)  # the whole-file reader's message

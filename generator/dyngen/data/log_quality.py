@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from .as_written import same_as_before
 from .recording import Recording
 
 UNEVEN = 0.01  # steps differing from the median by more than this share are not one grid
@@ -63,10 +64,7 @@ def repeated_rows(r: Recording) -> np.ndarray:
 
 def _repeats(data: np.ndarray, q: np.ndarray, before=None) -> tuple[np.ndarray, int]:
     """(repeats, the first row of a run at the end): a run counts when the row after it has other positions."""
-    same = np.zeros(data.shape[0], dtype=bool)
-    same[1:] = np.all(data[1:] == data[:-1], axis=1)
-    if before is not None and data.shape[0]:
-        same[0] = bool(np.all(data[0] == before))
+    same = same_as_before(data, before)
     other = np.flatnonzero(~same)  # rows that are no repeat of the row before
     end = int(other[-1]) + 1 if other.size else 0  # from here on, repeats with no row after them yet
     after = other[np.minimum(np.searchsorted(other, np.arange(end), side="right"), other.size - 1)]
@@ -87,10 +85,7 @@ class Streamed:
     def blocks(self, blocks):
         before, pending, name = None, None, ""
         for block in blocks:
-            self.report.repeated += block.copies  # left out at reading (data/recording.without_copies)
-            if block.read_note and not self.report.notes:
-                self.report.notes.append(block.read_note)
-                self.report.warnings.append(f"{block.name}: {block.read_note}")
+            _as_read(self.report, block, say=not self.report.notes)  # its note said once, by the first block
             name, r = block.name, (block if pending is None else _joined(pending, block))
             data = _all_columns(r)
             repeats, end = _repeats(data, r.q, before)
@@ -127,6 +122,15 @@ def _say_repeats(report: LogReport, name: str, kept: int) -> None:
                                    "while the arm moves (a logger writing one sample twice): left out")
 
 
+def _as_read(report: LogReport, r: Recording, say: bool = True) -> None:
+    """What reading did (data/as_written.py): rows that copied the row before, stamp included, counted with
+    the repeats; its note (rows missing values at the ends, stamps in ms, us, ns or Unix time) said."""
+    report.repeated += r.copies
+    if r.read_note and say:
+        report.notes.append(r.read_note)
+        report.warnings.append(f"{r.name}: {r.read_note}")
+
+
 def _joined(a: Recording, b: Recording) -> Recording:
     cat = (lambda x, y: None if x is None else np.concatenate([x, y]))
     return dataclasses.replace(b, t=cat(a.t, b.t), q=cat(a.q, b.q), tau=cat(a.tau, b.tau), qd=cat(a.qd, b.qd),
@@ -154,10 +158,8 @@ def _unheld(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogReport]:
     """regrid False: uneven stamps are kept (no filter follows; differences over uneven times are exact)."""
-    report = LogReport(repeated=r.copies)  # rows that copied the row before, stamp included, left out at reading
-    if r.read_note:  # rows missing values at the ends, stamps in ms, us, ns or Unix time (data/recording.py)
-        report.notes.append(r.read_note)
-        report.warnings.append(f"{r.name}: {r.read_note}")
+    report = LogReport()
+    _as_read(report, r)
     if r.t.size < 16:
         return r, report
     repeats = repeated_rows(r)

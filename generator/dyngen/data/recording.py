@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import InputError, printable, shorten
 from ..untrusted import MAX_CSV_BYTES, read_text
+from .as_written import ragged_note, time_base, without_copies, without_ragged_ends  # rows as loggers write them
 
 # No robot's time [s], position [rad, m], velocity, acceleration or torque [Nm] comes near this;
 # larger values (1e308) would overflow the least squares instead of naming the cell.
@@ -23,11 +24,6 @@ MAX_VALUE = 1e9
 # velocities from it would overflow. A column name is a short label; a row a few kB.
 MIN_STEP = 1e-6
 MAX_TIME = 1e19  # the time column may be a clock's absolute reading: nanoseconds since 1970 until 2286
-ABSOLUTE = 1e6  # a first stamp beyond this (11 days in seconds) is an absolute clock: t counted from it
-# A joint-torque log is written at 20 Hz to 20 kHz: a median step of 0.05 ms to 50 ms in seconds. Stamps in
-# ms, us or ns are found by the step that lands there; each range below leaves a gap to the one before
-# (a step of 0.05-0.2 "s" or 50-200 "ms" is read as it stands, not guessed).
-UNITS = (("s", 1.0, 5e-5, 0.05), ("ms", 1e-3, 0.2, 50.0), ("us", 1e-6, 200.0, 5e4), ("ns", 1e-9, 2e5, 5e7))
 MAX_NAME = 64
 MAX_COLUMNS = 4000  # the stacked inertia matrix of 40 joints has 820
 MAX_CELL = 64  # characters of one number
@@ -71,61 +67,34 @@ def csv_line(row: int) -> str:
 def from_columns(name, header, columns, data, dof, where=csv_line) -> Recording:
     """The Recording of a checked header and its (T, len(header)) values; `where(row)` names a row."""
     data, head, tail = without_ragged_ends(data)
-    _check_values(name, header, data, lambda row: where(head + row), columns["t"])
-    data, copies, kept = without_copies(data)
-    raw = data[:, columns["t"]]
-    _check_time(name, raw, lambda row: where(head + int(kept[row])), increase_only=True)
-    origin, scale, note = time_base(raw)
-    data[:, columns["t"]] = (raw - origin) * scale
-    _check_time(name, data[:, columns["t"]], lambda row: where(head + int(kept[row])))
-    said = "; ".join(x for x in (ragged_note(head, tail), note) if x) or None
+    data, copies, base, _ = checked_rows(name, header, columns["t"], data, lambda row: where(head + row))
+    if data.shape[0] < 2:
+        _check_time(name, data[:, columns["t"]], where)  # its message: too few samples
+    said = "; ".join(x for x in (ragged_note(head, tail), base[2]) if x) or None
     return dataclasses.replace(as_recording(name, columns, data, dof), copies=copies, read_note=said)
 
 
-def without_ragged_ends(data: np.ndarray) -> tuple[np.ndarray, int, int]:
-    """(data without the rows at its start and end that miss a value (NaN or an empty cell: a logger
-    writing before every column has one, or after one stopped), how many at the start, at the end).
-    A missing value between complete rows is left for the checks to name."""
-    complete = ~np.isnan(data).any(axis=1)
-    if not complete.any():
-        return data, 0, 0
-    first, last = int(np.argmax(complete)), data.shape[0] - int(np.argmax(complete[::-1]))
-    return data[first:last], first, data.shape[0] - last
-
-
-def ragged_note(head: int, tail: int) -> str | None:
-    if not head and not tail:
-        return None
-    return (f"{head} row(s) at the start and {tail} at the end miss a value (a logger writing before every column "
-            "had one, or after one stopped): left out")
-
-
-def time_base(t: np.ndarray) -> tuple[float, float, str | None]:
-    """(origin, scale, note): seconds from the start are (t - origin) * scale. An absolute clock's
-    stamps (Unix time) are counted from the first; stamps in ms, us or ns are found by their median
-    step (UNITS), and said in the note."""
-    origin = float(t[0]) if t.size and abs(float(t[0])) > ABSOLUTE else 0.0
-    step = float(np.median(np.diff(t))) if t.size >= 2 else 0.0
-    unit, scale = next(((u, k) for u, k, low, high in UNITS if low <= step <= high), ("s", 1.0))
-    said = []
-    if origin:
-        said.append(f"t starts at {origin:.6g} {unit} (an absolute clock): counted from the first row")
-    if unit != "s":
-        said.append(f"t read in {unit}: its median step {step:.3g} would be a {1 / step:.3g} Hz log in seconds, "
-                    f"{1 / (step * scale):.4g} Hz in {unit}")
-    return origin, scale, "; ".join(said) or None
-
-
-def without_copies(data: np.ndarray, before=None) -> tuple[np.ndarray, int, np.ndarray]:
-    """(data without the rows that copy the row before in every column, stamp included (a logger or an
-    export writing one message twice: they carry nothing), how many, the kept rows' indices in data).
-    `before`: the row before data's first (reading in blocks)."""
-    same = np.zeros(data.shape[0], dtype=bool)
-    same[1:] = np.all(data[1:] == data[:-1], axis=1)
-    if before is not None and data.shape[0]:
-        same[0] = bool(np.all(data[0] == before))
-    kept = np.flatnonzero(~same)
-    return data[kept], int(same.sum()), kept
+def checked_rows(name, header, at_t: int, data: np.ndarray, where, last=None, base=None):
+    """(data, copies, base, last) for the rows of a whole file or of one block of it: every value in
+    range, the rows that copy the row before left out (without_copies), time increasing as written,
+    then t in seconds from its origin (base: time_base of the file's first block, else of these rows),
+    by at least MIN_STEP. `last`: the row before data's first, as written (reading in blocks); the
+    same for the next block. `where(row)` names row `row` of data."""
+    _check_values(name, header, data, where, at_t)
+    data, copies, kept = without_copies(data, last)
+    if not data.shape[0]:
+        return data, copies, base, last
+    raw = data[:, at_t].copy()
+    joined = raw if last is None else np.r_[last[at_t], raw]
+    at = (lambda row: where(int(kept[row - (last is not None)])))
+    base = base or time_base(raw)
+    origin, scale, _ = base
+    if joined.size >= 2:
+        _check_time(name, joined, at, increase_only=True)
+        _check_time(name, (joined - origin) * scale, at)
+    last = data[-1].copy()
+    data[:, at_t] = (raw - origin) * scale
+    return data, copies, base, last
 
 
 def as_recording(name, columns, data, dof) -> Recording:

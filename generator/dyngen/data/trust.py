@@ -147,19 +147,20 @@ def checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=())
     joint (data/rigid_fit.py), the conditioning is sound and the link parameters are off: an
     identification goes on with a warning (fixing them is its purpose), a diagnosis stops, its line
     saying so."""
-    out, off = [], []
+    out, off, firsts = [], [], {}
     for sig in signals:
-        first = trial(model, s, sig, "as conditioned") if sig.tau is not None and sig.t.size >= 16 else None
-        if first is not None and first.above and not first.conventions and _explained(model, sig, first):
-            off.append((sig, first))
-            continue
+        if sig.tau is not None and sig.t.size >= 16:
+            firsts[id(sig)] = first = trial(model, s, sig, f"as conditioned ({sig.note})")
+            if first.above and not first.conventions and _explained(model, sig, first):
+                off.append((sig, first))
+                continue
         out.append(sig)
     if off and purpose != "identification":
         sig, first = off[0]
         raise Unusable(f"the data cannot support {PURPOSES[purpose][0]}: on {sig.name} the nominal link parameters are "
                        f"far off ({_rms_pair(first)}), while a rigid-body fit of the data explains them: identify the "
                        f"link parameters first (dyngen identify); {PURPOSES[purpose][1]}", [Untrusted(sig.name, [first])])
-    done = iter(_checked(model, s, out, purpose, as_recorded))
+    done = iter(_checked(model, s, out, firsts, purpose, as_recorded))
     for sig, first in off:
         sig.warnings.append(f"{sig.name}: the nominal link parameters leave a residual above the measured torque "
                             f"({_rms_pair(first)}), while a rigid-body fit of the data explains it: the conditioning "
@@ -175,17 +176,18 @@ def _explained(model, sig, first: Trial) -> bool:
     return all(left[j] <= FIT_EXPLAINS * first.torque[j] for j in first.above)
 
 
-def _checked(model, s, signals: list, purpose: str = "diagnosis", as_recorded=()) -> list:
+def _checked(model, s, signals: list, firsts: dict, purpose: str = "diagnosis", as_recorded=()) -> list:
     """signals with any untrustworthy recording conditioned again; raises Unusable (its line says
-    that the data cannot support the `purpose`, a key of PURPOSES). as_recorded: (name, pieces)
+    that the data cannot support the `purpose`, a key of PURPOSES). firsts: id(signals) -> its Trial
+    as conditioned (those without one are not judged). as_recorded: (name, pieces)
     of recordings that cannot be conditioned again (read in blocks, their columns as recorded),
     each judged over its conditioned pieces pooled."""
     out, failed = [], []
     for sig in signals:
-        if sig.tau is None or sig.t.size < 16:
+        first = firsts.get(id(sig))
+        if first is None:
             out.append(sig)
             continue
-        first = trial(model, s, sig, f"as conditioned ({sig.note})")
         named = _other_convention(model, s, sig, first) if first.above else None  # degrees, no gravity
         if named is None and first.conventions:
             named = _conventions(first.conventions)  # a sign, a unit, a gear
