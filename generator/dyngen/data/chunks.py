@@ -27,7 +27,8 @@ from ..untrusted import MAX_CSV_BYTES, MAX_RATIO, RATIO_FROM, regular_file
 from . import columnar
 from .reader import read_recording
 from .as_written import ragged_note, without_ragged_ends
-from .recording import _check_time, _header, _numbers, as_recording, check_header, checked_rows, csv_line
+from .recording import (MAX_COMMENTS, _check_time, _header, _numbers, as_recording, check_header, checked_rows,
+                        csv_line, header_of)
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -77,24 +78,29 @@ def _csv_blocks(path, rows: int):
             if b"\r" in head.removesuffix(b"\r\n"):  # old Mac line ends (CR alone): as the whole-file reader
                 lines_of = io.BytesIO((head + lines_of.read()).replace(b"\r\n", b"\n").replace(b"\r", b"\n"))
                 head = lines_of.readline()
-            header_line = _decoded([head], name, 1, 0, "utf-8-sig")
-            offset = len(head)
-            header = _header(name, header_line.rstrip("\r\n"))  # the whole-file reader's bounds and message
+            ahead = [head]  # comment lines above the header (recording.header_of), and the line after them
+            while len(ahead) <= MAX_COMMENTS and ahead[-1].lstrip().startswith(b"#"):
+                ahead.append(lines_of.readline())
+            text = _decoded(ahead, name, 1, 0, "utf-8-sig").split("\n")
+            header_line, used = header_of([line.rstrip("\r") for line in text[:len(ahead)]])
+            offset = sum(len(x) for x in ahead[:used])
+            header = _header(name, header_line, used)  # the whole-file reader's bounds and message
             yield header
-            first, start = 2, 0
+            first, start, pending = used + 1, 0, ahead[used:]
             while True:
-                chunk = list(islice(lines_of, rows))
+                chunk = pending + list(islice(lines_of, rows - len(pending)))
+                pending = []
                 if not chunk:
                     break
                 lines = _decoded(chunk, name, first, offset).splitlines(keepends=True)
                 offset += sum(len(x) for x in chunk)
                 if any(x.strip() for x in lines):
                     data = _block(lines, name, header, first)
-                    yield start, data, csv_line
+                    yield start, data, lambda row: f"line {row + used + 1}"
                     start += data.shape[0]
                 first += len(chunk)
             if start == 0:
-                raise InputError(name, "line 2", "no data rows after the header")
+                raise InputError(name, f"line {used + 1}", "no data rows after the header")
         except (OSError, EOFError, zlib.error) as err:
             raise InputError(name, "", f"not a readable gzip file ({err or 'truncated'})") from None
     finally:

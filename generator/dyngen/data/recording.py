@@ -27,6 +27,7 @@ MAX_TIME = 1e19  # the time column may be a clock's absolute reading: nanosecond
 MAX_NAME = 64
 MAX_COLUMNS = 4000  # the stacked inertia matrix of 40 joints has 820
 MAX_CELL = 64  # characters of one number
+MAX_COMMENTS = 100  # lines starting with '#' above the header
 
 _NUMBERED = re.compile(r"^(q|qd|qdd|tau)(\d+)$", re.ASCII)  # ASCII digits only: "q\u0661" is not q1
 
@@ -53,10 +54,33 @@ def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ())
     text = read_text(path, MAX_CSV_BYTES)  # UTF-8 (plain or .gz), bounded; else one line naming the file
     if "\r" in text:  # Windows (CR LF) and old Mac (CR alone) line ends are line ends
         text = text.replace("\r\n", "\n").replace("\r", "\n")
-    header_line, _, body = text.partition("\n")
-    header = _header(name, header_line)
-    columns = check_header(name, header, dof, require_torques, required, "line 1 (header)")
-    return from_columns(name, header, columns, _numbers(body, name, header), dof)
+    head = text.split("\n", MAX_COMMENTS + 1)
+    header_line, used = header_of(head)
+    header = _header(name, header_line, used)
+    columns = check_header(name, header, dof, require_torques, required, f"line {used} (header)")
+    return from_columns(name, header, columns, _numbers("\n".join(head[used:]), name, header, used + 1), dof,
+                        lambda row: f"line {row + used + 1}")
+
+
+def header_of(lines: list) -> tuple[str, int]:
+    """(the header line, lines up to the data) of a file's first lines. Lines starting with '#' above
+    the header are comments; where data follow them at once, the last is the header with its '#'
+    (numpy.savetxt writes `# t,q1,...`)."""
+    k = 0
+    while k < min(len(lines) - 1, MAX_COMMENTS) and lines[k].lstrip().startswith("#"):
+        k += 1
+    if k and _numeric(lines[k]):
+        return lines[k - 1].lstrip()[1:], k
+    return lines[k], k + 1
+
+
+def _numeric(line: str) -> bool:
+    first = line.split(",", 1)[0].strip()
+    try:
+        float(first)
+    except ValueError:
+        return False
+    return True
 
 
 def csv_line(row: int) -> str:
@@ -109,8 +133,8 @@ def as_recording(name, columns, data, dof) -> Recording:
     return Recording(name, t, block("q"), block("tau"), block("qd"), block("qdd"), extra)
 
 
-def _header(name, line: str) -> list[str]:
-    where = "line 1 (header)"
+def _header(name, line: str, number: int = 1) -> list[str]:
+    where = f"line {number} (header)"
     if len(line) > MAX_COLUMNS * (MAX_NAME + 1):
         raise InputError(name, where, f"{len(line)} characters; a header is a list of short column names")
     try:
@@ -131,6 +155,8 @@ def check_header(name, header, dof, require_torques=True, required=(), where="co
         raise InputError(name, where, "empty file; expected a header such as t, q1..qN, tau1..tauN")
     columns = {}
     for k, h in enumerate(header):
+        if not h and k == 0 and len(header) > 1:
+            continue  # a row index without a name (pandas' to_csv writes one): not read
         if not h:
             raise InputError(name, where, f"column {k + 1} has no name")
         if h in columns:
@@ -141,7 +167,8 @@ def check_header(name, header, dof, require_torques=True, required=(), where="co
         if sep is not None:
             raise InputError(name, where, f"one column named {shorten(header[0])!r}: the values are separated by "
                              f"{sep!r}, not commas (CSV here is comma-separated: t,q1,...,tau1,...)")
-        raise InputError(name, where, "no time column t")
+        named = ", ".join(h for h in header[:6] if h) + (", ..." if len(header) > 6 else "")
+        raise InputError(name, where, f"no time column t (expected t, q1..qN, tau1..tauN; the file has {shorten(named)})")
     found = {}
     for h in columns:
         m = _NUMBERED.match(h)
