@@ -135,18 +135,24 @@ def test_positions_in_degrees_or_torques_without_gravity_are_named(logs, tmp_pat
     assert len(lines) == 1 and f"on {bad.name} {says}" in lines[0], lines
 
 
+def _heavy(folder):
+    """The YAML of the LWR's nominal links three times too heavy (every mass and inertia)."""
+    from dyngen.data.parameters_file import read_link_parameters
+
+    p = read_link_parameters(LWR, 7).reshape(7, 10)
+    heavy = folder / "heavy.yaml"
+    heavy.write_text("links:\n" + "".join(f"  - {{m: {3 * float(r[0])!r}, c: [{', '.join(repr(float(x)) for x in r[1:4])}], "
+                                          f"I: [{', '.join(repr(3 * float(x)) for x in r[4:])}]}}\n" for r in p))
+    return heavy
+
+
 @pytest.mark.parametrize("command", ["identify", "diagnose"])
 def test_link_parameters_far_off_are_told_from_a_broken_log(logs, tmp_path, command):
     """The good log against links three times too heavy (every mass and inertia): the nominal residual is
     above the torque, and the model's torque three times the measured one, as a unit error would give;
     but a rigid-body fit of the data explains them. Identify, whose purpose it is, goes on with a
     warning; diagnose stops, saying to identify first. Before, identify refused the log as untrustworthy."""
-    from dyngen.data.parameters_file import read_link_parameters
-
-    p = read_link_parameters(LWR, 7).reshape(7, 10)
-    heavy = tmp_path / "heavy.yaml"
-    heavy.write_text("links:\n" + "".join(f"  - {{m: {3 * float(r[0])!r}, c: [{', '.join(repr(float(x)) for x in r[1:4])}], "
-                                          f"I: [{', '.join(repr(3 * float(x)) for x in r[4:])}]}}\n" for r in p))
+    heavy = _heavy(tmp_path)
     out = tmp_path / "out"
     if command == "identify":
         done = identify(out, "--data", logs["good"], "--prior", heavy)
@@ -172,3 +178,25 @@ def test_every_torque_in_mnm_is_named(logs, tmp_path):
     done = identify(tmp_path / "out", "--data", bad)
     assert done.returncode == 3, done.stderr
     assert "joint 2's measured torque is 1e+03 x the nominal model's (a unit or a gear" in done.stderr
+
+
+@pytest.mark.parametrize("kind", [["--ols"], ["--kind", "gravity"]])
+def test_least_squares_makes_the_same_check(logs, tmp_path, kind):
+    """`--ols` and `--kind gravity` (least squares, recordings in blocks) judge each recording on its
+    windows as the least squares conditions them: the log whose torques do not belong to its positions
+    stops them (exit 3, one line, nothing written), links three times too heavy give the warning and
+    the fit, and the good log is fitted without a word. Before, they fitted the first without a word."""
+    out = tmp_path / "out"
+    done = identify(out, "--data", logs["swapped"], *kind)
+    assert done.returncode == 3, done.stderr
+    lines = [x for x in done.stderr.splitlines() if x.strip()]
+    assert len(lines) == 1 and lines[0].startswith("dyngen identify: the data cannot support an identification: "
+                                                   "on swapped.csv"), lines
+    assert not out.exists() and done.stdout == ""
+    done = identify(out, "--data", logs["good"], *kind)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    heavy = _heavy(tmp_path)
+    done = identify(tmp_path / "heavy", "--data", logs["good"], "--prior", heavy, *kind)
+    assert done.returncode == 0, done.stderr
+    assert "the conditioning is sound, the link parameters are off" in done.stderr
+    assert (tmp_path / "heavy" / "identified.yaml").is_file()

@@ -24,7 +24,7 @@ def parser(prog="dyngen identify") -> argparse.ArgumentParser:
         "trajectories (Y(q, qd, qdd) pi = tau); gravity reads the torques as gravity torques g(q) (static "
         "poses or the FRI's g(q), eq. 9); inertia reads the stacked inertia matrix from columns M11, M12, ... "
         "(eq. 10). Reports the regressor's condition number, every coefficient's standard deviation and "
-        "the coefficients the data do not excite. Exit status 3, with nothing written: with --kind full (not --ols), "
+        "the coefficients the data do not excite. Exit status 3, with nothing written (every kind but inertia): "
         "a --data or --select recording on which the nominal model (--prior, else parameters.nominal) leaves a "
         "residual over 1.5 times the measured torque on a joint under every conditioning tried (unless a rigid-body "
         "fit of the data explains it: then the links are what is off, and identification goes on), e.g. torques that "
