@@ -29,7 +29,8 @@ def regressor_rows(model, kind: str, q, qd, qdd, tau, extra) -> tuple[np.ndarray
 
 
 def identify(model, signals: list, kind: str) -> Estimate:
-    """The least-squares fit of every sample, folded into per-joint triangular factors as --ols folds blocks."""
+    """The least-squares fit of every sample that is data (Signals.inner), folded into per-joint triangular
+    factors as --ols folds blocks."""
     if kind not in REGRESSOR:
         raise ValueError(f"unknown kind {kind!r}; expected one of {', '.join(REGRESSOR)}")
     names = [e["standard"] for e in model.manifest["coefficients"][kind]["expressions"]]
@@ -41,7 +42,9 @@ def identify(model, signals: list, kind: str) -> Estimate:
             if missing:
                 raise InputError(s.name, "line 1 (header)", f"missing column(s) {', '.join(missing)} "
                                  "(stacked inertia matrix, needed for --kind inertia)")
-        Y, b = regressor_rows(model, kind, s.q, s.qd, s.qdd, s.tau, s.extra)
+        keep = s.inner()  # not the filter's start-up at the ends
+        Y, b = regressor_rows(model, kind, s.q[keep], s.qd[keep], s.qdd[keep], None if s.tau is None else s.tau[keep],
+                              {k: v[keep] for k, v in s.extra.items()})
         factors = factors or Triangular(Y.shape[-1], Y.shape[1])
         factors.add(Y, b)
     rows = int(factors.rows.sum())
