@@ -15,6 +15,7 @@ HEAVY_TAILS = 1.5  # the spectrum's noise is used when it exceeds the robust est
 NO_FILTER_NOISE = 1e-12  # rad: positions this clean are differentiated without a filter
 BAND_FROM = 0.25  # of the sampling rate: the band whose median power is the spectral noise floor (up to 0.5)
 MEDIAN_OF_CHI2_2 = np.log(2.0)  # median / mean of a periodogram bin (chi-square, 2 degrees of freedom)
+COLOURED = 2.0  # noise between twice the cutoff and the decision's band this many times its sigma: not white
 
 
 @dataclass(frozen=True)
@@ -50,6 +51,26 @@ def spectral_noise(q: np.ndarray) -> np.ndarray:
     band = (f >= BAND_FROM) & (f > 0)
     shape = (2.0 * np.sin(np.pi * f[band])) ** 6
     return np.sqrt(np.median(power[band] / shape[:, None], axis=0) / MEDIAN_OF_CHI2_2)
+
+
+def coloured(q: np.ndarray, rate: float, cutoff: float, sigma: np.ndarray) -> bool:
+    """Whether the noise of q (positions, or recorded velocities) between twice the cutoff and the
+    band that position_noise measures (BAND_FROM of the rate) exceeds COLOURED times the white
+    noise sigma found there, on most joints: no motion reaches that band, so it is noise the cutoff
+    decision did not allow for (a polling logger's late stamps, made a regular grid, hold it below
+    the upper band), and the accelerations carry more of it than the cutoff was chosen for. A
+    model's torque formed of them carries it beyond the cutoff, where the filtered torque has
+    none: that torque is filtered alike (a second pass then removes noise, not the motion's steps)."""
+    x = np.diff(np.asarray(q, dtype=float), n=3, axis=0)
+    f = np.fft.rfftfreq(x.shape[0], 1.0 / rate)
+    band = (f >= 2.0 * cutoff) & (f < BAND_FROM * rate)
+    if np.count_nonzero(band) < 16:
+        return False
+    window = np.hanning(x.shape[0])
+    power = np.abs(np.fft.rfft((x - x.mean(axis=0)) * window[:, None], axis=0)[band]) ** 2 / np.sum(window ** 2)
+    shape = (2.0 * np.sin(np.pi * f[band] / rate)) ** 6
+    found = np.sqrt(np.median(power / shape[:, None], axis=0) / MEDIAN_OF_CHI2_2)
+    return bool(np.median(found / np.maximum(sigma, 1e-300)) > COLOURED)
 
 
 def acceleration_noise(sigma_q, cutoff: float, rate: float, order: int = 2) -> np.ndarray:

@@ -66,6 +66,7 @@ class Signals:
     log: object = None  # log_quality.LogReport: what was done to the rows and stamps as written
     source: object = None  # the Recording as read and the Conditioning used (to condition it again)
     options: object = None
+    model_filtered: bool = False  # the models' torques pass through lowpass too (automatic.coloured)
 
     @property
     def rate(self) -> float:
@@ -138,6 +139,8 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     out.log, out.source, out.options = log, recording, options
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
+        out.model_filtered = cutoff is not None and automatic.coloured(r.q if differentiate else r.qd, rate, cutoff,
+                                                                       decision.q_noise)
         if cutoff is not None and decision.band > 0 and cutoff < 2 * decision.band:
             out.warnings.append(f"{r.name}: {'position' if differentiate else 'velocity'} noise ({_sigma(decision.q_noise)})"
                                 f" allows a cutoff of only {cutoff:.3g} Hz, below twice the motion's band "

@@ -95,7 +95,7 @@ def columns_of(effect, context, segment, joint=None) -> np.ndarray:
             signals = dataclasses.replace(signals, **late, extra={})
             tau_model = delayed(tau_model, signals.t, delay)
         x = np.asarray(effect.columns(context, signals, tau_model), float)
-        x = signals.filtered(x) if effect.switching else x
+        x = signals.filtered(x) if effect.switching or (signals.model_filtered and not effect.sensor) else x
         x = delayed(x, signals.t, delay) if delay and not effect.switching else x
         if part:
             out = np.zeros((x.shape[0], segment.residual.shape[1], x.shape[2]))

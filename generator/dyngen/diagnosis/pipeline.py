@@ -25,6 +25,9 @@ from .record import CandidateGain, Diagnosis, RecordingNote, Unstable
 from .refine import restricted
 from .settle import settle
 
+ALIKE = ("; the model's torques filtered alike (the positions' noise above twice the cutoff exceeds twice its white "
+         "estimate: the accelerations carry more noise than the cutoff allowed for)")
+
 
 def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options = Options(),
              test=None) -> Diagnosis:
@@ -247,5 +250,6 @@ def _result(robot, model, s, split, selection, settled, choice, final, judged, j
         within_fit_speeds=judged.within_fit_speeds, completed=completed,
         consistent=None if reid is None else reidentify.finding(reid, [j for j in range(n) if modes[j] == joints.CONSISTENT]),
         reidentified=reid,
-        conditioning=[RecordingNote(sig.name, role, sig.note, sig.trim) for role, group in roles_of for sig in group],
+        conditioning=[RecordingNote(sig.name, role, sig.note + ALIKE * sig.model_filtered, sig.trim)
+                      for role, group in roles_of for sig in group],
         warnings=apart)

@@ -33,9 +33,11 @@ def segments(model, s, fit_signals, select_signals, test_signals, block_seconds:
     out = []
 
     def segment(sig, fit, select, test, groups=None):
-        # The filtered motion's torque is the filtered torque's model (filtering it again
-        # would smooth twice what the recording smoothed once).
+        # The filtered motion's torque is the filtered torque's model (filtering it again would smooth
+        # twice what the recording smoothed once), unless the positions' noise is not the white noise the
+        # cutoff was chosen for (Signals.model_filtered, automatic.coloured): then it is filtered alike.
         tau_model = model.batch(RNEA.name, sig.q, sig.qd, sig.qdd, s)
+        tau_model = sig.filtered(tau_model) if sig.model_filtered else tau_model
         return Segment(sig, tau_model, sig.tau - tau_model, fit, select, test, groups=groups)
 
     none = lambda sig: np.zeros(sig.t.size, dtype=bool)  # noqa: E731
