@@ -54,7 +54,10 @@ def test_joint_count_mismatch(tmp_path):
 def test_non_monotonic_time(tmp_path):
     rows = good_rows()
     rows[3][0] = rows[2][0]
-    assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 5, column t: time does not increase (0.02 after 0.02)"
+    assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 5, column t: time does not increase (0.02 after " \
+        "0.02); rows with other values share the stamp: was the time written with too few digits?"
+    rows[3][0] = 0.015
+    assert error_of(write(tmp_path, HEADER, rows)) == "run.csv: line 5, column t: time does not increase (0.015 after 0.02)"
 
 
 def test_nan_and_text(tmp_path):

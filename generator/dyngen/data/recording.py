@@ -255,7 +255,9 @@ def _check_time(name, t, where=csv_line, increase_only: bool = False) -> None:
     if t.size < 2:
         raise InputError(name, "column t", f"{t.size} sample(s); at least 2 are needed")
     steps = np.diff(t)
-    checks = ((steps <= 0, lambda k: f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})"),
+    checks = ((steps <= 0, lambda k: f"time does not increase ({float(t[k + 1])!r} after {float(t[k])!r})" + (
+                  "; rows with other values share the stamp: was the time written with too few digits?"
+                  if steps[k] == 0 else "")),
               (steps < MIN_STEP, lambda k: f"a time step of {float(steps[k]):.3g} s (at least {MIN_STEP:g} s: "
                                            "no sensor samples faster than 1 MHz)"))
     for bad, what in checks[:1] if increase_only else checks:
