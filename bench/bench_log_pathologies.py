@@ -55,6 +55,7 @@ LOGS = {
     "1k-dropped": (1000.0, Encoder(), "dropped"),
     "1k-jittered": (1000.0, Encoder(), "jittered"),
     "1k-held": (1000.0, Encoder(), "held"),
+    "1k-glitched": (1000.0, Encoder(), "glitched"),
     "100Hz-17bit": (100.0, Encoder(noise=5e-5, bits=17), None),
     "100Hz-17bit-repeated": (100.0, Encoder(noise=5e-5, bits=17), "repeated"),
     "100Hz-17bit-dropped": (100.0, Encoder(noise=5e-5, bits=17), "dropped"),

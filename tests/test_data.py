@@ -285,3 +285,38 @@ def test_headers_as_common_writers_make_them(tmp_path, layout):
     assert error_of(path).startswith(f"run.csv: line {bad}, column tau2: not a number")
     with pytest.raises(InputError, match=f"line {bad}, column tau2"):
         list(chunks(path, N, rows=8))
+
+
+def test_a_bus_s_errors_are_repaired_on_the_real_lwr4_log(tmp_path):
+    """The real LWR4+ log with positions only, then with five positions (0.1 rad) and five torques (200 Nm)
+    wrong for one row each and joint 1's angle logged in [0, 2 pi): the conditioning is the clean log's
+    (same automatic cutoff; positions and torques within the encoder's and the filter's rounding), and
+    a warning counts the spikes and names the wrapped joint. Before, the spikes made the position
+    noise 0.004 rad and the cutoff 0.6 Hz (40 Hz clean), and the wrap made the log unusable."""
+    from conftest import ROOT
+
+    header, *lines = (ROOT / "examples" / "lwr4-real" / "measurement_1.csv").read_text().splitlines()
+    names = header.split(",")
+    keep = [0] + [names.index(f"{p}{j}") for p in ("q", "tau") for j in range(1, 8)]
+    data = np.array([[float(x) for x in line.split(",")] for line in lines])[:, keep]
+    head = ",".join(names[k] for k in keep)
+
+    def written(name, d):
+        path = tmp_path / name
+        path.write_text(head + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in d) + "\n")
+        return condition(read_recording(path, 7))
+
+    clean = written("clean.csv", data)
+    bad = data.copy()
+    rows = np.random.default_rng(0).choice(np.arange(100, data.shape[0] - 100), 10, replace=False)
+    bad[rows[:5], 3] += 0.1  # q3
+    bad[rows[5:], 9] -= 200.0  # tau2
+    bad[:, 1] = np.mod(bad[:, 1], 2 * np.pi)  # q1 crosses 0: it wraps
+    sig = written("glitched.csv", bad)
+    assert sig.cutoff == pytest.approx(clean.cutoff, rel=1e-6) and clean.cutoff > 10
+    inner = clean.inner()
+    assert np.max(np.abs(np.mod(sig.q - clean.q + np.pi, 2 * np.pi) - np.pi)[inner]) < 1e-4
+    assert np.max(np.abs(sig.tau - clean.tau)[inner]) < 0.05 * np.max(np.abs(clean.tau))
+    said = " ".join(sig.warnings)
+    assert "5 spike(s) in q (joint(s) 3" in said and "5 spike(s) in tau (joint(s) 2" in said
+    assert "positions of joint(s) 1 wrap around a full turn" in said

@@ -7,7 +7,8 @@ judgement of a diagnosis on them.
 PATHOLOGIES name logger.py's transformations with the shares the issue measured on real logs
 (franka_ros: 5.5 % repeated rows; steps of 0.7-8.8 ms at 1 kHz): repeated rows, a polling
 logger on its own jittered clock (repeated, dropped and late rows at once), 5 % dropped samples,
-stamps late by up to 0.4 ms, torques updated at a tenth of the rate. Each file's seed is its
+stamps late by up to 0.4 ms, torques updated at a tenth of the rate, a bus's errors (one wrong
+position or torque in a thousand rows, an angle logged in [0, 2 pi)). Each file's seed is its
 name's length, so a variant folder is the same every time.
 """
 
@@ -26,6 +27,7 @@ PATHOLOGIES = {
     "dropped": lambda text, seed: logger.dropped(text, 0.05, seed),
     "jittered": lambda text, seed: logger.jittered(text, 0.4e-3, seed),
     "held": lambda text, seed: logger.held(text, "tau", 10),
+    "glitched": lambda text, seed: logger.glitched(text, seed),
 }
 
 TORQUE_SHARE = 0.05  # joints carrying less torque RMS than this share of the largest are not judged

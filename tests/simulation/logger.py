@@ -93,6 +93,23 @@ def polled(text: str, seed: int, jitter: float = 0.3, stall_share: float = 0.01,
     return unparse(header, rows)
 
 
+def glitched(text: str, seed: int, share: float = 0.001) -> str:
+    """A sensor bus's errors: with probability `share` per row one position (off by 0.05-0.5 rad) or one
+    torque (off by 20-200 Nm) wrong for that row alone, and joint 1's angle logged in [0, 2 pi)."""
+    header, data = parse(text)
+    names = header.split(",")
+    q = [k for k, n in enumerate(names) if n[:1] == "q" and n[1:].isdigit()]
+    tau = [k for k, n in enumerate(names) if n.startswith("tau") and n[3:].isdigit()]
+    rng = np.random.default_rng(seed)
+    data = data.copy()
+    for row in np.flatnonzero(rng.random(data.shape[0]) < share)[1:]:
+        position = rng.random() < 0.5
+        column = rng.choice(q if position else tau)
+        data[row, column] += rng.choice([-1.0, 1.0]) * rng.uniform(*((0.05, 0.5) if position else (20.0, 200.0)))
+    data[:, q[0]] = np.mod(data[:, q[0]], 2.0 * np.pi)
+    return unparse(header, data)
+
+
 def held(text: str, prefix: str, every: int) -> str:
     """Columns `prefix`1.. (e.g. "tau") updated only every `every`-th row, held in between."""
     header, data = parse(text)

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from . import glitches
 from .as_written import same_as_before
 from .recording import Recording
 
@@ -167,6 +168,9 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
         report.repeated += int(repeats.sum())
         r = _mapped(r, r.t[~repeats], lambda x: x[~repeats])
     _say_repeats(report, r.name, r.t.size)
+    r, found = glitches.repaired(r)  # wrapped angles, spikes: before held columns and the clock look at the rows
+    report.notes += found
+    report.warnings += [f"{r.name}: {x}" for x in found]
     held = held_blocks(r)
     for name, every in held.items():
         setattr(r, name, _unheld(r.t, getattr(r, name)))
