@@ -85,11 +85,20 @@ class Signals:
                                    tau=None if self.tau is None else self.tau[:, one], extra={})
 
     def inner(self) -> np.ndarray:
-        """Boolean (T,): the samples that are data (not the filter's start-up)."""
-        keep = np.ones(self.t.size, dtype=bool)
+        """Boolean (T,): the samples that are data (not the filter's start-up, nor in_gaps)."""
+        keep = ~self.in_gaps()
         if self.trim:
             keep[:self.trim] = keep[-self.trim:] = False
         return keep
+
+    def in_gaps(self) -> np.ndarray:
+        """Boolean (T,): the samples interpolated in a long gap of the stamps (log_quality.LogReport.gaps),
+        and `trim` samples either side (the filter's reach, as at the ends): made for the filter only."""
+        out = np.zeros(self.t.size, dtype=bool)
+        for a, b in getattr(self.log, "gaps", ()):
+            first, end = np.searchsorted(self.t, a, side="right"), np.searchsorted(self.t, b, side="left")
+            out[max(first - self.trim, 0):end + self.trim] = True
+        return out
 
 
 def condition(recording: Recording, options: Conditioning = Conditioning()) -> Signals:
@@ -135,6 +144,10 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     if log.notes:
         out.note = "; ".join(log.notes) + f"; {out.note}"
         out.warnings.extend(log.warnings)
+    for a, b in log.gaps:
+        out.warnings.append(f"{r.name}: a gap of {b - a:.3g} s in the stamps ({(b - a) * rate:.0f} steps, at "
+                            f"{a - r.t[0]:.4g} s): interpolated for the filter only; those samples and "
+                            f"{trim / rate:.2g} s either side are not used as data")
     out.log, out.source, out.options = log, recording, options
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band

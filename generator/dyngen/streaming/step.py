@@ -18,6 +18,8 @@ import functools
 import itertools
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..identification.samples import regressor_rows
 from ..identification.triangular import Triangular
 
@@ -88,8 +90,9 @@ def run(task: Task) -> Sums:
     blocks.close()
     s = condition(read_recording(task.path, task.dof, need_tau, task.required, task.effort_topic),
                   task.conditioning)
-    for a in range(0, s.t.size, task.rows):
-        cut = slice(a, a + task.rows)
+    rows = np.flatnonzero(~s.in_gaps())  # samples interpolated in a long gap of the stamps are not data
+    for a in range(0, rows.size, task.rows):
+        cut = rows[a:a + task.rows]
         add(s.q[cut], s.qd[cut], s.qdd[cut], None if s.tau is None else s.tau[cut],
             {k: v[cut] for k, v in s.extra.items()})
     return Sums(s.name, factors, samples, s.note, False, list(s.warnings))
