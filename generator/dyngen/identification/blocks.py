@@ -179,13 +179,16 @@ def _tapped(blocks, tap):
         yield block
 
 
-def _kept(signals) -> np.ndarray:
-    """Boolean (T,): the data samples (Signals.inner: not the filter's start-up at the ends, nor the samples
-    interpolated in a long gap of the stamps with the filter's reach around it). Where a gap is left out,
-    the samples either side of it follow each other in a block: what is computed along the time (the
-    Coulomb column's lag) is computed on the whole recording first; the residuals' correlation time and
-    batch means (statistics.py) see one join, as between two recordings."""
-    return signals.inner()
+def _kept(signals):
+    """The data samples (Signals.inner: not the filter's start-up at the ends, nor the samples interpolated
+    in a long gap of the stamps with the filter's reach around it): a slice where they are contiguous (views,
+    as the arithmetic has always seen them), else a boolean mask. Where a gap is left out, the samples
+    either side of it follow each other in a block: what is computed along the time (the Coulomb column's
+    lag) is computed on the whole recording first; the residuals' correlation time and batch means
+    (statistics.py) see one join in a series of thousands of samples."""
+    keep = signals.inner()
+    k = np.flatnonzero(keep)
+    return slice(int(k[0]), int(k[-1]) + 1) if k.size and k[-1] - k[0] + 1 == k.size else keep
 
 
 class Blocks:

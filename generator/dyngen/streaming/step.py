@@ -92,7 +92,7 @@ def run(task: Task) -> Sums:
                   task.conditioning)
     rows = np.flatnonzero(~s.in_gaps())  # samples interpolated in a long gap of the stamps are not data
     for a in range(0, rows.size, task.rows):
-        cut = rows[a:a + task.rows]
+        cut = rows[a:a + task.rows] if rows.size < s.t.size else slice(a, a + task.rows)  # a view, as always
         add(s.q[cut], s.qd[cut], s.qdd[cut], None if s.tau is None else s.tau[cut],
             {k: v[cut] for k, v in s.extra.items()})
     return Sums(s.name, factors, samples, s.note, False, list(s.warnings))
