@@ -26,18 +26,20 @@ class Decision:
     band: float  # Hz: 99 % of the motion's velocity power lies below
 
 
-def position_noise(q: np.ndarray) -> np.ndarray:
-    """Per joint white-noise sigma of q from robust third differences, or the spectrum's where larger."""
+def position_noise(q: np.ndarray, rows=None) -> np.ndarray:
+    """Per joint white-noise sigma of q from robust third differences, or the spectrum's where larger.
+    rows: boolean (T - 3,), the third differences of data samples alone (None: all; see decide)."""
     if q.shape[0] < 8:
         return np.zeros(q.shape[1])
     d3 = np.diff(q, n=3, axis=0)
+    d3 = d3 if rows is None else d3[rows]
     mad = np.median(np.abs(d3 - np.median(d3, axis=0)), axis=0)
     robust = 1.4826 * mad / np.sqrt(20.0)
-    broadband = spectral_noise(q)
+    broadband = spectral_noise(q, rows)
     return np.where(broadband > HEAVY_TAILS * robust, broadband, robust)
 
 
-def spectral_noise(q: np.ndarray) -> np.ndarray:
+def spectral_noise(q: np.ndarray, rows=None) -> np.ndarray:
     """Per joint sigma of the broadband position errors, which a robust scale does not see (a
     logger's late samples sit qd * delay off the motion on a few per cent of the rows): for white
     noise of sigma the third difference's power density is sigma^2 (2 sin(pi f / fs))^6, so its
@@ -46,7 +48,11 @@ def spectral_noise(q: np.ndarray) -> np.ndarray:
     if x.shape[0] < 64:
         return np.zeros(q.shape[1])
     window = np.hanning(x.shape[0])
-    power = np.abs(np.fft.rfft((x - x.mean(axis=0)) * window[:, None], axis=0)) ** 2 / np.sum(window ** 2)
+    if rows is None:
+        power = np.abs(np.fft.rfft((x - x.mean(axis=0)) * window[:, None], axis=0)) ** 2 / np.sum(window ** 2)
+    else:  # the other rows zero: the power of white noise is its sigma^2 times the window's weight on the rows
+        x = np.where(rows[:, None], x - x[rows].mean(axis=0), 0.0)
+        power = np.abs(np.fft.rfft(x * window[:, None], axis=0)) ** 2 / np.sum(window[rows] ** 2)
     f = np.fft.rfftfreq(x.shape[0])  # cycles per sample
     band = (f >= BAND_FROM) & (f > 0)
     shape = (2.0 * np.sin(np.pi * f[band])) ** 6
@@ -87,10 +93,13 @@ def motion_band(qd: np.ndarray, rate: float) -> float:
     return 0.0 if cumulative[-1] <= 0 else float(f[min(np.searchsorted(cumulative, 0.99 * cumulative[-1]), f.size - 1)])
 
 
-def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision:
-    """lowpass_of(cutoff) -> a filter along time; order 1: q are recorded velocities, differentiated once."""
+def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2, data=None) -> Decision:
+    """lowpass_of(cutoff) -> a filter along time; order 1: q are recorded velocities, differentiated once.
+    data: boolean (T,), the samples that are data (None: all): the noise and the acceleration are
+    measured on them alone, not on samples interpolated in a gap of the stamps (smooth: no noise)."""
     rate = 1.0 / float(np.median(np.diff(t)))
-    sigma = position_noise(q)
+    rows = None if data is None else data[:-3] & data[1:-2] & data[2:-1] & data[3:]
+    sigma = position_noise(q, rows)
 
     def derivatives(x):
         qd = np.gradient(x, t, axis=0) if order == 2 else x
@@ -102,7 +111,7 @@ def decide(t: np.ndarray, q: np.ndarray, lowpass_of, order: int = 2) -> Decision
     cutoff = rate / 20
     for _ in range(6):  # converges in two or three steps: the RMS changes slowly with the cutoff
         qdd = derivatives(lowpass_of(cutoff)(q))[1]
-        measured = float(np.mean(qdd ** 2))
+        measured = float(np.mean(qdd ** 2)) if data is None else float(np.mean(qdd[data] ** 2))
         signal = np.sqrt(max(measured - float(np.mean(acceleration_noise(sigma, cutoff, rate, order) ** 2)), 0.0))
         # the largest fc with noise(fc) <= NOISE_SHARE * signal
         target = NOISE_SHARE * max(signal, 1e-12)

@@ -23,6 +23,7 @@ EDGE_PERIODS = 1.0  # trimmed at each end: this many periods of the cutoff (the 
 PAD_PERIODS = 2.0  # the recording is continued this many periods of the cutoff before filtering
 VELOCITY_AGREES = (0.8, 1.25)  # recorded qd / the positions' derivative; beyond: another unit, sign or gear side
 VELOCITY_EXPLAINED = 0.3  # ... when that factor leaves at most this share of the recorded qd's RMS
+MIN_DATA = 16  # samples of data that long gaps in the stamps must leave (Signals.in_gaps)
 
 
 def cutoff_of(text: str):
@@ -86,11 +87,25 @@ class Signals:
                                    tau=None if self.tau is None else self.tau[:, one], extra={})
 
     def inner(self) -> np.ndarray:
-        """Boolean (T,): the samples that are data (not the filter's start-up)."""
-        keep = np.ones(self.t.size, dtype=bool)
+        """Boolean (T,): the samples that are data (not the filter's start-up, nor in_gaps)."""
+        keep = ~self.in_gaps()
         if self.trim:
             keep[:self.trim] = keep[-self.trim:] = False
         return keep
+
+    def in_gaps(self) -> np.ndarray:
+        """Boolean (T,): the samples interpolated in a long gap of the stamps (log_quality.LogReport.gaps),
+        and `trim` samples either side (the filter's reach, as at the ends): made for the filter only."""
+        return _in_gaps(self.t, getattr(self.log, "gaps", ()), self.trim)
+
+
+def _in_gaps(t: np.ndarray, gaps, reach: int) -> np.ndarray:
+    """Boolean (T,): samples strictly inside each (start, end) of gaps, and `reach` samples either side."""
+    out = np.zeros(t.size, dtype=bool)
+    for a, b in gaps:
+        first, end = np.searchsorted(t, a, side="right"), np.searchsorted(t, b, side="left")
+        out[max(first - reach, 0):end + reach] = True
+    return out
 
 
 def condition(recording: Recording, options: Conditioning = Conditioning()) -> Signals:
@@ -111,7 +126,8 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
             raise InputError(r.name, "cutoff", f"{cutoff!r}: expected a frequency in Hz or {AUTO!r}")
         if differentiate or r.qdd is None:  # q differentiated twice, or recorded qd once: a cutoff from its noise
             decision = automatic.decide(r.t, r.q if differentiate else r.qd,
-                                        lambda fc: _lowpass(r.name, rate, fc, options.order), 2 if differentiate else 1)
+                                        lambda fc: _lowpass(r.name, rate, fc, options.order), 2 if differentiate else 1,
+                                        ~_in_gaps(r.t, log.gaps, 0) if log.gaps else None)
             cutoff = decision.cutoff
         else:
             cutoff = None  # the recording's own velocities: nothing to differentiate, nothing to filter
@@ -136,7 +152,15 @@ def condition(recording: Recording, options: Conditioning = Conditioning()) -> S
     if log.notes:
         out.note = "; ".join(log.notes) + f"; {out.note}"
         out.warnings.extend(log.warnings)
+    for a, b in log.gaps:
+        out.warnings.append(f"{r.name}: a gap of {b - a:.3g} s in the stamps ({(b - a) * rate:.0f} steps, at "
+                            f"{a - r.t[0]:.4g} s): interpolated for the filter only; those samples and "
+                            f"{trim / rate:.2g} s either side are not used as data")
     out.log, out.source, out.options = log, recording, options
+    if log.gaps and np.count_nonzero(out.inner()) < MIN_DATA:
+        raise InputError(r.name, "column t", f"{len(log.gaps)} long gap(s) in the stamps (up to {log.longest_gap:.3g} s) "
+                         f"leave {np.count_nonzero(out.inner())} samples of data, fewer than {MIN_DATA}: the samples "
+                         "interpolated in a gap, and the filter's reach around it, are not data")
     if decision is not None:
         out.q_noise, out.qdd_noise, out.band = decision.q_noise, decision.qdd_noise, decision.band
         out.model_filtered = cutoff is not None and automatic.coloured(r.q if differentiate else r.qd, rate, cutoff,

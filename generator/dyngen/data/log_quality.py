@@ -18,7 +18,7 @@ from .recording import Recording
 
 UNEVEN = 0.01  # steps differing from the median by more than this share are not one grid
 HELD_MEDIAN = 2  # a block whose updates are this many rows apart (median) is at a lower rate
-LONG_GAP = 10  # warn when interpolation fills a gap of more than this many steps
+LONG_GAP = 10  # a step of more than this many is a gap: filled for the filter, its samples not data (Signals.inner)
 REPEATS_WORTH_SAYING = 0.001  # share of rows
 JITTER_SHARE = 0.45  # of a step: stamps further from the clock than this are not jitter
 ROUGHER = 0.5  # the clock is used when the positions' jerk energy over it is below this share
@@ -30,6 +30,7 @@ class LogReport:
     held: dict = field(default_factory=dict)  # block -> median rows between its updates
     filled: int = 0  # samples interpolated onto the grid where the log had none
     longest_gap: float = 0.0  # s
+    gaps: list = field(default_factory=list)  # (start, end) s of each step over LONG_GAP steps: filled for the filter only
     clock: str | None = None  # regular_clock's note, when the stamps were replaced by a clock
     notes: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
@@ -192,12 +193,12 @@ def regular_samples(r: Recording, regrid: bool = True) -> tuple[Recording, LogRe
         grid = grid[grid <= r.t[-1] + 1e-9 * period]
         report.filled = max(grid.size - r.t.size, 0)
         report.longest_gap = float(steps.max())
+        report.gaps = [(float(r.t[i]), float(r.t[i + 1])) for i in np.flatnonzero(steps > LONG_GAP * period)]
         r = _mapped(r, grid, lambda x, t=r.t: CubicSpline(t, x, axis=0)(grid))
+        within = ", those in long gaps for the filter only, not as data" if report.gaps else ""
         report.notes.append(f"stamps uneven (steps {1e3 * float(steps.min()):.3g}-{1e3 * float(steps.max()):.3g} ms): "
-                            f"interpolated onto a regular {1e3 * period:.4g} ms grid ({report.filled} samples filled)")
-        if report.longest_gap > LONG_GAP * period:
-            report.warnings.append(f"{r.name}: a gap of {1e3 * report.longest_gap:.3g} ms in the stamps "
-                                   f"({report.longest_gap / period:.0f} steps) was filled by interpolation")
+                            f"interpolated onto a regular {1e3 * period:.4g} ms grid ({report.filled} samples "
+                            f"filled{within})")
     return r, report
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..catalogue import RNEA
+from ..errors import InputError
 from .conditioning import AUTO, condition
 
 TORQUE_FLOOR = 0.05  # joints carrying less torque RMS than this share of the largest are not judged
@@ -124,7 +125,7 @@ def _alternatives(sig):
     if sig.cutoff is None or not sig.note.startswith("qd, qdd differentiated"):
         try:
             first = _again(sig, differentiate=True, cutoff=AUTO)
-        except ValueError:
+        except (ValueError, InputError):  # InputError: a gap leaves too few samples (conditioning.MIN_DATA)
             return
         yield "positions differentiated, automatic cutoff", first
     start = first.cutoff if first.cutoff is not None else first.rate / 20
@@ -132,7 +133,7 @@ def _alternatives(sig):
     while cutoff >= MIN_CUTOFF and sig.t.size > 8 * first.rate / cutoff:
         try:
             yield f"positions differentiated, {cutoff:.3g} Hz", _again(sig, differentiate=True, cutoff=cutoff)
-        except ValueError:
+        except (ValueError, InputError):
             return
         cutoff /= 2
 

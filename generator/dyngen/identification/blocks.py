@@ -65,7 +65,7 @@ class Source:
     def held(cls, signals, block_rows: int = ROWS) -> "Source":
         keep = _kept(signals)
         t = signals.t[keep]
-        return cls(signals.name, t.size, float(t[0]), float(t[-1]), np.abs(signals.qd).max(axis=0),
+        return cls(signals.name, t.size, float(t[0]), float(t[-1]), np.abs(signals.qd[~signals.in_gaps()]).max(axis=0),
                    getattr(signals, "note", ""), list(getattr(signals, "warnings", [])), signals,
                    block_rows=block_rows)
 
@@ -179,10 +179,16 @@ def _tapped(blocks, tap):
         yield block
 
 
-def _kept(signals) -> slice:
-    T = len(signals.t)
-    k = int(getattr(signals, "trim", 0) or 0)
-    return slice(k, T - k) if 0 < k and 2 * k < T else slice(0, T)
+def _kept(signals):
+    """The data samples (Signals.inner: not the filter's start-up at the ends, nor the samples interpolated
+    in a long gap of the stamps with the filter's reach around it): a slice where they are contiguous (views,
+    as the arithmetic has always seen them), else a boolean mask. Where a gap is left out, the samples
+    either side of it follow each other in a block: what is computed along the time (the Coulomb column's
+    lag) is computed on the whole recording first; the residuals' correlation time and batch means
+    (statistics.py) see one join in a series of thousands of samples."""
+    keep = signals.inner()
+    k = np.flatnonzero(keep)
+    return slice(int(k[0]), int(k[-1]) + 1) if k.size and k[-1] - k[0] + 1 == k.size else keep
 
 
 class Blocks:

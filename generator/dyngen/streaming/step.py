@@ -90,7 +90,7 @@ def run(task: Task) -> Sums:
     blocks.close()
     s = condition(read_recording(task.path, task.dof, need_tau, task.required, task.effort_topic),
                   task.conditioning)
-    kept = np.flatnonzero(s.inner())  # not the filter's start-up at the ends
+    kept = np.flatnonzero(s.inner())  # not the filter's start-up at the ends, nor samples invented in a long gap
     for a in range(0, kept.size, task.rows):
         cut = kept[a:a + task.rows]
         add(s.q[cut], s.qd[cut], s.qdd[cut], None if s.tau is None else s.tau[cut],
