@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from dyngen.data import read_recording
+from dyngen.data.rosbag import BagReading
 from dyngen.errors import InputError
 
 pa = pytest.importorskip("pyarrow")
@@ -101,11 +102,33 @@ def test_bag_equals_csv(tmp_path):
     same(csv, read_recording(storage, N))
 
 
+def test_bag_joints_read_by_the_robot_s_names(tmp_path):
+    """A driver that publishes the arm's joints in another order (the UR driver: shoulder_pan last) and a
+    hand's joints beside them (franka: the fingers): with the URDF's names the chain's joints are read
+    by name, the others left out and said; without names, the count is refused in one line."""
+    t, q, qd, tau = signals()
+    csv = read_recording(write_csv(tmp_path / "run.csv", t, q, qd, tau), N)
+    order, names = [1, 2, 0], ("shoulder_lift", "elbow", "shoulder_pan")  # chain: pan, lift, elbow
+    extra = np.column_stack([q[:, order], 0.02 * np.ones(t.size)])  # a finger
+    with Writer(tmp_path / "ur_bag", version=9) as w:
+        c = w.add_connection("/joint_states", JS.__msgtype__, typestore=STORE)
+        for i in range(t.size):
+            m = state(t[i], [*names, "finger"], extra[i].copy(), np.r_[qd[i, order], 0.0], np.r_[tau[i, order], 0.0])
+            w.write(c, int(round(t[i] * 1e9)), STORE.serialize_cdr(m, JS.__msgtype__))
+    chain = ("shoulder_pan", "shoulder_lift", "elbow")
+    r = read_recording(tmp_path / "ur_bag", N, bag=BagReading(joints=chain))
+    same(csv, r)
+    assert "finger not in the chain, left out" in r.read_note and "shoulder_pan, shoulder_lift, elbow" in r.read_note
+    assert "the robot has 3 joints but the message names 4" in one_line(tmp_path / "ur_bag")
+    assert "no joint named wrist" in one_line(tmp_path / "ur_bag", bag=BagReading(joints=("shoulder_pan", "wrist",
+                                                                                          "elbow")))
+
+
 def test_bag_commanded_effort(tmp_path):
     t, q, qd, tau = signals()
     commanded = -tau + 1.0
     bag = write_bag(tmp_path / "cmd_bag", t, q, qd, tau, commands=commanded)
-    r = read_recording(bag, N, effort_topic="/effort_controller/commands")
+    r = read_recording(bag, N, bag=BagReading(effort_topic="/effort_controller/commands"))
     assert np.array_equal(r.tau, commanded) and np.array_equal(r.q, q)
 
 
@@ -158,7 +181,7 @@ def test_bad_bags(tmp_path):
     bag = write_bag(tmp_path / "nan_bag", t, np.where(np.arange(t.size)[:, None] == 9, np.inf, q), qd, tau)
     assert "message 10 on /joint_states, column q1" in one_line(bag)
     assert "topic /nope: not in the bag" in one_line(write_bag(tmp_path / "ok_bag", t, q, qd, tau),
-                                                       effort_topic="/nope")
+                                                       bag=BagReading(effort_topic="/nope"))
     (tmp_path / "link_bag").mkdir()
     (tmp_path / "link_bag" / "metadata.yaml").symlink_to("/etc/passwd")
     assert "not a regular file" in one_line(tmp_path / "link_bag")

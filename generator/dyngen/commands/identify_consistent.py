@@ -127,7 +127,7 @@ def _sampled(sources, robot, args, kept=None):
             out += kept[id(s)]
             continue
         # the windows kept from the parse (recordings.read_sources), else read again
-        got = s.sample.windows() if s.sample is not None else windows(s.path, robot.dof, s.effort_topic)
+        got = s.sample.windows() if s.sample is not None else windows(s.path, robot.dof, s.bag)
         got = [condition(w, conditioning_of(args)) for w in long_enough(got)]
         out += got
         if kept is not None:

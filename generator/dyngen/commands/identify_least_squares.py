@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import printable
-from .recordings import check_headers, compiled_model, conditioning_of, conditioning_text
+from .recordings import bag_of, check_headers, compiled_model, conditioning_of, conditioning_text
 
 
 def run_least_squares(args, robot, kind, required, progress, out: Path) -> int:
@@ -25,7 +25,7 @@ def run_least_squares(args, robot, kind, required, progress, out: Path) -> int:
     if kind == "inertia":
         assert stacked_inertia_columns(model.manifest) == list(required)
     names = [e["standard"] for e in model.manifest["coefficients"][kind]["expressions"]]
-    tasks = [Task(str(p), robot.dof, kind, str(model.folder), conditioning_of(args), required, args.effort_topic)
+    tasks = [Task(str(p), robot.dof, kind, str(model.folder), conditioning_of(args), required, bag_of(args, robot))
              for p in args.data]
     # --- hook (data/trust.py): a recording whose nominal residual exceeds its torque is conditioned again, or
     # nothing is fitted nor written (exit 3)
@@ -87,7 +87,7 @@ def _trusted(args, robot, model, tasks):
         np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
     if prior is None or tasks[0].kind == "inertia":
         return tasks, []
-    pieces = [[condition(w, task.conditioning) for w in long_enough(windows(task.path, task.dof, task.effort_topic))]
+    pieces = [[condition(w, task.conditioning) for w in long_enough(windows(task.path, task.dof, task.bag))]
               for task in tasks]
     said = {id(w): len(w.warnings) for group in pieces for w in group}
     done = iter(checked(model, model(STANDARD_FROM_DYNAMIC.name, np.asarray(prior, dtype=float)),

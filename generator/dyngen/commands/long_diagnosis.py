@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .recordings import conditioned, conditioning_of, long_enough
+from .recordings import bag_of, conditioned, conditioning_of, long_enough
 
 
 def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
@@ -19,10 +19,10 @@ def read_fit(paths, robot, args, model, p, max_rows: int) -> tuple[list, list]:
     recordings, sampled = [], []
     for path in paths:
         task = GapTask(str(path), robot.dof, str(model.folder), tuple(float(v) for v in p), conditioning_of(args),
-                       args.effort_topic)
+                       bag_of(args, robot))
         got = sample(task, max_rows)
         if not got.sampled:  # the whole-file reader and its checks, as before
-            recordings.append(read_recording(path, robot.dof, True, (), args.effort_topic))
+            recordings.append(read_recording(path, robot.dof, True, (), bag_of(args, robot)))
             continue
         windows = long_enough(got.recordings)
         recordings += windows
@@ -38,7 +38,7 @@ def read_windows(paths, robot, args, max_rows: int) -> list:
 
     recordings = []
     for path in paths:
-        got = windows(path, robot.dof, args.effort_topic, max_rows, conditioning=conditioning_of(args))
+        got = windows(path, robot.dof, bag_of(args, robot), max_rows, conditioning=conditioning_of(args))
         recordings += got if len(got) == 1 else long_enough(got)
     return conditioned(recordings, args)
 
@@ -58,10 +58,10 @@ def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list
     edges[-1] = 1.0
     for path in paths:
         t0, t1, first = None, None, None
-        for block in chunks(path, robot.dof, True, (), 8192, args.effort_topic):
+        for block in chunks(path, robot.dof, True, (), 8192, bag_of(args, robot)):
             t0, t1, name, first = block.t[0] if t0 is None else t0, block.t[-1], block.name, first or block
         spreads = [Spread(max_rows) if b > a else None for a, b in zip(edges[:-1], edges[1:])]
-        for block in chunks(path, robot.dof, True, (), 8192, args.effort_topic):
+        for block in chunks(path, robot.dof, True, (), 8192, bag_of(args, robot)):
             for k, spread in enumerate(spreads):
                 if spread is not None:
                     keep = (block.t >= t0 + edges[k] * (t1 - t0)) & (
@@ -76,7 +76,7 @@ def read_split(paths, robot, args, fractions, max_rows: int) -> tuple[list, list
             if k == 2 and len(got) > 1 and _local(first, conditioning_of(args)):  # judged over every row
                 span = (t0 + edges[k] * (t1 - t0), t0 + edges[k + 1] * (t1 - t0) if edges[k + 1] < 1.0 else np.inf)
                 for w in got:
-                    w.stream = Rows(str(path), robot.dof, args.effort_topic, span=span)
+                    w.stream = Rows(str(path), robot.dof, bag_of(args, robot), span=span)
             roles[k].extend(got if len(got) == 1 else long_enough(got))
     return tuple([condition(r, conditioning_of(args)) for r in role] for role in roles)
 

@@ -24,7 +24,8 @@ def add_data_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("robot", metavar="ROBOT.yaml", help="robot description (docs/conventions.md)")
     parser.add_argument("--data", action=Recordings, required=True, metavar="FILE",
                         help="a recording: CSV with header t, q1..qN, tau1..tauN, optional qd*, qdd*; or Parquet "
-                             "(.parquet, the same columns); or a ROS 2 bag's folder (joint_states); repeatable, and "
+                             "(.parquet, the same columns); or a ROS 2 bag's folder (joint_states, joints by a URDF's names); "
+                             "repeatable, and "
                              "a quoted glob ('logs/*.csv') stands for every file it matches")
     parser.add_argument("--effort-topic", metavar="TOPIC",
                         help="ROS 2 bags: take the torques from this topic (a commanded effort: JointState or "
@@ -88,7 +89,14 @@ def check_headers(paths, robot, args, require_torques: bool = True, required: tu
     from ..data.chunks import chunks
 
     for path in paths:
-        next(chunks(path, robot.dof, require_torques, required, 64, args.effort_topic))
+        next(chunks(path, robot.dof, require_torques, required, 64, bag_of(args, robot)))
+
+
+def bag_of(args, robot):
+    """How a ROS 2 bag is read (data.rosbag.BagReading): --effort-topic, and the URDF's joint names."""
+    from ..data.rosbag import BagReading
+
+    return BagReading(getattr(args, "effort_topic", None), tuple(robot.joint_names))
 
 
 def conditioning_of(args):
@@ -128,7 +136,7 @@ def read_all(paths, robot, args, require_torques=True, required=(), need_motion=
     hold one pose; with torques, some torque must be nonzero (an all-zero file fits nothing)."""
     from ..data import read_recording
 
-    topic = getattr(args, "effort_topic", None)
+    topic = bag_of(args, robot)
     return conditioned([read_recording(p, robot.dof, require_torques, required, topic) for p in paths], args,
                        need_motion)
 
@@ -153,7 +161,7 @@ def read_sources(paths, robot, args) -> list:
     from ..identification.blocks import Source
     from ..streaming.step import _local
 
-    topic, conditioning = getattr(args, "effort_topic", None), conditioning_of(args)
+    topic, conditioning = bag_of(args, robot), conditioning_of(args)
     read = []  # a Source read in blocks, or the Recording read whole
     for path in paths:
         first = next(chunks(path, robot.dof, True, (), 64, topic))

@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .recordings import check_headers, compiled_model, conditioning_of
+from .recordings import bag_of, check_headers, compiled_model, conditioning_of
 
 
 def run_survey(args, robot, p, progress) -> int:
@@ -27,7 +27,7 @@ def run_survey(args, robot, p, progress) -> int:
     progress.say(f"dyngen diagnose --survey: {robot.name} with {Path(args.params).name}, {len(args.data)} recording(s)")
     model = compiled_model(args, robot, progress)
     tasks = [GapTask(str(x), robot.dof, str(model.folder), tuple(float(v) for v in p), conditioning_of(args),
-                     args.effort_topic) for x in args.data]
+                     bag_of(args, robot)) for x in args.data]
     with progress.step(f"gap per recording, {len(tasks)} recording(s) in blocks"):
         result = survey(tasks, args.workers, args.scheduler)
     lines = table(result)

@@ -34,11 +34,11 @@ ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 
 
 
 def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), rows: int = ROWS,
-           effort_topic: str | None = None):
+           bag=None):
     """Recordings of consecutive blocks of at most `rows` samples (at least one block)."""
     kind = columnar.format_of(path)
     if kind == "rosbag":
-        yield read_recording(path, dof, require_torques, required, effort_topic)
+        yield read_recording(path, dof, require_torques, required, bag)
         return
     blocks = _parquet_blocks(path, rows) if kind == "parquet" else _csv_blocks(path, rows)
     name = Path(path).name

@@ -11,11 +11,12 @@ from .rosbag import read_bag
 
 
 def read_recording(path, dof: int, require_torques: bool = True, required: tuple = (),
-                   effort_topic: str | None = None) -> Recording:
-    """Read and check `path` for `dof` joints (`required`: further columns; `effort_topic`: a bag's)."""
+                   bag=None) -> Recording:
+    """Read and check `path` for `dof` joints (`required`: further columns; `bag`: how a ROS 2 bag is
+    read, a rosbag.BagReading)."""
     kind = format_of(Path(path))
     if kind == "parquet":
         return read_parquet(path, dof, require_torques, required)
     if kind == "rosbag":
-        return read_bag(path, dof, require_torques, effort_topic)
+        return read_bag(path, dof, require_torques, bag)
     return read_csv(path, dof, require_torques, required)

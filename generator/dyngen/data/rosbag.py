@@ -4,6 +4,7 @@ are decoded by rosbags' CDR reader for these fixed types only: nothing in the ba
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,17 @@ JOINT_STATE = "sensor_msgs/msg/JointState"
 ARRAY = "std_msgs/msg/Float64MultiArray"
 
 
+@dataclass(frozen=True)
+class BagReading:
+    """How a bag is read: the commanded effort's topic (None: the joint states' measured efforts), and
+    the robot's joint names in chain order (a URDF's; a driver may publish its joints in another order,
+    and a hand's beside the arm's). Without names, the first message's order is the chain's, and it
+    must name exactly the robot's joints."""
+
+    effort_topic: str | None = None
+    joints: tuple = ()
+
+
 def bag_folder(path) -> Path:
     path = Path(path)
     if path.suffix.lower() in BAG_FILES and not path.is_dir():
@@ -28,7 +40,7 @@ def _stamp(message) -> float:
     return message.header.stamp.sec + 1e-9 * message.header.stamp.nanosec
 
 
-def read_bag(path, dof: int, require_torques: bool = True, effort_topic: str | None = None) -> Recording:
+def read_bag(path, dof: int, require_torques: bool = True, bag: BagReading | None = None) -> Recording:
     folder = bag_folder(path)
     name = folder.name
     regular_folder(folder, MAX_CSV_BYTES)
@@ -37,7 +49,7 @@ def read_bag(path, dof: int, require_torques: bool = True, effort_topic: str | N
     store = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
     try:
         with rosbag2.Reader(folder) as reader:
-            return _read(reader, store, name, dof, require_torques, effort_topic)
+            return _read(reader, store, name, dof, require_torques, bag or BagReading())
     except InputError:
         raise
     except Exception as err:  # noqa: BLE001 -- a broken bag may raise anything from the library: one line
@@ -65,22 +77,20 @@ def _topic(reader, name, wanted=None) -> object:
     return chosen
 
 
-def _read(reader, store, name, dof, require_torques, effort_topic) -> Recording:
+def _read(reader, store, name, dof, require_torques, bag: BagReading) -> Recording:
     states = _topic(reader, name)
     topic = states[0].topic
+    effort_topic = bag.effort_topic
     commands = _topic(reader, name, effort_topic) if effort_topic else None
-    joints, stamps, clock, q, qd, tau = None, [], [], [], [], []
+    joints, first, stamps, clock, q, qd, tau, others = None, None, [], [], [], [], [], []
     for k, (connection, time, raw) in enumerate(reader.messages(connections=states)):
         m = store.deserialize_cdr(raw, connection.msgtype)
         where = f"message {k + 1} on {topic}"
         names = [str(n) for n in m.name]
+        if len(set(names)) != len(names):
+            raise InputError(name, where, "a joint is named twice")
         if joints is None:
-            joints = names
-            if len(joints) != dof:
-                raise InputError(name, where, f"the robot has {dof} joints but the message names {len(joints)} "
-                                 f"({shorten(', '.join(joints), 120)})")
-            if len(set(joints)) != len(joints):
-                raise InputError(name, where, "a joint is named twice")
+            first, (joints, others) = names, _chain(name, where, dof, names, bag.joints)
         order = _order(name, where, joints, names)
         position, velocity, effort = (np.asarray(v, dtype=float) for v in (m.position, m.velocity, m.effort))
         for label, values, needed in (("position", position, True), ("velocity", velocity, False),
@@ -111,14 +121,36 @@ def _read(reader, store, name, dof, require_torques, effort_topic) -> Recording:
         blocks.append(np.vstack(tau) if isinstance(tau, list) else tau)
     columns = check_header(name, header, dof, require_torques)
     rows = np.flatnonzero(keep)
-    return from_columns(name, header, columns, np.hstack(blocks), dof,
-                        where=lambda row: f"message {rows[row] + 1} on {topic}")
+    out = from_columns(name, header, columns, np.hstack(blocks), dof,
+                       where=lambda row: f"message {rows[row] + 1} on {topic}")
+    if others or joints != first:
+        said = f"joints read by name in the robot's order ({shorten(', '.join(joints), 160)})" + (
+            f"; {shorten(', '.join(others), 120)} not in the chain, left out" if others else "")
+        out.read_note = "; ".join(x for x in (said, out.read_note) if x)
+    return out
+
+
+def _chain(name, where, dof, names, robot_joints) -> tuple[list, list]:
+    """(the chain's joint names in its order, the other joints the message names), from the first message."""
+    if not robot_joints:
+        if len(names) != dof:
+            raise InputError(name, where, f"the robot has {dof} joints but the message names {len(names)} "
+                             f"({shorten(', '.join(names), 120)}); a URDF names its joints, so that they are "
+                             "read by name")
+        return names, []
+    missing = [j for j in robot_joints if j not in names]
+    if missing:
+        raise InputError(name, where, f"no joint named {shorten(', '.join(missing), 120)} (the message names "
+                         f"{shorten(', '.join(names), 160)})")
+    return list(robot_joints), [n for n in names if n not in robot_joints]
 
 
 def _order(name, where, joints, names) -> list:
-    if names == joints:
-        return list(range(len(names)))
-    if sorted(names) != sorted(joints):
+    """Where each of `joints` is in this message's `names` (which may hold more)."""
+    if names[:len(joints)] == joints:
+        return list(range(len(joints)))
+    missing = [j for j in joints if j not in names]
+    if missing:
         raise InputError(name, where, f"joints {shorten(', '.join(names), 120)}; the first message named "
                          f"{shorten(', '.join(joints), 120)}")
     return [names.index(j) for j in joints]

@@ -84,6 +84,7 @@ class Robot:
     snap_effects: tuple = ()  # per snap: the largest gravity-torque change it causes (snap_effect.py)
     notes: tuple = ()  # what the reader did that the user should know (links lumped beyond the tip)
     links: tuple = ()  # the URDF link name of each moving body
+    joint_names: tuple = ()  # the URDF name of each moving joint, in chain order (a bag's joint states are read by them)
     link_frames: tuple = ()  # per body: the URDF link's frame in dyngen's link frame i (a Rigid)
     urdf_file: Optional[str] = None  # the URDF read (its full path), for export/urdf_copy.py
     urdf_options: dict = field(default_factory=dict)  # base_link, tip_link, snap it was read with

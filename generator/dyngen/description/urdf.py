@@ -113,6 +113,7 @@ def load_urdf(path, base_link=None, tip_link=None, snap=True, name=None, gravity
                  gravity=tuple(gravity or (sp.Integer(0), sp.Integer(0), sp.Rational("-9.81"))),
                  nominal=tuple(nominal), models=tuple(models), snaps=tuple(snaps), notes=tuple(notes),
                  links=tuple(link for link, _ in bodies), link_frames=tuple(link_frames),
+                 joint_names=tuple(j.name for j in path_joints if j.type != "fixed"),
                  urdf_file=str(Path(path).resolve()),
                  urdf_options={"base_link": base_link, "tip_link": tip_link, "snap": snap})
     if robot.snaps and snap is True:  # each snap's effect, from the file read with that one kept

@@ -83,7 +83,7 @@ def every_test_row(model, final, modes, completed, judged, segments):
 
 def blocks_of(tasks):
     """Every row of the recordings `tasks` (streaming.gap.GapTask or alike: path, dof, rows,
-    effort_topic; a streaming.sample.Rows' span: those rows only), read in blocks, repeated rows left out as conditioning does. Only recordings
+    bag; a streaming.sample.Rows' span: those rows only), read in blocks, repeated rows left out as conditioning does. Only recordings
     whose blocks are conditioned on their own are marked so (qd and qdd recorded, no filter); a
     law that reads earlier samples (a time shift) starts each block afresh."""
     from ..data.chunks import chunks
@@ -91,7 +91,7 @@ def blocks_of(tasks):
     from ..streaming.sample import _part
 
     for task in tasks:
-        blocks = Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.effort_topic))
+        blocks = Streamed().blocks(chunks(task.path, task.dof, True, (), task.rows, task.bag))
         span = getattr(task, "span", None)
         for block in blocks if span is None else (_part(b, (b.t >= span[0]) & (b.t < span[1])) for b in blocks):
             if block.t.size:

@@ -50,7 +50,7 @@ class Source:
     signals: object = None  # the conditioned recording, held whole (None: read from `path`)
     path: str | None = None
     dof: int = 0
-    effort_topic: str | None = None
+    bag: object = None  # data.rosbag.BagReading: how a ROS 2 bag is read (None: its defaults)
     block_rows: int = ROWS
     sample: object = None  # the sanity check's windows, made from the parse's blocks (commands/recordings.py)
     _coulomb: dict = field(default_factory=dict)  # (smoothing, lags) -> whole column, this pass (held)
@@ -70,7 +70,7 @@ class Source:
                    block_rows=block_rows)
 
     @classmethod
-    def of_file(cls, path, dof: int, effort_topic=None, block_rows: int = ROWS, tap=None) -> "Source":
+    def of_file(cls, path, dof: int, bag=None, block_rows: int = ROWS, tap=None) -> "Source":
         """The file parsed once, its blocks kept for every pass: its length, time span and
         velocities, and whether it moves and has torques (data.recording.check_informative).
         tap(block): each block as read, before the repeated rows are left out (the sanity check's sample)."""
@@ -78,7 +78,7 @@ class Source:
 
         roomy_heap()  # the passes' block-sized arrays reused, not mapped afresh
         source = cls(Path(path).name, 0, 0.0, 0.0, np.zeros(dof), "qd, qdd as recorded, no filter", path=str(path),
-                     dof=dof, effort_topic=effort_topic, block_rows=block_rows)
+                     dof=dof, bag=bag, block_rows=block_rows)
         first, source.moved, source.torque = None, False, False
         for block in source._file_blocks(tap):
             first = first or block
@@ -121,7 +121,7 @@ class Source:
         # kernel, without the GIL: the parse is one process, the other core free); one write at a time
         with ThreadPoolExecutor(1) as writer:
             written = None
-            read = chunks(self.path, self.dof, True, (), self.block_rows, self.effort_topic)
+            read = chunks(self.path, self.dof, True, (), self.block_rows, self.bag)
             for number, block in enumerate(self._log.blocks(read if tap is None else _tapped(read, tap))):
                 data = np.column_stack([block.t, block.q, block.qd, block.qdd, block.tau])
                 if written is not None:

@@ -30,7 +30,7 @@ class GapTask:
     folder: str
     p: tuple  # link parameters (the diagnosis' dynamic parameters)
     conditioning: object
-    effort_topic: str | None = None
+    bag: object = None  # data.rosbag.BagReading: how a ROS 2 bag is read (None: its defaults)
     rows: int = 8192
 
 
@@ -79,14 +79,14 @@ def run(task: GapTask) -> Gap:
     from ..data.log_quality import Streamed
 
     sums = Sums.start(_model(task.folder), task.p, task.dof)
-    blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
+    blocks = chunks(task.path, task.dof, True, (), task.rows, task.bag)
     first = next(blocks)
     if _local(first, task.conditioning):
         for piece in Streamed().blocks(itertools.chain([first], blocks)):  # one block at a time, repeats left out
             sums.add(piece.q, piece.qd, piece.qdd, piece.tau, np.tanh(piece.qd / VELOCITY))
         return sums.result(first.name, True)
     blocks.close()
-    sig = condition(read_recording(task.path, task.dof, True, (), task.effort_topic), task.conditioning)
+    sig = condition(read_recording(task.path, task.dof, True, (), task.bag), task.conditioning)
     keep = sig.inner()  # the filter's start-up is not data (as in the diagnosis)
     tanh = sig.filtered(np.tanh(sig.qd / VELOCITY))
     index = np.flatnonzero(keep)

@@ -83,12 +83,12 @@ class Rows:
     """Every row of a recording, for a pass over it in blocks (diagnosis/pipeline.py block_segments)."""
     path: str
     dof: int
-    effort_topic: str | None = None
+    bag: object = None  # data.rosbag.BagReading: how a ROS 2 bag is read (None: its defaults)
     rows: int = 8192
     span: tuple | None = None  # (from, to) s: only the rows from <= t < to (a --split piece; to = inf: to the end)
 
 
-def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window: float = WINDOW,
+def windows(path, dof: int, bag=None, max_rows: int = MAX_ROWS, window: float = WINDOW,
             conditioning=None) -> list:
     """The recording whole (within max_rows samples), else its evenly spread windows, read in
     blocks; windows whose blocks are conditioned on their own (step._local under `conditioning`)
@@ -96,13 +96,13 @@ def windows(path, dof: int, effort_topic=None, max_rows: int = MAX_ROWS, window:
     from ..data.chunks import chunks
 
     spread, name, first = Spread(max_rows, window), None, None
-    for block in chunks(path, dof, True, (), 8192, effort_topic):
+    for block in chunks(path, dof, True, (), 8192, bag):
         spread.add(block)
         name, first = block.name, first or block
     got = spread.windows(name)
     if len(got) > 1 and conditioning is not None and _local(first, conditioning):
         for w in got:
-            w.stream = Rows(str(path), dof, effort_topic)
+            w.stream = Rows(str(path), dof, bag)
     return got
 
 
@@ -111,7 +111,7 @@ def sample(task: GapTask, max_rows: int = MAX_ROWS, window: float = WINDOW) -> S
     from ..data.log_quality import Streamed
 
     roomy_heap()
-    blocks = chunks(task.path, task.dof, True, (), task.rows, task.effort_topic)
+    blocks = chunks(task.path, task.dof, True, (), task.rows, task.bag)
     first = next(blocks)
     local = _local(first, task.conditioning)
     model = _model(task.folder)

@@ -34,7 +34,7 @@ class Task:
     folder: str  # the generated, compiled model
     conditioning: object  # data.Conditioning
     required: tuple = ()  # the stacked inertia columns, for kind inertia
-    effort_topic: str | None = None
+    bag: object = None  # data.rosbag.BagReading: how a ROS 2 bag is read (None: its defaults)
     rows: int = 8192  # samples per block
 
 
@@ -69,7 +69,7 @@ def run(task: Task) -> Sums:
 
     model = _model(task.folder)
     need_tau = task.kind != "inertia"
-    blocks = chunks(task.path, task.dof, need_tau, task.required, task.rows, task.effort_topic)
+    blocks = chunks(task.path, task.dof, need_tau, task.required, task.rows, task.bag)
     first = next(blocks)
     factors, samples = None, 0
 
@@ -88,7 +88,7 @@ def run(task: Task) -> Sums:
         note = "; ".join(log.report.notes + ["qd, qdd as recorded, no filter"])
         return Sums(first.name, factors, samples, note, True, log.report.warnings)
     blocks.close()
-    s = condition(read_recording(task.path, task.dof, need_tau, task.required, task.effort_topic),
+    s = condition(read_recording(task.path, task.dof, need_tau, task.required, task.bag),
                   task.conditioning)
     kept = np.flatnonzero(s.inner())  # not the filter's start-up at the ends, nor samples invented in a long gap
     for a in range(0, kept.size, task.rows):
