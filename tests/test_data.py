@@ -261,18 +261,20 @@ def test_rows_missing_values_at_the_ends_are_left_out(tmp_path):
     assert error_of(path).startswith("run.csv: line 22, column q2: nan (NaN or infinite value; missing values")
 
 
-@pytest.mark.parametrize("layout", ["savetxt", "comments", "pandas"])
+@pytest.mark.parametrize("layout", ["savetxt", "comments", "pandas", "trailing"])
 def test_headers_as_common_writers_make_them(tmp_path, layout):
     """numpy.savetxt writes its header as a comment (`# t,q1,...`), loggers put '#' lines above the
-    header, pandas' to_csv writes an unnamed row index first: the values read are those of the plain
-    file, whole and in blocks, and a bad cell is named at its line in the file."""
+    header, pandas' to_csv writes an unnamed row index first, a loop writing `value,` ends every line
+    with a comma: the values read are those of the plain file, whole and in blocks, and a bad cell is
+    named at its line in the file."""
     from dyngen.data.chunks import chunks
 
     rows = [[0.01 * k, np.sin(0.1 * k), 0.2 * k, 1.0 + k, 2.0] for k in range(30)]
     plain = read_recording(write(tmp_path, HEADER, rows, "plain.csv"), N)
     above, header, body = {"savetxt": (["# t,q1,q2,tau1,tau2"], [], rows),
                            "comments": (["# logged by rig 3", "#rate: 100 Hz"], HEADER, rows),
-                           "pandas": ([], [""] + HEADER, [[k] + row for k, row in enumerate(rows)])}[layout]
+                           "pandas": ([], [""] + HEADER, [[k] + row for k, row in enumerate(rows)]),
+                           "trailing": ([], HEADER + [""], [row + [""] for row in rows])}[layout]
     lines = above + ([",".join(header)] if header else []) + [",".join(str(v) for v in row) for row in body]
     path = tmp_path / "run.csv"
     path.write_text("\n".join(lines) + "\n")

@@ -28,7 +28,7 @@ from . import columnar
 from .reader import read_recording
 from .as_written import ragged_note, without_ragged_ends
 from .recording import (MAX_COMMENTS, _check_time, _header, _numbers, as_recording, check_header, checked_rows,
-                        csv_line, header_of)
+                        csv_line, header_of, without_trailing_commas)
 
 ROWS = 8192  # samples per block: 7 joints x 50 regressor columns of them is 23 MB
 
@@ -85,6 +85,7 @@ def _csv_blocks(path, rows: int):
             header_line, used = header_of([line.rstrip("\r") for line in text[:len(ahead)]])
             offset = sum(len(x) for x in ahead[:used])
             header = _header(name, header_line, used)  # the whole-file reader's bounds and message
+            trailing = header_line.rstrip().endswith(",")
             yield header
             first, start, pending = used + 1, 0, ahead[used:]
             while True:
@@ -92,7 +93,8 @@ def _csv_blocks(path, rows: int):
                 pending = []
                 if not chunk:
                     break
-                lines = _decoded(chunk, name, first, offset).splitlines(keepends=True)
+                text = _decoded(chunk, name, first, offset)
+                lines = (without_trailing_commas(text) if trailing else text).splitlines(keepends=True)
                 offset += sum(len(x) for x in chunk)
                 if any(x.strip() for x in lines):
                     data = _block(lines, name, header, first)

@@ -61,15 +61,21 @@ def repaired(r):
     for name, x in (("q", q), ("tau", r.tau)):
         if x is None:
             continue
-        bad = spikes(x)
-        if bad.any():
-            x = x.copy()
-            rows, joints = np.nonzero(bad)
-            x[rows, joints] = 0.5 * (x[rows - 1, joints] + x[rows + 1, joints])
+        x, joints = despiked(x)
+        if joints.size:
             changes[name] = x
-            notes.append(f"{rows.size} spike(s) in {name} (joint(s) {_joints(np.unique(joints))}: one sample off "
+            notes.append(f"{joints.size} spike(s) in {name} (joint(s) {_joints(np.unique(joints))}: one sample off "
                          "while its neighbours agree) replaced by their neighbours' mean")
     return dataclasses.replace(r, **changes), notes
+
+
+def despiked(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(x with its spikes replaced by their neighbours' mean, the joint of each spike)."""
+    rows, joints = np.nonzero(spikes(x))
+    if rows.size:
+        x = np.array(x, dtype=float)
+        x[rows, joints] = 0.5 * (x[rows - 1, joints] + x[rows + 1, joints])
+    return x, joints
 
 
 def _joints(js) -> str:

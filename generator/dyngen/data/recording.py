@@ -58,8 +58,15 @@ def read_csv(path, dof: int, require_torques: bool = True, required: tuple = ())
     header_line, used = header_of(head)
     header = _header(name, header_line, used)
     columns = check_header(name, header, dof, require_torques, required, f"line {used} (header)")
-    return from_columns(name, header, columns, _numbers("\n".join(head[used:]), name, header, used + 1), dof,
+    body = "\n".join(head[used:])
+    body = without_trailing_commas(body) if header_line.rstrip().endswith(",") else body
+    return from_columns(name, header, columns, _numbers(body, name, header, used + 1), dof,
                         lambda row: f"line {row + used + 1}")
+
+
+def without_trailing_commas(text: str) -> str:
+    """Rows of a writer that ends every line with a comma, as its header (a loop writing `value,`)."""
+    return "\n".join(line[:-1] if line.endswith(",") else line for line in text.rstrip(" \n").split("\n")) + "\n"
 
 
 def header_of(lines: list) -> tuple[str, int]:
@@ -141,6 +148,8 @@ def _header(name, line: str, number: int = 1) -> list[str]:
         header = [h.strip() for h in next(csv.reader([line]), [])]
     except csv.Error as err:
         raise InputError(name, where, f"not CSV ({shorten(str(err))})") from None
+    if len(header) > 1 and not header[-1]:
+        header.pop()  # a comma ending every line (without_trailing_commas)
     if len(header) > MAX_COLUMNS:
         raise InputError(name, where, f"{len(header)} columns (at most {MAX_COLUMNS})")
     for k, h in enumerate(header):

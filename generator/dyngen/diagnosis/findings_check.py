@@ -22,6 +22,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..data.automatic import position_noise
+from ..data.glitches import despiked
 from ..identification.sanity import inertia_about_joints, rotor_inertia_range
 from .fit import predict
 from .moments import split_values
@@ -39,14 +40,14 @@ FLOOR = 0.25
 def floor(fit_signals) -> np.ndarray | None:
     """Per joint the significance floor [Nm]: FLOOR times the torque noise sigma of the raw
     torques as logged (robust third differences, automatic.position_noise; rows that repeat the
-    one before left out), the median over the fit recordings; None where no raw torques are kept."""
+    one before and spikes left out), the median over the fit recordings; None where no raw torques are kept."""
     sigmas = []
     for sig in fit_signals:
         raw = getattr(sig.source, "tau", None)
         if raw is None or raw.shape[0] < 8:
             continue
         moved = np.r_[True, np.any(np.diff(sig.source.q, axis=0) != 0, axis=1)]
-        sigmas.append(position_noise(raw[moved]))
+        sigmas.append(position_noise(despiked(raw[moved])[0]))  # a bus's single wrong samples are no noise
     return FLOOR * np.median(sigmas, axis=0) if sigmas else None
 
 
