@@ -59,6 +59,7 @@ LOGS = {
     "100Hz-17bit": (100.0, Encoder(noise=5e-5, bits=17), None),
     "100Hz-17bit-repeated": (100.0, Encoder(noise=5e-5, bits=17), "repeated"),
     "100Hz-17bit-dropped": (100.0, Encoder(noise=5e-5, bits=17), "dropped"),
+    "100Hz-17bit-polled": (100.0, Encoder(noise=5e-5, bits=17), "polled"),
     "1k-17bit": (1000.0, Encoder(noise=5e-5, bits=17), None),
 }
 

@@ -22,6 +22,7 @@ LONG_GAP = 10  # a step of more than this many is a gap: filled for the filter, 
 REPEATS_WORTH_SAYING = 0.001  # share of rows
 JITTER_SHARE = 0.45  # of a step: stamps further from the clock than this are not jitter
 ROUGHER = 0.5  # the clock is used when the positions' jerk energy over it is below this share
+COMB_ROWS = 4096  # rows whose short steps find a polling logger's clock (_polled)
 
 
 @dataclass
@@ -224,7 +225,8 @@ def regular_clock(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]
     clock = float(np.median(t - k * period)) + k * period
     off = np.abs(t - clock)
     if off.max() > JITTER_SHARE * period:
-        return _counted(t, q)
+        counted, note = _counted(t, q)
+        return (counted, note) if note else _polled(t, q)
     if off.max() <= 1e-6 * period:
         return t, None
     if _roughness(clock, q) >= ROUGHER * _roughness(t, q):
@@ -248,6 +250,44 @@ def _counted(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]:
     return count, (f"time stamps wander by up to {1e3 * float(np.max(np.abs(t - count))):.2g} ms off a regular "
                    f"{1e3 * float(count[1] - count[0]):.4g} ms clock that has one sample per row; the positions are "
                    "smooth over that clock, not over the stamps: the clock is used")
+
+
+def _polled(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """A logger polling the latest sample on its own clock writes each row up to a period after the
+    sample it holds (tests/simulation/logger.py polled: at 100 Hz its 3 ms delays wander over the
+    whole period): each row is the last tick of the clock phase + k T at or before its stamp. The
+    period and phase: the shortest steps (a tick between their rows) as a comb, its strongest
+    period; then, for periods around it, the latest phase below every stamp; the smoothest clock
+    that gives every row its own tick, used when smoother than the stamps by ROUGHER."""
+    head = t[:COMB_ROWS]  # the comb on the first rows (its cost grows as their count squared), the search
+    steps, span, centre = np.diff(head), head[-1] - head[0], 0.5 * (head[0] + head[-1])  # below over every row
+    middle = (0.5 * (head[1:] + head[:-1]) - centre)[steps < np.quantile(steps, 0.3)]
+    median = float(np.median(steps))
+    fine = median * median / (8.0 * span)  # the comb's phase at the end moves by 1/8 turn
+
+    def comb(periods):
+        return np.exp(2j * np.pi * middle[None, :] / periods[:, None]).sum(axis=1)
+
+    periods = np.arange(0.75 * median, 1.02 * median, fine)
+    strength = np.concatenate([np.abs(comb(periods[i:i + 256])) for i in range(0, periods.size, 256)])
+    periods = periods[np.argmax(strength)] + np.linspace(-fine, fine, 65)
+    z = comb(periods)
+    period = float(periods[np.argmax(np.abs(z))])
+    start = centre + period * float(np.angle(z[np.argmax(np.abs(z))])) / (2.0 * np.pi)
+    best, tried = None, np.linspace(-0.06, 0.06, 121)[:, None]
+    for step in period * (1.0 + np.linspace(-5e-5, 5e-5, 101)):  # within 1/200 of a period at the ends
+        phases = start + tried * step
+        ticks = np.floor((t[None, :] - phases) / step)
+        whole = phases[np.all(np.diff(ticks, axis=1) > 0, axis=1), 0]  # every row its own tick
+        if whole.size:
+            clock = step * ticks[np.argmin(np.abs(phases[:, 0] - np.median(whole)))] + np.median(whole)
+            best = min(best or (np.inf, clock), (_roughness(clock, q), clock), key=lambda x: x[0])
+    if best is None or best[0] >= ROUGHER * _roughness(t, q):
+        return t, None
+    clock = best[1]
+    return clock, (f"time stamps late by up to {1e3 * float(np.max(t - clock)):.2g} ms after the samples of a regular "
+                   f"{1e3 * float(np.median(np.diff(clock))):.4g} ms clock (a logger polling the latest sample); the "
+                   "positions are smooth over the clock, not over the stamps: the clock is used")
 
 
 def _roughness(t: np.ndarray, q: np.ndarray) -> float:
