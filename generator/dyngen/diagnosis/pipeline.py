@@ -29,17 +29,6 @@ ALIKE = ("; the model's torques filtered alike (the positions' noise above twice
          "estimate: the accelerations carry more noise than the cutoff allowed for)")
 
 
-def _one_treatment(*groups) -> None:
-    """The model's torques filtered alike on every recording of the diagnosis, or on none, as most of
-    them ask (conditioning.Signals.model_filtered, data/automatic.py `coloured`): effects fitted under
-    one treatment and tested under another would be judged on the difference (a window of a long
-    recording may ask for it where the recording's other windows and the test do not)."""
-    every = [sig for group in groups for sig in group or []]
-    alike = 2 * sum(bool(sig.model_filtered) for sig in every) > len(every)
-    for sig in every:
-        sig.model_filtered = alike
-
-
 def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options = Options(),
              test=None) -> Diagnosis:
     p = np.asarray(p, dtype=float)
@@ -47,7 +36,6 @@ def diagnose(robot, model, p, fit_signals, select_signals=None, options: Options
     # 0. roles; a recording whose nominal residual exceeds its torques is conditioned again, or
     # trust.Unusable is raised (nothing claimed)
     fit_signals, select_signals, test = trust.checked_roles(model, s, fit_signals, select_signals, test)
-    _one_treatment(fit_signals, select_signals, test)
     segments, split = roles.segments(model, s, fit_signals, select_signals, test, options.block_seconds)
     # position-dependent laws are known only over the positions the fit data cover
     context = Context(model, robot, p, s, options.sign_velocity, fit.positions(segments))
