@@ -23,6 +23,7 @@ REPEATS_WORTH_SAYING = 0.001  # share of rows
 JITTER_SHARE = 0.45  # of a step: stamps further from the clock than this are not jitter
 ROUGHER = 0.5  # the clock is used when the positions' jerk energy over it is below this share
 COMB_ROWS = 4096  # rows whose short steps find a polling logger's clock (_polled)
+POLLED_ROWS = 60000  # _polled's search holds 121 trial clocks of every row: longer recordings keep their stamps
 
 
 @dataclass
@@ -259,6 +260,8 @@ def _polled(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, str | None]:
     period and phase: the shortest steps (a tick between their rows) as a comb, its strongest
     period; then, for periods around it, the latest phase below every stamp; the smoothest clock
     that gives every row its own tick, used when smoother than the stamps by ROUGHER."""
+    if t.size > POLLED_ROWS:
+        return t, None
     head = t[:COMB_ROWS]  # the comb on the first rows (its cost grows as their count squared), the search
     steps, span, centre = np.diff(head), head[-1] - head[0], 0.5 * (head[0] + head[-1])  # below over every row
     middle = (0.5 * (head[1:] + head[:-1]) - centre)[steps < np.quantile(steps, 0.3)]
