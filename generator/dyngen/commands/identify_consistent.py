@@ -14,7 +14,7 @@ def run_consistent(args, robot, model, signals, progress, out: Path) -> int:
     """signals: identification.blocks.Source of every --data recording (commands/recordings.py); `out`: the
     YAML to write, already checked against the output-path policy (identify.py)."""
     from ..atomic import write_file
-    from ..data.parameters_file import read_link_parameters
+    from ..data.parameters_file import prior_or_nominal, read_link_parameters
     from ..export import write_all
     from ..identification.consistent import ConsistentOptions, identify_consistent
     from ..identification.consistent_output import consistent_table, consistent_yaml, summary_lines
@@ -26,10 +26,7 @@ def run_consistent(args, robot, model, signals, progress, out: Path) -> int:
     if args.prior:
         options = replace(options, prior=read_link_parameters(args.prior, robot.dof))
     select = read_sources(args.select, robot, args) if args.select else None
-    import numpy as np
-
-    prior = options.prior if options.prior is not None else (
-        np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
+    prior = prior_or_nominal(options.prior, robot)
     # --- hook (data/trust.py): a recording whose nominal residual exceeds its torque is conditioned again, or
     # nothing is fitted nor written (exit 3)
     from ..data.trust import EXIT_UNUSABLE, Unusable

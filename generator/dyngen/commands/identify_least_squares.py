@@ -74,23 +74,21 @@ def _trusted(args, robot, model, tasks):
     Raises trust.Unusable."""
     import dataclasses
 
-    import numpy as np
-
     from ..catalogue import STANDARD_FROM_DYNAMIC
     from ..data import condition
-    from ..data.parameters_file import read_link_parameters
+    from ..data.parameters_file import prior_or_nominal, read_link_parameters
     from ..data.trust import checked
     from ..streaming.sample import windows
     from .recordings import long_enough
 
-    prior = read_link_parameters(args.prior, robot.dof) if getattr(args, "prior", None) else (
-        np.array([v for link in robot.nominal for v in link.as_tuple()]) if robot.nominal is not None else None)
+    prior = prior_or_nominal(read_link_parameters(args.prior, robot.dof) if getattr(args, "prior", None) else None,
+                             robot)
     if prior is None or tasks[0].kind == "inertia":
         return tasks, []
     pieces = [[condition(w, task.conditioning) for w in long_enough(windows(task.path, task.dof, task.bag))]
               for task in tasks]
     said = {id(w): len(w.warnings) for group in pieces for w in group}
-    done = iter(checked(model, model(STANDARD_FROM_DYNAMIC.name, np.asarray(prior, dtype=float)),
+    done = iter(checked(model, model(STANDARD_FROM_DYNAMIC.name, prior),
                         [w for group in pieces for w in group], "identification"))
     out, warnings = [], []
     for task, group in zip(tasks, pieces):

@@ -42,8 +42,7 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
         return
     blocks = _parquet_blocks(path, rows) if kind == "parquet" else _csv_blocks(path, rows)
     name = Path(path).name
-    where_header = "columns" if kind == "parquet" else "line 1 (header)"
-    header = next(blocks)
+    header, where_header = next(blocks)
     columns = check_header(name, header, dof, require_torques, required, where_header)
     last, total, base, head = None, 0, None, None
     for start, data, where in blocks:
@@ -62,7 +61,7 @@ def chunks(path, dof: int, require_torques: bool = True, required: tuple = (), r
 
 
 def _csv_blocks(path, rows: int):
-    """The header, then (first row, (k, columns) values, where) per block of CSV lines."""
+    """(The header, where it is), then (first row, (k, columns) values, where) per block of CSV lines."""
     path = Path(path)
     name = path.name
     regular_file(path, MAX_CSV_BYTES)
@@ -86,7 +85,7 @@ def _csv_blocks(path, rows: int):
             offset = sum(len(x) for x in ahead[:used])
             header = _header(name, header_line, used)  # the whole-file reader's bounds and message
             trailing = header_line.rstrip().endswith(",")
-            yield header
+            yield header, f"line {used} (header)"
             first, start, pending = used + 1, 0, ahead[used:]
             while True:
                 chunk = pending + list(islice(lines_of, rows - len(pending)))
@@ -161,6 +160,6 @@ class _Bounded(io.RawIOBase):
 
 def _parquet_blocks(path, rows: int):
     header, batches = columnar.parquet_batches(path, rows)
-    yield header
+    yield header, "columns"
     for start, data in batches:
         yield start, data, columnar.parquet_row

@@ -53,3 +53,11 @@ def _number(value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise TypeError
     return float(value)
+
+
+def prior_or_nominal(prior, robot):
+    """The link parameters a recording is judged against (data/trust.py): `prior` where given, else the
+    robot's parameters.nominal, else None."""
+    if prior is not None:
+        return np.asarray(prior, dtype=float)
+    return None if robot.nominal is None else np.array([v for link in robot.nominal for v in link.as_tuple()])
